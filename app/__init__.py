@@ -1,0 +1,1 @@
+"""FeelFlow app package."""

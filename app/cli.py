@@ -1,0 +1,70 @@
+"""The `feelflow` command line (also `python -m app`).
+
+Each sub-command lives in `app/commands/<name>.py` with `add_arguments(parser)` and
+`main(args) -> int`. Errors a user can cause are reported as one line on stderr with exit 2;
+no tracebacks reach the user.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+#: sub-command -> one-line help
+COMMANDS = {
+    "gui": "open the wind-tunnel window (the default)",
+    "run": "run a scene headless and write forces as CSV",
+    "validate": "run the physics validation cases and print a table",
+    "bench": "measure solver speed (both backends) or the haptic loop",
+    "devices": "list haptic devices: serial ports, HID devices, simulators",
+    "report": "reproduce the seed's experiments and write a Markdown report",
+}
+
+
+class UserError(Exception):
+    """Bad input from the user (scene, file, parameter): printed as one line, exit code 2."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="feelflow", description="FeelFlow: a desktop wind tunnel you can touch")
+    parser.add_argument("--selftest", action="store_true",
+                        help="open the real window, exercise it and exit 0 only if everything worked")
+    parser.add_argument("--screenshot", metavar="PATH", help="with --selftest: save a screenshot")
+    parser.add_argument("--seconds", type=float, default=8.0, help="with --selftest: how long to run")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, help_ in COMMANDS.items():
+        p = sub.add_parser(name, help=help_, description=help_)
+        try:
+            module = importlib.import_module(f"app.commands.{name}")
+        except ModuleNotFoundError as exc:  # command not built yet
+            if exc.name != f"app.commands.{name}":
+                raise
+            p.set_defaults(_missing=name)
+            continue
+        module.add_arguments(p)
+        p.set_defaults(_module=module)
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.selftest:
+        args.command = "gui"
+    if args.command is None:
+        args.command = "gui"
+        args = parser.parse_args(["gui", *(argv if argv is not None else sys.argv[1:])])
+    if getattr(args, "_missing", None):
+        print(f"feelflow: '{args.command}' is not available in this version", file=sys.stderr)
+        return 2
+    try:
+        return int(args._module.main(args) or 0)
+    except UserError as exc:
+        print(f"feelflow: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""Sub-commands of `feelflow`, one module each (see app/cli.py)."""

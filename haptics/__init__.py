@@ -1,0 +1,1 @@
+"""FeelFlow haptics package."""

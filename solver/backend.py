@@ -1,0 +1,86 @@
+"""One solver interface, two backends (`numpy`, `gl`), chosen by an explicit registry.
+
+A backend implements docs/algorithm.md. Physics tests are parametrised over `BACKENDS`.
+"""
+from __future__ import annotations
+
+import importlib
+from abc import ABC, abstractmethod
+
+import numpy as np
+
+from solver.config import FlowConfig
+
+#: backend name -> "module:Class"; no silent fallback from one to the other
+BACKENDS: dict[str, str] = {
+    "numpy": "solver.numpy_backend:NumpySolver",
+    "gl": "solver.gl_backend:GLSolver",
+}
+
+
+class BackendError(RuntimeError):
+    """The backend cannot run here (no GL context, unsupported feature); the message says why."""
+
+
+class Solver(ABC):
+    """A D2Q9 lattice with at most one rigid body (docs/algorithm.md)."""
+
+    name: str = "abstract"
+
+    def __init__(self, config: FlowConfig):
+        self.config = config.validate()
+        self.time = 0  # steps done
+
+    # --- body -----------------------------------------------------------------
+    @abstractmethod
+    def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
+        """Place the body (a `shapes` shape at its pose, or None) moving at `velocity`,
+        rotating at `omega`; covers/uncovers nodes and books their momentum (algorithm.md)."""
+
+    # --- stepping -------------------------------------------------------------
+    @abstractmethod
+    def step(self, n: int = 1) -> None:
+        """Advance n steps; evaluate the enabled force models on each."""
+
+    # --- forces ---------------------------------------------------------------
+    @abstractmethod
+    def enable_force_models(self, names) -> None:
+        """Compute only these models (names from `solver.forces.MODELS`)."""
+
+    @abstractmethod
+    def forces(self) -> dict[str, tuple[float, float]]:
+        """Mean force per model over the last `step(n)` call, lattice units."""
+
+    # --- fields ---------------------------------------------------------------
+    @abstractmethod
+    def distributions(self) -> np.ndarray:
+        """Full (unshifted) post-collision populations f*, float64 array (9, ny, nx)."""
+
+    @abstractmethod
+    def set_distributions(self, f: np.ndarray) -> None:
+        """Replace the state with full populations f (9, ny, nx)."""
+
+    def macroscopic(self):
+        """(rho, ux, uy), each (ny, nx) float64, from the stored populations."""
+        from solver.lattice import C
+
+        f = self.distributions()
+        rho = f.sum(axis=0)
+        ux = np.tensordot(C[:, 0].astype(float), f, axes=1) / rho
+        uy = np.tensordot(C[:, 1].astype(float), f, axes=1) / rho
+        return rho, ux, uy
+
+    def total_mass(self) -> float:
+        return float(self.distributions().sum())
+
+    def close(self) -> None:
+        """Release resources (GL objects); the solver is unusable after."""
+
+
+def create_solver(backend: str, config: FlowConfig, **kwargs) -> Solver:
+    """Instantiate a backend by name; `gl` needs `ctx=` (a moderngl.Context)."""
+    if backend not in BACKENDS:
+        raise BackendError(f"unknown backend {backend!r}; choose one of {sorted(BACKENDS)}")
+    module_name, cls_name = BACKENDS[backend].split(":")
+    cls = getattr(importlib.import_module(module_name), cls_name)
+    return cls(config, **kwargs)

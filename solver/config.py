@@ -1,0 +1,86 @@
+"""Flow configuration: everything a backend needs to set up the lattice, validated.
+
+Units are lattice units (dx = dt = 1). `solver/units.py` converts to what a student reads.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from solver.lattice import CS2
+
+X_BOUNDARIES = ("tunnel", "periodic")
+Y_BOUNDARIES = ("no_slip", "free_slip", "periodic")
+COLLISIONS = ("bgk", "trt")
+PROFILES = ("uniform", "parabolic")
+DTYPES = ("float64", "float32")
+
+
+class ConfigError(ValueError):
+    """A configuration value is out of range; `key` names it, the message says why."""
+
+    def __init__(self, key: str, message: str):
+        super().__init__(f"{key}: {message}")
+        self.key = key
+
+
+@dataclass(frozen=True)
+class FlowConfig:
+    nx: int
+    ny: int
+    nu: float = 0.02
+    collision: str = "trt"
+    trt_magic: float = 3.0 / 16.0
+    dtype: str = "float64"
+    x_boundary: str = "tunnel"
+    y_boundary: str = "no_slip"
+    inflow_speed: float = 0.05
+    inflow_profile: str = "uniform"
+    inflow_ramp_steps: int = 1000
+    body_force: tuple[float, float] = (0.0, 0.0)
+    sponge_cells: int = 0
+    sponge_strength: float = 10.0
+    initial_velocity: tuple[float, float] = (0.0, 0.0)
+    mach_limit: float = 0.17
+    extra: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def tau(self) -> float:
+        """BGK relaxation time, nu = (tau - 1/2) c_s^2 (seed eq. 5)."""
+        return self.nu / CS2 + 0.5
+
+    @property
+    def max_speed(self) -> float:
+        """Largest speed allowed anywhere (body or inflow): mach_limit * c_s."""
+        return self.mach_limit * math.sqrt(CS2)
+
+    def validate(self) -> "FlowConfig":
+        def need(ok: bool, key: str, msg: str):
+            if not ok:
+                raise ConfigError(key, msg)
+
+        for key in ("nx", "ny"):
+            v = getattr(self, key)
+            need(isinstance(v, int) and 8 <= v <= 8192, key, f"must be an integer in 8..8192, got {v!r}")
+        need(math.isfinite(self.nu) and self.nu > 0, "nu", f"must be a positive number, got {self.nu!r}")
+        need(self.tau > 0.5 + 1e-6, "nu", "too small: tau = 3 nu + 1/2 must exceed 1/2")
+        need(self.tau < 10, "nu", f"too large (tau = {self.tau:.2f} > 10): lower the viscosity or raise the resolution")
+        need(self.collision in COLLISIONS, "collision", f"must be one of {COLLISIONS}, got {self.collision!r}")
+        need(0 < self.trt_magic < 10, "trt_magic", f"must be in (0, 10), got {self.trt_magic!r}")
+        need(self.dtype in DTYPES, "dtype", f"must be one of {DTYPES}, got {self.dtype!r}")
+        need(self.x_boundary in X_BOUNDARIES, "x_boundary", f"must be one of {X_BOUNDARIES}, got {self.x_boundary!r}")
+        need(self.y_boundary in Y_BOUNDARIES, "y_boundary", f"must be one of {Y_BOUNDARIES}, got {self.y_boundary!r}")
+        need(self.inflow_profile in PROFILES, "inflow_profile", f"must be one of {PROFILES}, got {self.inflow_profile!r}")
+        need(0 < self.mach_limit <= 0.5, "mach_limit", f"must be in (0, 0.5], got {self.mach_limit!r}")
+        need(math.isfinite(self.inflow_speed) and abs(self.inflow_speed) <= self.max_speed, "inflow_speed",
+             f"{self.inflow_speed!r} exceeds the Mach limit: |U| <= {self.max_speed:.4f} (Ma {self.mach_limit})")
+        need(isinstance(self.inflow_ramp_steps, int) and self.inflow_ramp_steps >= 0, "inflow_ramp_steps",
+             "must be a non-negative integer")
+        need(isinstance(self.sponge_cells, int) and 0 <= self.sponge_cells < self.nx // 2, "sponge_cells",
+             f"must be an integer in 0..{self.nx // 2 - 1}")
+        need(self.sponge_strength >= 1, "sponge_strength", "must be >= 1")
+        for key in ("body_force", "initial_velocity"):
+            v = getattr(self, key)
+            need(len(v) == 2 and all(math.isfinite(c) for c in v), key, "must be two finite numbers")
+        need(math.hypot(*self.initial_velocity) <= self.max_speed, "initial_velocity", "exceeds the Mach limit")
+        return self

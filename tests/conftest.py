@@ -1,0 +1,34 @@
+"""Shared fixtures: a real EGL (llvmpipe) GL context, backend parametrisation, temp caches."""
+from __future__ import annotations
+
+import os
+import tempfile
+
+import pytest
+
+# Mesa's shader cache and Qt's caches go to a temp dir, never the user's home (shared/notes).
+_cache = tempfile.mkdtemp(prefix="feelflow-test-cache-")
+os.environ.setdefault("MESA_SHADER_CACHE_DIR", _cache)
+os.environ.setdefault("XDG_CACHE_HOME", _cache)
+
+
+@pytest.fixture(scope="session")
+def gl_context():
+    """A standalone EGL OpenGL 3.3 core context (llvmpipe where there is no GPU)."""
+    moderngl = pytest.importorskip("moderngl")
+    try:
+        ctx = moderngl.create_context(standalone=True, backend="egl", require=330)
+    except Exception as exc:  # no EGL on this machine: the gl tier cannot run
+        pytest.fail(f"EGL standalone context unavailable: {exc}")
+    yield ctx
+    ctx.release()
+
+
+def make_solver(backend: str, config, request=None):
+    """Create a solver of the named backend; gl gets the session EGL context."""
+    from solver.backend import create_solver
+
+    if backend == "gl":
+        ctx = request.getfixturevalue("gl_context")
+        return create_solver("gl", config, ctx=ctx)
+    return create_solver(backend, config)
