@@ -1,0 +1,24 @@
+"""`feelflow bench [solver|haptics]`: speed of the solver backends, or of the haptic loop.
+
+The solver bench lives in `app/commands/bench_solver.py`, the haptic one in
+`app/commands/bench_haptics.py`; this module only dispatches.
+"""
+from __future__ import annotations
+
+import importlib
+
+TARGETS = {"solver": "app.commands.bench_solver", "haptics": "app.commands.bench_haptics"}
+
+
+def add_arguments(parser):
+    parser.add_argument("target", nargs="?", default="solver", choices=sorted(TARGETS),
+                        help="what to measure (default: solver)")
+    parser.add_argument("--json", metavar="PATH", help="also write the results as JSON")
+    parser.add_argument("--device", metavar="URL", default="sim://haply2diy",
+                        help="haptics: the device to run the loop against (default: a simulator)")
+    parser.add_argument("--seconds", type=float, default=None, help="how long to measure")
+    parser.add_argument("--quick", action="store_true", help="solver: fewer steps (smoke test)")
+
+
+def main(args) -> int:
+    return importlib.import_module(TARGETS[args.target]).main(args)

@@ -1,0 +1,1 @@
+"""Force models (one module each) behind one interface (solver/forces/base.py)."""

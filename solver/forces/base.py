@@ -1,0 +1,54 @@
+"""The interface every force model shares: a model sees only the body's neighbourhood.
+
+Both backends hand the same `BodyWindow` (numpy arrays) to the same model code, so forces agree
+between backends by construction (docs/algorithm.md, 'Forces').
+"""
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.config import FlowConfig
+
+
+@dataclass
+class BodyWindow:
+    """The state around the body at the start of a step (before t -> t+1).
+
+    x0, y0: grid index of the window's lower-left node; arrays are [.., iy - y0, ix - x0].
+    f: (9, h, w) full post-collision populations f*(t), float64.
+    solid, q: the body raster cut to the window (q as in shapes.BodyRaster).
+    shape: the body (a shapes.Shape at its current pose); velocity (vx, vy); omega.
+    impulse: (Jx, Jy) cover/uncover momentum booked for this step.
+    config: the flow configuration (inflow, viscosity, boundaries).
+    fluid_in_domain: (h, w) bool, True for fluid nodes (False for solid and nothing else:
+        the window never extends outside the domain; the body is kept away from its edges).
+    """
+
+    x0: int
+    y0: int
+    f: np.ndarray
+    solid: np.ndarray
+    q: np.ndarray
+    shape: object
+    velocity: tuple[float, float]
+    omega: float
+    impulse: tuple[float, float]
+    config: FlowConfig
+
+    @property
+    def fluid(self) -> np.ndarray:
+        return ~self.solid
+
+
+class ForceModel(ABC):
+    """A way to compute the force of the fluid on the body, lattice units per step."""
+
+    name: str = "abstract"
+    description: str = ""
+
+    @abstractmethod
+    def compute(self, window: BodyWindow) -> tuple[float, float]:
+        """(F_x, F_y) on the body for this step."""
