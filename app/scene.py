@@ -97,8 +97,9 @@ class _Table:
         if isinstance(v, bool) or not isinstance(v, int):
             self.reader.fail(self.key(key), f"must be an integer, got {_show(v)}")
         if (lo is not None and v < lo) or (hi is not None and v > hi):
-            rng = f"{lo if lo is not None else '-inf'}..{hi if hi is not None else 'inf'}"
-            self.reader.fail(self.key(key), f"must be an integer in {rng}, got {v}")
+            rng = f"in {lo}..{hi}" if lo is not None and hi is not None else (
+                f">= {lo}" if lo is not None else f"<= {hi}")
+            self.reader.fail(self.key(key), f"must be an integer {rng}, got {v}")
         return v
 
     def number(self, key, default=MISSING, positive=False, nonnegative=False):
@@ -268,47 +269,56 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
                  reference_length=length, reference_speed=speed)
 
 
+#: shape parameters that are angles: radians in `shapes`, degrees in scene files
+ANGLE_KEYS = ("angle", "apex_angle")
+
+
 def _body(reader: _Reader, table: _Table, nx: int, ny: int):
     from shapes.base import ShapeError
-    from shapes.io import from_dict
+    from shapes.io import KINDS, from_dict
 
-    kind = table.raw("kind")
-    if not isinstance(kind, str):
-        reader.fail("body.kind", f"must be a shape name, got {_show(kind)}")
-    x = table.number("x")
-    y = table.number("y")
-    angle_deg = table.number("angle", 0.0)
-    params = {k: v for k, v in table.data.items() if k not in ("kind", "x", "y", "angle")}
-    table.used.update(params)
-    description = {"kind": kind, "x": x, "y": y, "angle": math.radians(angle_deg), **params}
+    kind = table.choice("kind", list(KINDS))
+    _, required, optional = KINDS[kind]
+    description = {"kind": kind, "x": table.number("x"), "y": table.number("y"),
+                   "angle": math.radians(table.number("angle", 0.0))}
+    for key in required + tuple(optional):
+        if key == "vertices":
+            value = table.raw(key)
+            if not isinstance(value, list) or not all(
+                    isinstance(v, list) and len(v) == 2
+                    and all(not isinstance(c, bool) and isinstance(c, (int, float)) for c in v) for v in value):
+                reader.fail("body.vertices", f"must be a list of [x, y] number pairs, got {_show(value)}")
+            description[key] = [[float(c) for c in v] for v in value]
+        elif key in optional and isinstance(optional[key], str):
+            description[key] = table.choice(key, _string_choices(kind, key), optional[key])
+        elif key in ANGLE_KEYS:
+            description[key] = math.radians(table.number(key, optional.get(key, MISSING), positive=True))
+        else:
+            description[key] = table.number(key, optional.get(key, MISSING), positive=True)
+    table.done()
     try:
         shape = from_dict(description)
         shape.validate(nx, ny)
     except ShapeError as exc:
-        reader.fail(_shape_key(kind, params, str(exc)), _shape_message(kind, params, str(exc)))
-    except TypeError as exc:  # a parameter the shape does not have, or one it needs
-        text = str(exc)
-        m = re.search(r"unexpected keyword argument '(\w+)'", text)
-        if m:
-            reader.fail(f"body.{m.group(1)}", f"unknown key for a {kind} (see docs/scenes.md)")
-        m = re.search(r"required (?:positional |keyword-only )?arguments?: '(\w+)'", text)
-        if m:
-            reader.fail(f"body.{m.group(1)}", f"missing (required for a {kind})")
-        reader.fail("body", f"invalid {kind}: {text}")
+        message = str(exc).splitlines()[0]
+        reader.fail(_shape_key(description, message), message)
     return shape
 
 
-def _shape_key(kind: str, params: dict, message: str) -> str:
-    for name in sorted(params, key=len, reverse=True):
-        if re.search(rf"\b{re.escape(name)}\b", message):
+def _string_choices(kind: str, key: str) -> tuple[str, ...]:
+    from shapes import polygon
+
+    return {("wedge", "pointing"): polygon.WEDGE_POINTING}[(kind, key)]
+
+
+def _shape_key(description: dict, message: str) -> str:
+    """The scene key a shape error is about (its message names the parameter)."""
+    for name in sorted(description, key=len, reverse=True):
+        if name != "kind" and re.search(rf"\b{re.escape(name)}\b", message):
             return f"body.{name}"
-    if re.search(r"\bkind\b|unknown shape", message):
-        return "body.kind"
+    if "vertices" in description and re.search(r"vert|edge|self-intersect|area", message):
+        return "body.vertices"
     return "body"
-
-
-def _shape_message(kind: str, params: dict, message: str) -> str:
-    return message.splitlines()[0] if message else f"invalid {kind}"
 
 
 def _phases(reader: _Reader, motion, inflow_speed: float) -> list[Phase]:

@@ -12,7 +12,10 @@ import os
 import sys
 import tempfile
 import time
+import warnings
 from pathlib import Path
+
+import numpy as np
 
 from app.cli import UserError
 
@@ -60,7 +63,6 @@ def _fmt(v: float) -> str:
 
 def main(args) -> int:
     from app.headless import make_solver
-    from solver.motion import MotionRunner
     from app.scene import load_scene
 
     scene = load_scene(args.scene)
@@ -74,36 +76,17 @@ def main(args) -> int:
 
     solver = make_solver(backend, scene.config)
     try:
-        solver.enable_force_models(scene.force_models)
-        runner = MotionRunner(solver, scene.body, scene.motion)
-        header = ["step", "x", "y", "vx", "vy"]
-        for m in scene.force_models:
-            header += [f"fx_{m}", f"fy_{m}"]
-        rows = []
-        start = time.perf_counter()
-        diverged_at = None
-        while runner.t < steps:
-            n = min(scene.output_interval, steps - runner.t)
-            velocity = scene.motion.velocity_at(runner.t + n - 1)
-            forces = runner.advance(n)
-            x, y = runner.position
-            row = [runner.t, _fmt(x), _fmt(y), _fmt(velocity[0]), _fmt(velocity[1])]
-            values = []
-            for m in scene.force_models:
-                values += list(forces[m])
-            row += [_fmt(v) for v in values]
-            if not all(math.isfinite(v) for v in values) or not math.isfinite(solver.total_mass()):
-                diverged_at = runner.t
-                break
-            rows.append(row)
-        wall = time.perf_counter() - start
+        # a blow-up is detected and reported in one line, not as floating-point warnings
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)
+            header, rows, wall, diverged = run_scene(scene, solver, steps)
     finally:
         solver.close()
 
     write_csv_atomic(out, header, rows)
-    if diverged_at is not None:
-        print(f"feelflow: the simulation diverged (NaN) within steps {diverged_at - n}..{diverged_at}; "
-              f"{len(rows)} rows before it written to {out}. Lower the speeds or raise the viscosity "
+    if diverged is not None:
+        print(f"feelflow: the simulation diverged (NaN) within steps {diverged[0]}..{diverged[1]}; "
+              f"the {len(rows)} rows before it are in {out}. Lower the speeds or raise the viscosity "
               f"or the resolution.", file=sys.stderr)
         return 1
     cells = scene.config.nx * scene.config.ny
@@ -112,3 +95,35 @@ def main(args) -> int:
           f"Re {scene.reynolds:.4g} with L = {scene.reference_length:g} cells, U = {scene.reference_speed:g}, "
           f"Ma {scene.mach:.3f}); {wall:.1f} s, {mlups:.1f} MLUPS")
     return 0
+
+
+def run_scene(scene, solver, steps: int):
+    """Step `scene` in `solver` along its motion script for `steps` steps.
+
+    Returns (header, rows, wall seconds, None or (first, last) step of the interval in which the
+    flow diverged)."""
+    from solver import backend as backends
+    from solver.motion import MotionRunner
+
+    diverged_error = getattr(backends, "SolverDiverged", ())
+    solver.enable_force_models(scene.force_models)
+    runner = MotionRunner(solver, scene.body, scene.motion)
+    header = ["step", "x", "y", "vx", "vy"]
+    for m in scene.force_models:
+        header += [f"fx_{m}", f"fy_{m}"]
+    rows = []
+    start = time.perf_counter()
+    while runner.t < steps:
+        t0 = runner.t
+        n = min(scene.output_interval, steps - t0)
+        velocity = scene.motion.velocity_at(t0 + n - 1)
+        try:
+            forces = runner.advance(n)
+        except diverged_error:
+            return header, rows, time.perf_counter() - start, (t0, t0 + n)
+        values = [v for m in scene.force_models for v in forces[m]]
+        if not all(math.isfinite(v) for v in values) or not math.isfinite(solver.total_mass()):
+            return header, rows, time.perf_counter() - start, (t0, t0 + n)
+        x, y = runner.position
+        rows.append([runner.t] + [_fmt(v) for v in (x, y, *velocity, *values)])
+    return header, rows, time.perf_counter() - start, None

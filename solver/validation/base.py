@@ -23,7 +23,7 @@ class Check:
     source: str = ""
 
     def holds(self, value: float) -> bool:
-        return math.isfinite(value) and self.low <= value <= self.high
+        return bool(math.isfinite(value) and self.low <= value <= self.high)
 
     def describe(self) -> str:
         return f"{self.low:.6g} .. {self.high:.6g}"
