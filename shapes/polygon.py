@@ -54,6 +54,44 @@ def _segments_intersect(a, b, c, d) -> np.ndarray:
     return proper | touch
 
 
+def _flat_points(px, py):
+    """Points as (N, 1) columns for broadcasting against edges, and their original shape."""
+    px, py = np.broadcast_arrays(np.asarray(px, dtype=np.float64), np.asarray(py, dtype=np.float64))
+    return px.reshape(-1, 1), py.reshape(-1, 1), px.shape
+
+
+def edge_distance(qx, qy, ax, ay, ex, ey):
+    """Distance from points q to edges a -> a + e (element-wise, broadcasting)."""
+    len2 = ex * ex + ey * ey
+    wx, wy = qx - ax, qy - ay
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = np.clip((wx * ex + wy * ey) / len2, 0.0, 1.0)
+    t = np.where(len2 > 0.0, t, 0.0)
+    return np.hypot(wx - t * ex, wy - t * ey)
+
+
+def edge_crossing_x(qy, ax, ay, ex, ey):
+    """For the horizontal line y = qy: does edge a -> a + e straddle it (half-open rule), and at
+    which x (element-wise, broadcasting; x meaningless where it does not straddle)."""
+    straddle = (ay > qy) != ((ay + ey) > qy)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        xcross = ax + (qy - ay) * ex / ey
+    return straddle, xcross
+
+
+def link_edge_hit(px, py, dx, dy, ax, ay, ex, ey):
+    """Parameter t in (0, 1] where segment p -> p + d crosses edge a -> a + e, inf if it does not
+    (element-wise, broadcasting; parallel segments never cross)."""
+    denom = dx * ey - dy * ex
+    wx, wy = ax - px, ay - py
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = (wx * ey - wy * ex) / denom
+        s = (wx * dy - wy * dx) / denom
+    hit = ((denom != 0.0) & (t > 0.0) & (t <= 1.0 + _EDGE_SLACK)
+           & (s >= -_EDGE_SLACK) & (s <= 1.0 + _EDGE_SLACK))
+    return np.where(hit, t, np.inf)
+
+
 @dataclass(frozen=True, init=False)
 class PolygonalShape(Shape):
     """Geometry shared by every body whose boundary is a polygon; subclasses give local vertices."""
@@ -91,52 +129,39 @@ class PolygonalShape(Shape):
     # --- point and segment queries (vectorised over points x edges) -------------------------
     def boundary_distance(self, px, py):
         """Unsigned distance from points to the nearest edge."""
-        px = np.asarray(px, dtype=np.float64)
-        py = np.asarray(py, dtype=np.float64)
-        shape = np.broadcast(px, py).shape
-        qx = px.reshape(-1, 1)
-        qy = py.reshape(-1, 1)
+        qx, qy, shape = _flat_points(px, py)
         a, e = self._world, self._edges
-        len2 = (e * e).sum(axis=1)
-        wx, wy = qx - a[:, 0], qy - a[:, 1]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            t = np.clip((wx * e[:, 0] + wy * e[:, 1]) / len2, 0.0, 1.0)
-        t = np.where(len2 > 0.0, t, 0.0)
-        dist = np.hypot(wx - t * e[:, 0], wy - t * e[:, 1]).min(axis=1)
+        dist = edge_distance(qx, qy, a[:, 0], a[:, 1], e[:, 0], e[:, 1]).min(axis=1)
         return dist.reshape(shape)
 
     def contains(self, px, py):
         """Even-odd crossing test, with points within BOUNDARY_TOLERANCE of an edge inside."""
-        px = np.asarray(px, dtype=np.float64)
-        py = np.asarray(py, dtype=np.float64)
-        shape = np.broadcast(px, py).shape
-        qx = np.broadcast_to(px, shape).reshape(-1, 1)
-        qy = np.broadcast_to(py, shape).reshape(-1, 1)
+        qx, qy, shape = _flat_points(px, py)
         a, e = self._world, self._edges
-        ay, by = a[:, 1], a[:, 1] + e[:, 1]
-        straddle = (ay > qy) != (by > qy)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            xcross = a[:, 0] + (qy - ay) * e[:, 0] / e[:, 1]
+        straddle, xcross = edge_crossing_x(qy, a[:, 0], a[:, 1], e[:, 0], e[:, 1])
         inside = (np.count_nonzero(straddle & (qx < xcross), axis=1) % 2) == 1
-        inside = inside.reshape(shape)
-        return inside | (self.boundary_distance(px, py) <= BOUNDARY_TOLERANCE)
+        near = edge_distance(qx, qy, a[:, 0], a[:, 1], e[:, 0], e[:, 1]).min(axis=1) <= BOUNDARY_TOLERANCE
+        return (inside | near).reshape(shape)
 
     def segment_hit(self, px, py, dx, dy):
         px, py, dx, dy = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (px, py, dx, dy)))
         shape = px.shape
-        qx, qy = px.reshape(-1, 1), py.reshape(-1, 1)
-        ux, uy = dx.reshape(-1, 1), dy.reshape(-1, 1)
         a, e = self._world, self._edges
-        denom = ux * e[:, 1] - uy * e[:, 0]
-        wx, wy = a[:, 0] - qx, a[:, 1] - qy
-        with np.errstate(invalid="ignore", divide="ignore"):
-            t = (wx * e[:, 1] - wy * e[:, 0]) / denom
-            s = (wx * uy - wy * ux) / denom
-        hit = ((denom != 0.0) & (t > 0.0) & (t <= 1.0 + _EDGE_SLACK)
-               & (s >= -_EDGE_SLACK) & (s <= 1.0 + _EDGE_SLACK))
-        first = np.where(hit, t, np.inf).min(axis=1)
+        t = link_edge_hit(px.reshape(-1, 1), py.reshape(-1, 1), dx.reshape(-1, 1), dy.reshape(-1, 1),
+                          a[:, 0], a[:, 1], e[:, 0], e[:, 1])
+        first = t.min(axis=1)
         first = np.where(np.isfinite(first), np.minimum(first, 1.0), 0.0)
         return first.reshape(shape)
+
+    def edge_pieces(self, max_length: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """Edges cut into pieces no longer than `max_length`: (edge index (k,), piece midpoints (k, 2))."""
+        e = self._edges
+        length = np.hypot(e[:, 0], e[:, 1])
+        pieces = np.maximum(1, np.ceil(length / max_length)).astype(np.int64)
+        edge = np.repeat(np.arange(len(length)), pieces)
+        k = np.arange(edge.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+        frac = (k + 0.5) / pieces[edge]
+        return edge, self._world[edge] + frac[:, None] * e[edge]
 
     # --- geometry for drawing and forces ------------------------------------------------------
     def outline(self) -> np.ndarray:

@@ -90,3 +90,17 @@ def test_save_replaces_existing_file(tmp_path):
     save_shape(path, Cylinder(8))
     save_shape(path, FlatPlate(10, 1))
     assert load_shape(path) == FlatPlate(10, 1)
+
+
+def test_examples_in_docs_parse():
+    """Every JSON example in docs/shapes.md is a valid shape or shape file."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "shapes.md").read_text()
+    blocks = [b.split("```", 1)[0] for b in text.split("```json\n")[1:]]
+    one_line = [ln for ln in blocks[0].splitlines() if ln.strip()]
+    assert len(one_line) == 5
+    assert {from_dict(json.loads(ln)).kind for ln in one_line} == {
+        "cylinder", "plate", "wedge", "half_airfoil", "polygon"}
+    doc = json.loads(blocks[1])
+    assert doc["format"] == "feelflow-shape" and from_dict(doc["shape"]).kind == "half_airfoil"
