@@ -207,37 +207,41 @@ class PolygonalShape(Shape):
             raise ShapeError(f"{self.kind} has a repeated vertex ({v[i, 0]:g}, {v[i, 1]:g})")
         scale = float(np.ptp(v, axis=0).max())
         rel = v - v[0]
-        spread = np.abs(rel[:, None, 0] * rel[None, :, 1] - rel[:, None, 1] * rel[None, :, 0]).max()
+        far = rel[np.argmax(np.hypot(rel[:, 0], rel[:, 1]))]
+        spread = np.abs(rel[:, 0] * far[1] - rel[:, 1] * far[0]).max()  # all on one line: 0
         if spread <= 1e-12 * scale * scale:
             raise ShapeError(f"{self.kind} has zero area (its vertices are collinear)")
-        b = np.roll(v, -1, axis=0)
-        i, j = np.triu_indices(n, k=2)
-        keep = ~((i == 0) & (j == n - 1))  # first and last edges are neighbours
-        i, j = i[keep], j[keep]
-        crossing = _segments_intersect(v[i], b[i], v[j], b[j])
         # neighbouring edges meet at their shared vertex; they must not fold back onto each other
         en = np.roll(e, -1, axis=0)
         folded = (e[:, 0] * en[:, 1] - e[:, 1] * en[:, 0] == 0.0) & ((e * en).sum(axis=1) < 0.0)
-        if np.any(crossing) or np.any(folded):
+        if np.any(folded):
+            k = int(np.argmax(folded))
+            raise ShapeError(f"{self.kind} is self-intersecting (edges {k} and {(k + 1) % n} fold back)")
+        # other edge pairs must not meet at all; in blocks of edges to bound memory
+        b = np.roll(v, -1, axis=0)
+        block = max(1, 1_000_000 // n)
+        for start in range(0, n, block):
+            i, j = np.meshgrid(np.arange(start, min(n, start + block)), np.arange(n), indexing="ij")
+            keep = (j >= i + 2) & ~((i == 0) & (j == n - 1))  # first and last edges are neighbours
+            i, j = i[keep], j[keep]
+            crossing = _segments_intersect(v[i], b[i], v[j], b[j])
             if np.any(crossing):
                 k = int(np.argmax(crossing))
-                where = f"edges {i[k]} and {j[k]} cross"
-            else:
-                where = f"edges {int(np.argmax(folded))} and {(int(np.argmax(folded)) + 1) % n} fold back"
-            raise ShapeError(f"{self.kind} is self-intersecting ({where})")
+                raise ShapeError(f"{self.kind} is self-intersecting (edges {i[k]} and {j[k]} cross)")
         if self.area <= 1e-12 * scale * scale:
             raise ShapeError(f"{self.kind} has zero area")
 
     def validate(self, nx=None, ny=None):
         check_pose(self)
-        self.check_parameters()
-        self.check_polygon()
+        if self.user_vertices:
+            self.check_polygon()
         check_extent(self)
         check_in_domain(self, nx, ny)
         return self
 
-    def check_parameters(self) -> None:
-        """Parameter checks of parametric subclasses (already done on construction)."""
+    #: True when the vertices come from the user (checked by validate); parametric bodies are
+    #: simple polygons by construction once their parameters passed the constructor's checks
+    user_vertices = False
 
 
 def _vertex_tuple(vertices) -> tuple[tuple[float, float], ...]:
@@ -262,6 +266,7 @@ class Polygon(PolygonalShape):
     vertices: tuple = ()
 
     kind = "polygon"
+    user_vertices = True
 
     def __init__(self, vertices, x=0.0, y=0.0, angle=0.0):
         object.__setattr__(self, "vertices", _vertex_tuple(vertices))
