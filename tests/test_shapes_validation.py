@@ -103,3 +103,9 @@ def test_many_vertex_polygon_validates():
     th[500] = th[10]                            # one vertex jumps back across the circle
     with pytest.raises(ShapeError, match="self-intersecting"):
         Polygon(np.column_stack([100 * np.cos(th), 100 * np.sin(th)])).validate()
+
+
+@pytest.mark.parametrize("direction", [(0, 0), (1, math.nan), "east", (1, 2, 3)])
+def test_bad_flow_direction(direction):
+    _refused(lambda: Cylinder(8).frontal_area(direction), "flow direction")
+    _refused(lambda: FlatPlate(8, 1).frontal_area(direction), "flow direction")
