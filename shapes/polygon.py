@@ -194,15 +194,16 @@ class PolygonalShape(Shape):
         first = np.where(np.isfinite(first), np.minimum(first, 1.0), 0.0)
         return first.reshape(shape)
 
-    def edge_pieces(self, max_length: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-        """Edges cut into pieces no longer than `max_length`: (edge index (k,), piece midpoints (k, 2))."""
+    def edge_pieces(self, max_length: float = 1.0):
+        """Edges cut into equal pieces no longer than `max_length`: (edge index (k,), piece
+        midpoints (k, 2), piece lengths (k,)); zero-length edges are skipped."""
         e = self._edges
         length = np.hypot(e[:, 0], e[:, 1])
-        pieces = np.maximum(1, np.ceil(length / max_length)).astype(np.int64)
+        pieces = np.where(length > 0.0, np.maximum(1, np.ceil(length / max_length)), 0).astype(np.int64)
         edge = np.repeat(np.arange(len(length)), pieces)
         k = np.arange(edge.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)
         frac = (k + 0.5) / pieces[edge]
-        return edge, self._world[edge] + frac[:, None] * e[edge]
+        return edge, self._world[edge] + frac[:, None] * e[edge], (length[edge] / pieces[edge])
 
     # --- geometry for drawing and forces ------------------------------------------------------
     def outline(self) -> np.ndarray:
@@ -215,18 +216,9 @@ class PolygonalShape(Shape):
 
     def surface_elements(self, spacing: float = 0.5):
         """Each edge cut into ceil(length/spacing) equal pieces: midpoints, outward normals, lengths."""
-        spacing = positive_number("surface element spacing", spacing)
-        e = self._edges
-        length = np.hypot(e[:, 0], e[:, 1])
-        keep = length > 0.0
-        a, e, length = self._world[keep], e[keep], length[keep]
-        pieces = np.maximum(1, np.ceil(length / spacing)).astype(np.int64)
-        edge = np.repeat(np.arange(len(length)), pieces)
-        k = np.arange(edge.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)
-        frac = (k + 0.5) / pieces[edge]
-        points = a[edge] + frac[:, None] * e[edge]
-        normals = np.column_stack([e[:, 1], -e[:, 0]])[edge] / length[edge, None]
-        lengths = (length / pieces)[edge]
+        edge, points, lengths = self.edge_pieces(positive_number("surface element spacing", spacing))
+        e = self._edges[edge]
+        normals = np.column_stack([e[:, 1], -e[:, 0]]) / np.hypot(e[:, 0], e[:, 1])[:, None]
         return points, normals, lengths
 
     def bounding_box(self):
