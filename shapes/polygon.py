@@ -15,8 +15,8 @@ from functools import lru_cache
 import numpy as np
 
 from shapes.base import Shape, ShapeError
-from shapes.cylinder import unit_direction
-from shapes.validation import check_extent, check_in_domain, check_pose, finite_number, positive_number
+from shapes.validation import (check_extent, check_in_domain, check_pose, finite_number, positive_number,
+                               unit_direction)
 
 #: points closer than this to an edge count as on the boundary (and so inside)
 BOUNDARY_TOLERANCE = 1e-9
@@ -52,6 +52,85 @@ def _segments_intersect(a, b, c, d) -> np.ndarray:
     touch = (((d1 == 0) & on_segment(c, d, a)) | ((d2 == 0) & on_segment(c, d, b))
              | ((d3 == 0) & on_segment(a, b, c)) | ((d4 == 0) & on_segment(a, b, d)))
     return proper | touch
+
+
+def _flat_points(px, py):
+    """Points as (N, 1) columns for broadcasting against edges, and their original shape."""
+    px, py = np.broadcast_arrays(np.asarray(px, dtype=np.float64), np.asarray(py, dtype=np.float64))
+    return px.reshape(-1, 1), py.reshape(-1, 1), px.shape
+
+
+def edge_distance(qx, qy, ax, ay, ex, ey):
+    """Distance from points q to edges a -> a + e (element-wise, broadcasting)."""
+    len2 = ex * ex + ey * ey
+    wx, wy = qx - ax, qy - ay
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = np.clip((wx * ex + wy * ey) / len2, 0.0, 1.0)
+    t = np.where(len2 > 0.0, t, 0.0)
+    return np.hypot(wx - t * ex, wy - t * ey)
+
+
+def edge_crossing_x(qy, ax, ay, ex, ey):
+    """For the horizontal line y = qy: does edge a -> a + e straddle it (half-open rule), and at
+    which x (element-wise, broadcasting; x meaningless where it does not straddle)."""
+    straddle = (ay > qy) != ((ay + ey) > qy)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        xcross = ax + (qy - ay) * ex / ey
+    return straddle, xcross
+
+
+def link_edge_hit(px, py, dx, dy, ax, ay, ex, ey):
+    """Parameter t in (0, 1] where segment p -> p + d crosses edge a -> a + e, inf if it does not
+    (element-wise, broadcasting; parallel segments never cross)."""
+    denom = dx * ey - dy * ex
+    wx, wy = ax - px, ay - py
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = (wx * ey - wy * ex) / denom
+        s = (wx * dy - wy * dx) / denom
+    hit = ((denom != 0.0) & (t > 0.0) & (t <= 1.0 + _EDGE_SLACK)
+           & (s >= -_EDGE_SLACK) & (s <= 1.0 + _EDGE_SLACK))
+    return np.where(hit, t, np.inf)
+
+
+@lru_cache(maxsize=256)
+def _polygon_problem(kind: str, vertices: tuple) -> str | None:
+    """What makes the polygon invalid (too few vertices, repeated vertex, zero area,
+    self-intersection), or None. O(n^2); cached, as the vertices do not change with the pose."""
+    v = np.array(vertices, dtype=np.float64)
+    n = len(v)
+    if n < 3:
+        return f"{kind} needs at least 3 vertices, got {n}"
+    e = np.roll(v, -1, axis=0) - v
+    length = np.hypot(e[:, 0], e[:, 1])
+    if np.any(length == 0.0):
+        i = int(np.argmax(length == 0.0))
+        return f"{kind} has a repeated vertex ({v[i, 0]:g}, {v[i, 1]:g})"
+    scale = float(np.ptp(v, axis=0).max())
+    rel = v - v[0]
+    far = rel[np.argmax(np.hypot(rel[:, 0], rel[:, 1]))]
+    spread = np.abs(rel[:, 0] * far[1] - rel[:, 1] * far[0]).max()  # all on one line: 0
+    if spread <= 1e-12 * scale * scale:
+        return f"{kind} has zero area (its vertices are collinear)"
+    # neighbouring edges meet at their shared vertex; they must not fold back onto each other
+    en = np.roll(e, -1, axis=0)
+    folded = (e[:, 0] * en[:, 1] - e[:, 1] * en[:, 0] == 0.0) & ((e * en).sum(axis=1) < 0.0)
+    if np.any(folded):
+        k = int(np.argmax(folded))
+        return f"{kind} is self-intersecting (edges {k} and {(k + 1) % n} fold back)"
+    # other edge pairs must not meet at all; in blocks of edges to bound memory
+    b = np.roll(v, -1, axis=0)
+    block = max(1, 1_000_000 // n)
+    for start in range(0, n, block):
+        i, j = np.meshgrid(np.arange(start, min(n, start + block)), np.arange(n), indexing="ij")
+        keep = (j >= i + 2) & ~((i == 0) & (j == n - 1))  # first and last edges are neighbours
+        i, j = i[keep], j[keep]
+        crossing = _segments_intersect(v[i], b[i], v[j], b[j])
+        if np.any(crossing):
+            k = int(np.argmax(crossing))
+            return f"{kind} is self-intersecting (edges {i[k]} and {j[k]} cross)"
+    if abs(polygon_area_centroid(v)[0]) <= 1e-12 * scale * scale:
+        return f"{kind} has zero area"
+    return None
 
 
 @dataclass(frozen=True, init=False)
@@ -91,52 +170,40 @@ class PolygonalShape(Shape):
     # --- point and segment queries (vectorised over points x edges) -------------------------
     def boundary_distance(self, px, py):
         """Unsigned distance from points to the nearest edge."""
-        px = np.asarray(px, dtype=np.float64)
-        py = np.asarray(py, dtype=np.float64)
-        shape = np.broadcast(px, py).shape
-        qx = px.reshape(-1, 1)
-        qy = py.reshape(-1, 1)
+        qx, qy, shape = _flat_points(px, py)
         a, e = self._world, self._edges
-        len2 = (e * e).sum(axis=1)
-        wx, wy = qx - a[:, 0], qy - a[:, 1]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            t = np.clip((wx * e[:, 0] + wy * e[:, 1]) / len2, 0.0, 1.0)
-        t = np.where(len2 > 0.0, t, 0.0)
-        dist = np.hypot(wx - t * e[:, 0], wy - t * e[:, 1]).min(axis=1)
+        dist = edge_distance(qx, qy, a[:, 0], a[:, 1], e[:, 0], e[:, 1]).min(axis=1)
         return dist.reshape(shape)
 
     def contains(self, px, py):
         """Even-odd crossing test, with points within BOUNDARY_TOLERANCE of an edge inside."""
-        px = np.asarray(px, dtype=np.float64)
-        py = np.asarray(py, dtype=np.float64)
-        shape = np.broadcast(px, py).shape
-        qx = np.broadcast_to(px, shape).reshape(-1, 1)
-        qy = np.broadcast_to(py, shape).reshape(-1, 1)
+        qx, qy, shape = _flat_points(px, py)
         a, e = self._world, self._edges
-        ay, by = a[:, 1], a[:, 1] + e[:, 1]
-        straddle = (ay > qy) != (by > qy)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            xcross = a[:, 0] + (qy - ay) * e[:, 0] / e[:, 1]
+        straddle, xcross = edge_crossing_x(qy, a[:, 0], a[:, 1], e[:, 0], e[:, 1])
         inside = (np.count_nonzero(straddle & (qx < xcross), axis=1) % 2) == 1
-        inside = inside.reshape(shape)
-        return inside | (self.boundary_distance(px, py) <= BOUNDARY_TOLERANCE)
+        near = edge_distance(qx, qy, a[:, 0], a[:, 1], e[:, 0], e[:, 1]).min(axis=1) <= BOUNDARY_TOLERANCE
+        return (inside | near).reshape(shape)
 
     def segment_hit(self, px, py, dx, dy):
         px, py, dx, dy = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (px, py, dx, dy)))
         shape = px.shape
-        qx, qy = px.reshape(-1, 1), py.reshape(-1, 1)
-        ux, uy = dx.reshape(-1, 1), dy.reshape(-1, 1)
         a, e = self._world, self._edges
-        denom = ux * e[:, 1] - uy * e[:, 0]
-        wx, wy = a[:, 0] - qx, a[:, 1] - qy
-        with np.errstate(invalid="ignore", divide="ignore"):
-            t = (wx * e[:, 1] - wy * e[:, 0]) / denom
-            s = (wx * uy - wy * ux) / denom
-        hit = ((denom != 0.0) & (t > 0.0) & (t <= 1.0 + _EDGE_SLACK)
-               & (s >= -_EDGE_SLACK) & (s <= 1.0 + _EDGE_SLACK))
-        first = np.where(hit, t, np.inf).min(axis=1)
+        t = link_edge_hit(px.reshape(-1, 1), py.reshape(-1, 1), dx.reshape(-1, 1), dy.reshape(-1, 1),
+                          a[:, 0], a[:, 1], e[:, 0], e[:, 1])
+        first = t.min(axis=1)
         first = np.where(np.isfinite(first), np.minimum(first, 1.0), 0.0)
         return first.reshape(shape)
+
+    def edge_pieces(self, max_length: float = 1.0):
+        """Edges cut into equal pieces no longer than `max_length`: (edge index (k,), piece
+        midpoints (k, 2), piece lengths (k,)); zero-length edges are skipped."""
+        e = self._edges
+        length = np.hypot(e[:, 0], e[:, 1])
+        pieces = np.where(length > 0.0, np.maximum(1, np.ceil(length / max_length)), 0).astype(np.int64)
+        edge = np.repeat(np.arange(len(length)), pieces)
+        k = np.arange(edge.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+        frac = (k + 0.5) / pieces[edge]
+        return edge, self._world[edge] + frac[:, None] * e[edge], (length[edge] / pieces[edge])
 
     # --- geometry for drawing and forces ------------------------------------------------------
     def outline(self) -> np.ndarray:
@@ -149,18 +216,9 @@ class PolygonalShape(Shape):
 
     def surface_elements(self, spacing: float = 0.5):
         """Each edge cut into ceil(length/spacing) equal pieces: midpoints, outward normals, lengths."""
-        spacing = positive_number("surface element spacing", spacing)
-        e = self._edges
-        length = np.hypot(e[:, 0], e[:, 1])
-        keep = length > 0.0
-        a, e, length = self._world[keep], e[keep], length[keep]
-        pieces = np.maximum(1, np.ceil(length / spacing)).astype(np.int64)
-        edge = np.repeat(np.arange(len(length)), pieces)
-        k = np.arange(edge.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)
-        frac = (k + 0.5) / pieces[edge]
-        points = a[edge] + frac[:, None] * e[edge]
-        normals = np.column_stack([e[:, 1], -e[:, 0]])[edge] / length[edge, None]
-        lengths = (length / pieces)[edge]
+        edge, points, lengths = self.edge_pieces(positive_number("surface element spacing", spacing))
+        e = self._edges[edge]
+        normals = np.column_stack([e[:, 1], -e[:, 0]]) / np.hypot(e[:, 0], e[:, 1])[:, None]
         return points, normals, lengths
 
     def bounding_box(self):
@@ -170,49 +228,23 @@ class PolygonalShape(Shape):
 
     # --- validation ---------------------------------------------------------------------------
     def check_polygon(self) -> None:
-        """Enough distinct vertices, non-zero area, no self-intersection (O(n^2), not per frame)."""
-        v = self._local
-        n = len(v)
-        if n < 3:
-            raise ShapeError(f"{self.kind} needs at least 3 vertices, got {n}")
-        e = np.roll(v, -1, axis=0) - v
-        length = np.hypot(e[:, 0], e[:, 1])
-        if np.any(length == 0.0):
-            i = int(np.argmax(length == 0.0))
-            raise ShapeError(f"{self.kind} has a repeated vertex ({v[i, 0]:g}, {v[i, 1]:g})")
-        scale = float(np.ptp(v, axis=0).max())
-        rel = v - v[0]
-        spread = np.abs(rel[:, None, 0] * rel[None, :, 1] - rel[:, None, 1] * rel[None, :, 0]).max()
-        if spread <= 1e-12 * scale * scale:
-            raise ShapeError(f"{self.kind} has zero area (its vertices are collinear)")
-        b = np.roll(v, -1, axis=0)
-        i, j = np.triu_indices(n, k=2)
-        keep = ~((i == 0) & (j == n - 1))  # first and last edges are neighbours
-        i, j = i[keep], j[keep]
-        crossing = _segments_intersect(v[i], b[i], v[j], b[j])
-        # neighbouring edges meet at their shared vertex; they must not fold back onto each other
-        en = np.roll(e, -1, axis=0)
-        folded = (e[:, 0] * en[:, 1] - e[:, 1] * en[:, 0] == 0.0) & ((e * en).sum(axis=1) < 0.0)
-        if np.any(crossing) or np.any(folded):
-            if np.any(crossing):
-                k = int(np.argmax(crossing))
-                where = f"edges {i[k]} and {j[k]} cross"
-            else:
-                where = f"edges {int(np.argmax(folded))} and {(int(np.argmax(folded)) + 1) % n} fold back"
-            raise ShapeError(f"{self.kind} is self-intersecting ({where})")
-        if self.area <= 1e-12 * scale * scale:
-            raise ShapeError(f"{self.kind} has zero area")
+        """Enough distinct vertices, non-zero area, no self-intersection (cached per vertex list)."""
+        vertices = self.vertices if self.user_vertices else tuple(map(tuple, self._local.tolist()))
+        problem = _polygon_problem(self.kind, vertices)
+        if problem:
+            raise ShapeError(problem)
 
     def validate(self, nx=None, ny=None):
         check_pose(self)
-        self.check_parameters()
-        self.check_polygon()
+        if self.user_vertices:
+            self.check_polygon()
         check_extent(self)
         check_in_domain(self, nx, ny)
         return self
 
-    def check_parameters(self) -> None:
-        """Parameter checks of parametric subclasses (already done on construction)."""
+    #: True when the vertices come from the user (checked by validate); parametric bodies are
+    #: simple polygons by construction once their parameters passed the constructor's checks
+    user_vertices = False
 
 
 def _vertex_tuple(vertices) -> tuple[tuple[float, float], ...]:
@@ -237,6 +269,7 @@ class Polygon(PolygonalShape):
     vertices: tuple = ()
 
     kind = "polygon"
+    user_vertices = True
 
     def __init__(self, vertices, x=0.0, y=0.0, angle=0.0):
         object.__setattr__(self, "vertices", _vertex_tuple(vertices))
