@@ -1,0 +1,73 @@
+"""Loading the GLSL programs in `shaders/`: lattice constants injected, driver lines kept true.
+
+Every file in `shaders/` is one shader stage, `#version 330 core` on line 1 (GL 3.3 core, which
+macOS's 4.1 core also runs). A line `// @LATTICE` is replaced by the D2Q9 constants of
+`solver.lattice.glsl_constants()` (the one lattice definition, DESIGN rule 3) and by any
+compile-time `#define`s a variant asks for; a `#line` directive after the injected block puts
+the driver's line numbers back on the file's own lines, so a compile error reported by the
+driver as "0:57(3)" is line 57 of the file. `ShaderError` names the file and that line.
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from solver.lattice import glsl_constants
+
+SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
+MARKER = "// @LATTICE"
+_DRIVER_LINE = re.compile(r"^\s*\d+:(\d+)\((\d+)\):\s*(.*)$")
+
+
+class ShaderError(RuntimeError):
+    """A shader failed to load or compile; the message starts with `file:line:`."""
+
+
+def shader_source(name: str, defines: dict | None = None) -> str:
+    """The text of `shaders/<name>` with constants and defines injected at the marker."""
+    path = SHADER_DIR / name
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ShaderError(f"{path}: cannot read shader: {exc.strerror}") from None
+    lines = text.splitlines()
+    if not lines or lines[0].strip() != "#version 330 core":
+        raise ShaderError(f"{path}:1: the first line must be '#version 330 core'")
+    out = []
+    for number, line in enumerate(lines, start=1):
+        if line.strip() == MARKER:
+            out.extend(f"#define {k} {int(v) if isinstance(v, bool) else v}" for k, v in (defines or {}).items())
+            out.append(glsl_constants())
+            out.append(f"#line {number + 1}")
+        else:
+            out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def _explain(stage_file: str, log: str) -> str:
+    """Turn the driver's log into 'file:line:col: message' lines."""
+    path = SHADER_DIR / stage_file
+    messages = []
+    for raw in log.splitlines():
+        m = _DRIVER_LINE.match(raw)
+        if m:
+            messages.append(f"{path}:{m.group(1)}:{m.group(2)}: {m.group(3)}")
+    return "\n".join(messages) if messages else f"{path}: {log.strip()}"
+
+
+def create_program(ctx, vertex: str, fragment: str, defines: dict | None = None):
+    """Compile `shaders/<vertex>` + `shaders/<fragment>` into a moderngl Program.
+
+    Raises ShaderError whose first line is `<file>:<line>:<col>: <driver message>`.
+    """
+    vs = shader_source(vertex, defines)
+    fs = shader_source(fragment, defines)
+    try:
+        return ctx.program(vertex_shader=vs, fragment_shader=fs)
+    except Exception as exc:  # moderngl raises a plain Error with the driver's log
+        log = str(exc)
+        stage = fragment
+        if "vertex_shader\n" in log and "fragment_shader\n" not in log:
+            stage = vertex
+        body = log.split("===============", 1)[-1]
+        raise ShaderError(_explain(stage, body)) from None
