@@ -23,9 +23,9 @@ class ShaderError(RuntimeError):
     """A shader failed to load or compile; the message starts with `file:line:`."""
 
 
-def shader_source(name: str, defines: dict | None = None) -> str:
+def shader_source(name: str, defines: dict | None = None, directory: Path = SHADER_DIR) -> str:
     """The text of `shaders/<name>` with constants and defines injected at the marker."""
-    path = SHADER_DIR / name
+    path = Path(directory) / name
     try:
         text = path.read_text()
     except OSError as exc:
@@ -44,9 +44,8 @@ def shader_source(name: str, defines: dict | None = None) -> str:
     return "\n".join(out) + "\n"
 
 
-def _explain(stage_file: str, log: str) -> str:
+def _explain(path: Path, log: str) -> str:
     """Turn the driver's log into 'file:line:col: message' lines."""
-    path = SHADER_DIR / stage_file
     messages = []
     for raw in log.splitlines():
         m = _DRIVER_LINE.match(raw)
@@ -55,13 +54,14 @@ def _explain(stage_file: str, log: str) -> str:
     return "\n".join(messages) if messages else f"{path}: {log.strip()}"
 
 
-def create_program(ctx, vertex: str, fragment: str, defines: dict | None = None):
+def create_program(ctx, vertex: str, fragment: str, defines: dict | None = None,
+                   directory: Path = SHADER_DIR):
     """Compile `shaders/<vertex>` + `shaders/<fragment>` into a moderngl Program.
 
     Raises ShaderError whose first line is `<file>:<line>:<col>: <driver message>`.
     """
-    vs = shader_source(vertex, defines)
-    fs = shader_source(fragment, defines)
+    vs = shader_source(vertex, defines, directory)
+    fs = shader_source(fragment, defines, directory)
     try:
         return ctx.program(vertex_shader=vs, fragment_shader=fs)
     except Exception as exc:  # moderngl raises a plain Error with the driver's log
@@ -70,4 +70,4 @@ def create_program(ctx, vertex: str, fragment: str, defines: dict | None = None)
         if "vertex_shader\n" in log and "fragment_shader\n" not in log:
             stage = vertex
         body = log.split("===============", 1)[-1]
-        raise ShaderError(_explain(stage, body)) from None
+        raise ShaderError(_explain(Path(directory) / stage, body)) from None
