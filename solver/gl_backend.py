@@ -53,6 +53,8 @@ UNIT_G = (0, 1, 2)
 UNIT_MASK, UNIT_QA, UNIT_QB, UNIT_INFLOW, UNIT_OMEGA = 3, 4, 5, 6, 7
 #: tile edge of the finite check
 CHECK_BLOCK = 16
+#: region rectangles are aligned to llvmpipe's 4x4 shading blocks
+ALIGN = 4
 _Y_MODE = {"no_slip": 0, "free_slip": 1, "periodic": 2}
 
 
@@ -119,22 +121,19 @@ class GLSolver(Solver):
         defines = {
             "TRT": cfg.collision == "trt",
             "GUO_FORCE": any(c != 0.0 for c in cfg.body_force),
-            "SPONGE": sponge,
             "X_PERIODIC": cfg.x_boundary == "periodic",
             "Y_MODE": _Y_MODE[cfg.y_boundary],
             "FETCH_NORMALIZED": bool(self.tuning["fetch_normalized"]),
         }
-        self._programs = {
-            key: create_program(ctx, "rect_vertex.glsl", "lbm_step.glsl", {**defines, "BODY": b, "EDGES": e})
-            for key, b, e in (("fast", 0, 0), ("edge", 0, 1), ("body", 1, 0), ("full", 1, 1))
-        }
+        self._defines = defines
+        self._sponge = sponge
+        self._programs = {}
         op, om = relaxation_rates(cfg)
-        for prog in self._programs.values():
-            self._uniforms(prog, G0=UNIT_G[0], G1=UNIT_G[1], G2=UNIT_G[2], MASK=UNIT_MASK, QA=UNIT_QA,
-                           QB=UNIT_QB, INFLOW=UNIT_INFLOW, OMEGA=UNIT_OMEGA, N=(nx, ny),
-                           grid_size=(float(nx), float(ny)), inv_n=(1.0 / nx, 1.0 / ny),
-                           body_force=tuple(float(v) for v in cfg.body_force),
-                           omega_plus=float(np.mean(op)), omega_minus=float(np.mean(om)))
+        self._uniform_values = dict(
+            G0=UNIT_G[0], G1=UNIT_G[1], G2=UNIT_G[2], MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
+            INFLOW=UNIT_INFLOW, OMEGA=UNIT_OMEGA, N=(nx, ny), grid_size=(float(nx), float(ny)),
+            inv_n=(1.0 / nx, 1.0 / ny), body_force=tuple(float(v) for v in cfg.body_force),
+            omega_plus=float(np.ravel(op)[0]), omega_minus=float(np.ravel(om)[0]))  # column 0: no sponge
         self._objects = []  # GL objects to release
 
         def tex(size, components, dtype="f4", repeat=False):
@@ -158,7 +157,7 @@ class GLSolver(Solver):
         rates = np.stack(np.broadcast_arrays(np.asarray(op, float) * np.ones(nx), np.asarray(om, float)), -1)
         self._omega_tex.write(rates.astype("f4").tobytes())
         self._inflow_key = None
-        self._vbo, self._vao = {}, {}
+        self._draws = []
         self._field = self._check = None
 
         self.inflow_speed = float(cfg.inflow_speed)
@@ -180,38 +179,69 @@ class GLSolver(Solver):
             if name in prog:  # the compiler drops unused uniforms
                 prog[name].value = value
 
+    def _program(self, key):
+        """The step variant for region `key` = (body, edges, sponge), compiled on first use."""
+        if key not in self._programs:
+            body, edges, sponge = key
+            defines = {**self._defines, "BODY": body, "EDGES": edges, "SPONGE": sponge}
+            prog = create_program(self.ctx, "rect_vertex.glsl", "lbm_step.glsl", defines)
+            self._uniforms(prog, **self._uniform_values)
+            self._programs[key] = prog
+            if body:
+                self._upload_body_uniforms()
+        return self._programs[key]
+
+    def _regions(self, window):
+        """{(body, edges, sponge): [rectangles]}: which variant draws which part of the grid.
+
+        Rectangles are aligned to llvmpipe's 4x4 pixel blocks (a partly covered block runs the
+        whole shader), so the edge strips are ALIGN wide and the body window is grown to them.
+        """
+        nx, ny, a = self.nx, self.ny, ALIGN
+        sp = int(self._sponge)
+        x1, y1 = (nx - 1) // a * a, (ny - 1) // a * a
+        if not self.tuning["split"] or x1 <= a or y1 <= a:
+            return {(1, 1, sp): [(0, 0, nx, ny)]}
+        interior = (a, a, x1, y1)
+        edges = [(0, 0, nx, a), (0, y1, nx, ny), (0, a, a, y1), (x1, a, nx, y1)]
+        parts = {(0, 0, 0): [interior], (0, 1, sp): edges}
+        if window is not None and window[0] < window[2] and window[1] < window[3]:
+            w = (window[0] // a * a, window[1] // a * a, min(nx, -(-window[2] // a) * a),
+                 min(ny, -(-window[3] // a) * a))
+            parts[(0, 0, 0)] = _box_minus(interior, w)
+            parts[(0, 1, sp)] = [r for e in edges for r in _box_minus(e, w)]
+            inside = w[0] >= a and w[1] >= a and w[2] <= x1 and w[3] <= y1
+            parts[(1, 0, sp) if inside else (1, 1, sp)] = [w]
+        if sp:  # the sponge columns (aligned down) get the variant with per-column rates
+            xs = (nx - self.config.sponge_cells) // a * a
+            plain, sponge = [], []
+            for r in parts[(0, 0, 0)]:
+                if r[0] < xs:
+                    plain.append((r[0], r[1], min(r[2], xs), r[3]))
+                if r[2] > xs:
+                    sponge.append((max(r[0], xs), r[1], r[2], r[3]))
+            parts[(0, 0, 0)], parts[(0, 0, 1)] = plain, sponge
+        return {k: v for k, v in parts.items() if v}
+
     def _set_rects(self, window):
-        """Split the grid between the variants: body window, edge strips, fast interior."""
-        nx, ny = self.nx, self.ny
-        if not self.tuning["split"]:
-            parts = {"fast": [], "edge": [], "body": [], "full": [(0, 0, nx, ny)]}
-        else:
-            interior = (1, 1, nx - 1, ny - 1)
-            edges = [(0, 0, nx, 1), (0, ny - 1, nx, ny), (0, 1, 1, ny - 1), (nx - 1, 1, nx, ny - 1)]
-            parts = {"fast": [interior], "edge": edges, "body": [], "full": []}
-            if window is not None:
-                w = (max(window[0], 0), max(window[1], 0), min(window[2], nx), min(window[3], ny))
-                if w[0] < w[2] and w[1] < w[3]:
-                    parts["fast"] = _box_minus(interior, w)
-                    parts["edge"] = [r for e in edges for r in _box_minus(e, w)]
-                    touches_edge = w[0] < 1 or w[1] < 1 or w[2] > nx - 1 or w[3] > ny - 1
-                    parts["full" if touches_edge else "body"] = [w]
-        for key, rects in parts.items():
-            old = self._vao.pop(key, None)
-            if old is not None:
-                old.release()
-                self._vbo.pop(key).release()
-            if rects:
-                self._vbo[key] = self.ctx.buffer(_triangles(rects).tobytes())
-                self._vao[key] = self.ctx.vertex_array(self._programs[key], [(self._vbo[key], "2f", "in_pos")])
+        """Vertex data of every region (see _regions), drawn in this order each step."""
+        for vao, vbo in self._draws:
+            vao.release()
+            vbo.release()
+        self._draws = []
+        for key, rects in sorted(self._regions(window).items()):
+            vbo = self.ctx.buffer(_triangles(rects).tobytes())
+            vao = self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")])
+            self._draws.append((vao, vbo))
 
     def _upload_body_uniforms(self):
         b = self.body
         centre = (0.0, 0.0) if b is None else (float(b.shape.x), float(b.shape.y))
         velocity = (0.0, 0.0) if b is None else tuple(float(v) for v in b.velocity)
         omega = 0.0 if b is None else float(b.omega)
-        for key in ("body", "full"):
-            self._uniforms(self._programs[key], body_velocity=velocity, body_omega=omega, body_centre=centre)
+        for key, prog in self._programs.items():
+            if key[0]:
+                self._uniforms(prog, body_velocity=velocity, body_omega=omega, body_centre=centre)
 
     def _update_inflow(self, t):
         """u_in(iy, t) (solver/inflow.py) into the inflow texture, only when it changes."""
@@ -254,10 +284,8 @@ class GLSolver(Solver):
         src, dst = self._cur, 1 - self._cur
         self._begin_pass(self._fbo[dst], (self.nx, self.ny))
         self._bind_sources(src)
-        for key in ("fast", "edge", "body", "full"):
-            vao = self._vao.get(key)
-            if vao is not None:
-                vao.render(moderngl.TRIANGLES)
+        for vao, _ in self._draws:
+            vao.render(moderngl.TRIANGLES)
         self._cur = dst
         self.time += 1
 
@@ -265,17 +293,17 @@ class GLSolver(Solver):
         n = int(n)
         sums = {name: [0.0, 0.0] for name in self._models}
         for _ in range(n):
-            if self._models:
-                win = self.body_window()
-                if win is not None:
-                    if not np.all(np.isfinite(win.f)):
-                        raise SolverDiverged(self.time, "non-finite populations around the body")
-                    for name, model in self._models.items():
-                        fx, fy = model.compute(win)
-                        sums[name][0] += fx
-                        sums[name][1] += fy
+            src, impulse = self._cur, self._impulse
             self._impulse = (0.0, 0.0)
-            self._one_step()
+            self._one_step()  # queued; the forces of f*(t) are computed while the GPU runs it
+            if self._models and self.body is not None:
+                win = self._window(src, impulse)
+                if not np.all(np.isfinite(win.f)):
+                    raise SolverDiverged(self.time - 1, "non-finite populations around the body")
+                for name, model in self._models.items():
+                    fx, fy = model.compute(win)
+                    sums[name][0] += fx
+                    sums[name][1] += fy
             if self.check_interval > 0 and self.time % self.check_interval == 0:
                 self._check_finite()
         if n > 0:
@@ -379,20 +407,22 @@ class GLSolver(Solver):
 
     def body_window(self) -> BodyWindow | None:
         """The body's force window at the current time (full f*, float64): 3 small reads."""
+        return None if self.body is None else self._window(self._cur, self._impulse)
+
+    def _window(self, side, impulse) -> BodyWindow:
         b = self.body
-        if b is None:
-            return None
         solid, q = b.window_arrays()
-        return BodyWindow(x0=b.window[0], y0=b.window[1], f=unshifted(self._read_shifted(b.window)), solid=solid,
-                          q=q, shape=b.shape, velocity=b.velocity, omega=b.omega, impulse=self._impulse,
-                          config=self.config, links=b.links)
+        f = unshifted(self._read_shifted(b.window, side))
+        return BodyWindow(x0=b.window[0], y0=b.window[1], f=f, solid=solid, q=q, shape=b.shape,
+                          velocity=b.velocity, omega=b.omega, impulse=impulse, config=self.config, links=b.links)
 
     # --- fields -----------------------------------------------------------------
-    def _read_shifted(self, box=None) -> np.ndarray:
-        """Stored g (9, h, w) float32 over box (x0, y0, x1, y1), default the whole grid."""
+    def _read_shifted(self, box=None, side=None) -> np.ndarray:
+        """Stored g (9, h, w) float32 over box (x0, y0, x1, y1), default the whole grid, of the
+        current ping-pong side (or `side`)."""
         x0, y0, x1, y1 = box or (0, 0, self.nx, self.ny)
         w, h = x1 - x0, y1 - y0
-        fbo = self._fbo[self._cur]
+        fbo = self._fbo[self._cur if side is None else side]
         g = np.empty((12, h, w), dtype="f4")
         for k in range(3):
             data = fbo.read(viewport=(x0, y0, w, h), components=4, attachment=k, dtype="f4")
@@ -446,7 +476,7 @@ class GLSolver(Solver):
         return tex
 
     def close(self) -> None:
-        for obj in [*self._vao.values(), *self._vbo.values(), *self._objects, *self._programs.values()]:
+        for obj in [*(o for d in self._draws for o in d), *self._objects, *self._programs.values()]:
             obj.release()
-        self._vao, self._vbo, self._objects, self._programs = {}, {}, [], {}
+        self._draws, self._objects, self._programs = [], [], {}
         self._field = self._check = None
