@@ -37,7 +37,8 @@ uniform float body_omega;      // Omega, radians per step, counter-clockwise
 uniform vec2 body_centre;      // X
 #endif
 #if EDGES
-uniform sampler2D INFLOW;      // u_in(iy, t) in texel (iy, 0)
+uniform sampler2D INFLOW;      // inflow profile(iy) in texel (iy, 0)
+uniform float inflow_ramp;     // ramp(t): u_in(iy, t) = ramp(t) profile(iy)
 #endif
 
 layout(location = 0) out vec4 out0;
@@ -192,7 +193,7 @@ void main() {
     vec4 c = texelFetch(G2, x, 0);
     float own[9] = float[9](a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x);
 #if EDGES
-    float uin = X_PERIODIC == 0 ? texelFetch(INFLOW, ivec2(x.y, 0), 0).r : 0.0;
+    float uin = X_PERIODIC == 0 ? inflow_ramp * texelFetch(INFLOW, ivec2(x.y, 0), 0).r : 0.0;
 #endif
     for (int i = 1; i < Q; ++i) {
         int ib = OPP[i];

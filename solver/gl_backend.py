@@ -43,7 +43,7 @@ from solver.body import BodyState, expand_box, make_body_state, refill, shifted,
 from solver.forces import create_model
 from solver.forces.base import BodyWindow
 from solver.gl_programs import create_program
-from solver.inflow import inflow_velocity
+from solver.inflow import profile, ramp
 from solver.lattice import C, OPP, Q, RHO0, equilibrium
 from solver.numpy_backend import relaxation_rates
 from solver.speed_limit import cap_speed
@@ -244,15 +244,19 @@ class GLSolver(Solver):
                 self._uniforms(prog, body_velocity=velocity, body_omega=omega, body_centre=centre)
 
     def _update_inflow(self, t):
-        """u_in(iy, t) (solver/inflow.py) into the inflow texture, only when it changes."""
+        """u_in(iy, t) = ramp(t) profile(iy) (solver/inflow.py): the ramp as a uniform each
+        step, the profile texture rewritten only when the speed changes (a texture write while
+        a queued step reads it would stall the pipeline)."""
         cfg = self.config
         if cfg.x_boundary != "tunnel":
             return
-        key = (min(t, max(cfg.inflow_ramp_steps, 0)), self.inflow_speed)
-        if self._inflow_key == key:
-            return
-        self._inflow_key = key
-        self._inflow_tex.write(inflow_velocity(cfg, t, self.inflow_speed).astype("f4").tobytes())
+        if self._inflow_key != self.inflow_speed:
+            self._inflow_key = self.inflow_speed
+            self._inflow_tex.write(profile(cfg.ny, self.inflow_speed, cfg.inflow_profile).astype("f4").tobytes())
+        r = ramp(t, cfg.inflow_ramp_steps)
+        for key, prog in self._programs.items():
+            if key[1]:
+                self._uniforms(prog, inflow_ramp=r)
 
     def _begin_pass(self, fbo, size):
         """The state every pass needs, whatever the host (Qt) left: see the module docstring."""
@@ -309,6 +313,27 @@ class GLSolver(Solver):
         if n > 0:
             self._check_finite()
             self._forces = {name: (s[0] / n, s[1] / n) for name, s in sums.items()}
+
+    def time_variant(self, key, draws: int) -> float:
+        """Seconds to draw step variant `key` = (body, edges, sponge) over the whole grid
+        `draws` times (the state is advanced: for docs/performance.md's cost table only)."""
+        import time
+
+        vbo = self.ctx.buffer(_triangles([(0, 0, self.nx, self.ny)]).tobytes())
+        vao = self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")])
+        self._update_inflow(self.time)
+        self.finish()
+        t0 = time.perf_counter()
+        for _ in range(draws):
+            self._begin_pass(self._fbo[1 - self._cur], (self.nx, self.ny))
+            self._bind_sources(self._cur)
+            vao.render(moderngl.TRIANGLES)
+            self._cur = 1 - self._cur
+        self.finish()
+        elapsed = time.perf_counter() - t0
+        vao.release()
+        vbo.release()
+        return elapsed
 
     def finish(self) -> None:
         """Wait until the GPU has done all queued work (for honest timing)."""

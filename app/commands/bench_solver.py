@@ -104,18 +104,21 @@ class SceneRun:
 
 
 def measure(run: SceneRun, seconds: float, warmup: int = 20) -> dict:
+    """Steps until `seconds` of wall time; MLUPS per wall second and per CPU second (all
+    threads of this process: llvmpipe's too), the latter steadier on a shared machine."""
     run.advance(warmup)  # shader compile, first draw, caches
     cfg = run.solver.config
-    steps, elapsed, chunk = 0, 0.0, MOVE_EVERY
+    steps, elapsed, cpu, chunk = 0, 0.0, 0.0, MOVE_EVERY
     while elapsed < seconds:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         run.advance(chunk)
         elapsed += time.perf_counter() - t0
+        cpu += time.process_time() - c0
         steps += chunk
         chunk = min(chunk * 2, 400)
-    mlups = cfg.nx * cfg.ny * steps / elapsed / 1e6
-    return {"steps": steps, "seconds": round(elapsed, 4), "mlups": round(mlups, 2),
-            "steps_per_s": round(steps / elapsed, 1)}
+    nodes = cfg.nx * cfg.ny * steps / 1e6
+    return {"steps": steps, "seconds": round(elapsed, 4), "mlups": round(nodes / elapsed, 2),
+            "steps_per_s": round(steps / elapsed, 1), "mlups_per_cpu_s": round(nodes / max(cpu, 1e-9), 2)}
 
 
 def _gl_context():
@@ -182,11 +185,21 @@ VARIANTS = {
     "regions, texelFetch": {"split": True, "fetch_normalized": False},
     "regions, texture() + REPEAT (default)": {},
 }
+#: step variants (body, edges, sponge) whose cost per node the variants run measures
+REGION_VARIANTS = {"interior (fast path)": (0, 0, 0), "interior + sponge rates": (0, 0, 1),
+                   "edges: walls, inlet, outlet": (0, 1, 1), "body window": (1, 0, 1),
+                   "everything (body + edges)": (1, 1, 1)}
+
+
+def _stats(values):
+    return {"best": max(values), "median": float(np.median(values)), "samples": values}
 
 
 def run_variants(quick: bool, seconds: float | None):
-    """Interleaved rounds of every tuning variant on the moving-cylinder tunnel; best and
-    median MLUPS per variant, plus the force readback's cost and the llvmpipe thread count."""
+    """Interleaved rounds of every tuning variant on the moving-cylinder tunnel (MLUPS per wall
+    and per CPU second), the cost per node of each step variant, the force readback's cost,
+    and the llvmpipe thread count (subprocesses)."""
+    from shapes import Cylinder
     from solver.gl_backend import GLSolver
 
     seconds = seconds if seconds is not None else (0.3 if quick else 1.0)
@@ -201,30 +214,38 @@ def run_variants(quick: bool, seconds: float | None):
     no_force = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx))
     no_force.solver.enable_force_models([])
     runs["default, no force model (no window readback)"] = no_force
-    box = GLSolver(scene_config("box", nx, ny), ctx=ctx)
-    runs["empty periodic box (default)"] = SceneRun("box", box)
-    samples = {name: [] for name in runs}
+    runs["empty periodic box (default)"] = SceneRun("box", GLSolver(scene_config("box", nx, ny), ctx=ctx))
+    wall = {name: [] for name in runs}
+    per_cpu = {name: [] for name in runs}
     for run in runs.values():
         run.advance(20)
     for _ in range(rounds):
         for name, run in runs.items():
-            samples[name].append(measure(run, seconds, warmup=0)["mlups"])
+            m = measure(run, seconds, warmup=0)
+            wall[name].append(m["mlups"])
+            per_cpu[name].append(m["mlups_per_cpu_s"])
+    probe = GLSolver(scene_config("tunnel", nx, ny), ctx=ctx)
+    probe.set_body(Cylinder(ny / 8, x=nx / 4, y=ny / 2))
+    draws = 20 if quick else 60
+    cost = {name: [] for name in REGION_VARIANTS}
+    for key in REGION_VARIANTS.values():
+        probe.time_variant(key, 3)  # compile
+    for _ in range(rounds):
+        for name, key in REGION_VARIANTS.items():
+            cost[name].append(nx * ny * draws / probe.time_variant(key, draws) / 1e6)
     result = {"grid": f"{nx}x{ny}", "renderer": ctx.info.get("GL_RENDERER"), "machine": machine(),
-              "variants": {n: {"best": max(v), "median": float(np.median(v)), "samples": v}
-                           for n, v in samples.items()}}
+              "variants": {n: {"wall": _stats(wall[n]), "per_cpu_s": _stats(per_cpu[n])} for n in runs},
+              "step_variants_full_grid_mlups": {n: _stats(v) for n, v in cost.items()}}
     threads = {}
     for lp in ("1", "2", "4"):
         env = {**os.environ, "LP_NUM_THREADS": lp}
-        code = ("import json; from app.commands.bench_solver import *; "
+        code = ("import json; from app.commands.bench_solver import _gl_context, SceneRun, scene_config, measure; "
                 "from solver.gl_backend import GLSolver; ctx, _ = _gl_context(); "
                 f"r = SceneRun('tunnel', GLSolver(scene_config('tunnel', {nx}, {ny}), ctx=ctx)); "
                 f"print(json.dumps(measure(r, {seconds * rounds})))")
         out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
-        if out.returncode == 0:
-            threads[lp] = json.loads(out.stdout.strip().splitlines()[-1])["mlups"]
-        else:
-            threads[lp] = None
-    result["lp_num_threads"] = threads
+        threads[lp] = json.loads(out.stdout.strip().splitlines()[-1])["mlups"] if out.returncode == 0 else None
+    result["lp_num_threads_wall_mlups"] = threads
     return result
 
 
@@ -234,10 +255,15 @@ def main(args) -> int:
     if getattr(args, "variants", False):
         result = run_variants(quick, seconds)
         print(f"gl tuning variants, moving-cylinder tunnel {result['grid']}, {result['renderer']}")
+        print(f"  {'variant':48s} {'MLUPS (wall) best/median':>26s} {'per CPU-s best/median':>24s}")
         for name, v in result["variants"].items():
-            print(f"  {name:48s} best {v['best']:7.1f}  median {v['median']:7.1f} MLUPS")
-        for lp, mlups in result["lp_num_threads"].items():
-            print(f"  LP_NUM_THREADS={lp:2s} {'':33s} {mlups if mlups is not None else 'failed'} MLUPS")
+            w, c = v["wall"], v["per_cpu_s"]
+            print(f"  {name:48s} {w['best']:12.1f} {w['median']:9.1f} {c['best']:14.1f} {c['median']:9.1f}")
+        print("  step variant drawn over the whole grid (MLUPS, best/median):")
+        for name, v in result["step_variants_full_grid_mlups"].items():
+            print(f"    {name:46s} {v['best']:12.1f} {v['median']:9.1f}")
+        for lp, mlups in result["lp_num_threads_wall_mlups"].items():
+            print(f"  LP_NUM_THREADS={lp:2s} (moving tunnel, wall MLUPS) {mlups if mlups is not None else 'failed'}")
     else:
         m = machine()
         print(f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}, Python {m['python']}, "
