@@ -10,21 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from shapes.base import Shape, ShapeError
-from shapes.validation import check_extent, check_in_domain, check_pose, finite_number, positive_number
-
-
-def unit_direction(flow_direction) -> np.ndarray:
-    """A unit 2-vector from a direction given as (dx, dy) or as an angle in radians."""
-    d = np.asarray(flow_direction, dtype=np.float64)
-    if d.ndim == 0:
-        d = np.array([math.cos(float(d)), math.sin(float(d))])
-    if d.shape != (2,) or not np.all(np.isfinite(d)):
-        raise ShapeError(f"flow direction must be (dx, dy) or an angle, got {flow_direction!r}")
-    norm = math.hypot(d[0], d[1])
-    if norm == 0.0:
-        raise ShapeError("flow direction must not be the zero vector")
-    return d / norm
+from shapes.base import Shape
+from shapes.validation import (check_extent, check_in_domain, check_pose, finite_number, positive_number,
+                               unit_direction)
 
 
 @dataclass(frozen=True, init=False)

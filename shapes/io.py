@@ -58,21 +58,26 @@ def to_dict(shape: Shape) -> dict:
 
 
 def save_shape(path, shape: Shape) -> None:
-    """Write `shape` as a JSON shape file, atomically."""
+    """Write `shape` as a JSON shape file, atomically; ShapeError naming the file if it cannot."""
     path = Path(path)
     text = json.dumps({"format": FILE_FORMAT, "version": FILE_VERSION, "shape": shape.to_dict()}, indent=2)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:
+        raise ShapeError(f"{path}: cannot write shape file ({exc.strerror or exc})") from None
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             f.write(text + "\n")
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         try:
             os.unlink(tmp)
         except OSError:
             pass
+        if isinstance(exc, OSError):
+            raise ShapeError(f"{path}: cannot write shape file ({exc.strerror or exc})") from None
         raise
 
 

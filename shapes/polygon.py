@@ -15,8 +15,8 @@ from functools import lru_cache
 import numpy as np
 
 from shapes.base import Shape, ShapeError
-from shapes.cylinder import unit_direction
-from shapes.validation import check_extent, check_in_domain, check_pose, finite_number, positive_number
+from shapes.validation import (check_extent, check_in_domain, check_pose, finite_number, positive_number,
+                               unit_direction)
 
 #: points closer than this to an edge count as on the boundary (and so inside)
 BOUNDARY_TOLERANCE = 1e-9
@@ -92,6 +92,47 @@ def link_edge_hit(px, py, dx, dy, ax, ay, ex, ey):
     return np.where(hit, t, np.inf)
 
 
+@lru_cache(maxsize=256)
+def _polygon_problem(kind: str, vertices: tuple) -> str | None:
+    """What makes the polygon invalid (too few vertices, repeated vertex, zero area,
+    self-intersection), or None. O(n^2); cached, as the vertices do not change with the pose."""
+    v = np.array(vertices, dtype=np.float64)
+    n = len(v)
+    if n < 3:
+        return f"{kind} needs at least 3 vertices, got {n}"
+    e = np.roll(v, -1, axis=0) - v
+    length = np.hypot(e[:, 0], e[:, 1])
+    if np.any(length == 0.0):
+        i = int(np.argmax(length == 0.0))
+        return f"{kind} has a repeated vertex ({v[i, 0]:g}, {v[i, 1]:g})"
+    scale = float(np.ptp(v, axis=0).max())
+    rel = v - v[0]
+    far = rel[np.argmax(np.hypot(rel[:, 0], rel[:, 1]))]
+    spread = np.abs(rel[:, 0] * far[1] - rel[:, 1] * far[0]).max()  # all on one line: 0
+    if spread <= 1e-12 * scale * scale:
+        return f"{kind} has zero area (its vertices are collinear)"
+    # neighbouring edges meet at their shared vertex; they must not fold back onto each other
+    en = np.roll(e, -1, axis=0)
+    folded = (e[:, 0] * en[:, 1] - e[:, 1] * en[:, 0] == 0.0) & ((e * en).sum(axis=1) < 0.0)
+    if np.any(folded):
+        k = int(np.argmax(folded))
+        return f"{kind} is self-intersecting (edges {k} and {(k + 1) % n} fold back)"
+    # other edge pairs must not meet at all; in blocks of edges to bound memory
+    b = np.roll(v, -1, axis=0)
+    block = max(1, 1_000_000 // n)
+    for start in range(0, n, block):
+        i, j = np.meshgrid(np.arange(start, min(n, start + block)), np.arange(n), indexing="ij")
+        keep = (j >= i + 2) & ~((i == 0) & (j == n - 1))  # first and last edges are neighbours
+        i, j = i[keep], j[keep]
+        crossing = _segments_intersect(v[i], b[i], v[j], b[j])
+        if np.any(crossing):
+            k = int(np.argmax(crossing))
+            return f"{kind} is self-intersecting (edges {i[k]} and {j[k]} cross)"
+    if abs(polygon_area_centroid(v)[0]) <= 1e-12 * scale * scale:
+        return f"{kind} has zero area"
+    return None
+
+
 @dataclass(frozen=True, init=False)
 class PolygonalShape(Shape):
     """Geometry shared by every body whose boundary is a polygon; subclasses give local vertices."""
@@ -153,15 +194,16 @@ class PolygonalShape(Shape):
         first = np.where(np.isfinite(first), np.minimum(first, 1.0), 0.0)
         return first.reshape(shape)
 
-    def edge_pieces(self, max_length: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-        """Edges cut into pieces no longer than `max_length`: (edge index (k,), piece midpoints (k, 2))."""
+    def edge_pieces(self, max_length: float = 1.0):
+        """Edges cut into equal pieces no longer than `max_length`: (edge index (k,), piece
+        midpoints (k, 2), piece lengths (k,)); zero-length edges are skipped."""
         e = self._edges
         length = np.hypot(e[:, 0], e[:, 1])
-        pieces = np.maximum(1, np.ceil(length / max_length)).astype(np.int64)
+        pieces = np.where(length > 0.0, np.maximum(1, np.ceil(length / max_length)), 0).astype(np.int64)
         edge = np.repeat(np.arange(len(length)), pieces)
         k = np.arange(edge.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)
         frac = (k + 0.5) / pieces[edge]
-        return edge, self._world[edge] + frac[:, None] * e[edge]
+        return edge, self._world[edge] + frac[:, None] * e[edge], (length[edge] / pieces[edge])
 
     # --- geometry for drawing and forces ------------------------------------------------------
     def outline(self) -> np.ndarray:
@@ -174,18 +216,9 @@ class PolygonalShape(Shape):
 
     def surface_elements(self, spacing: float = 0.5):
         """Each edge cut into ceil(length/spacing) equal pieces: midpoints, outward normals, lengths."""
-        spacing = positive_number("surface element spacing", spacing)
-        e = self._edges
-        length = np.hypot(e[:, 0], e[:, 1])
-        keep = length > 0.0
-        a, e, length = self._world[keep], e[keep], length[keep]
-        pieces = np.maximum(1, np.ceil(length / spacing)).astype(np.int64)
-        edge = np.repeat(np.arange(len(length)), pieces)
-        k = np.arange(edge.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)
-        frac = (k + 0.5) / pieces[edge]
-        points = a[edge] + frac[:, None] * e[edge]
-        normals = np.column_stack([e[:, 1], -e[:, 0]])[edge] / length[edge, None]
-        lengths = (length / pieces)[edge]
+        edge, points, lengths = self.edge_pieces(positive_number("surface element spacing", spacing))
+        e = self._edges[edge]
+        normals = np.column_stack([e[:, 1], -e[:, 0]]) / np.hypot(e[:, 0], e[:, 1])[:, None]
         return points, normals, lengths
 
     def bounding_box(self):
@@ -195,49 +228,23 @@ class PolygonalShape(Shape):
 
     # --- validation ---------------------------------------------------------------------------
     def check_polygon(self) -> None:
-        """Enough distinct vertices, non-zero area, no self-intersection (O(n^2), not per frame)."""
-        v = self._local
-        n = len(v)
-        if n < 3:
-            raise ShapeError(f"{self.kind} needs at least 3 vertices, got {n}")
-        e = np.roll(v, -1, axis=0) - v
-        length = np.hypot(e[:, 0], e[:, 1])
-        if np.any(length == 0.0):
-            i = int(np.argmax(length == 0.0))
-            raise ShapeError(f"{self.kind} has a repeated vertex ({v[i, 0]:g}, {v[i, 1]:g})")
-        scale = float(np.ptp(v, axis=0).max())
-        rel = v - v[0]
-        spread = np.abs(rel[:, None, 0] * rel[None, :, 1] - rel[:, None, 1] * rel[None, :, 0]).max()
-        if spread <= 1e-12 * scale * scale:
-            raise ShapeError(f"{self.kind} has zero area (its vertices are collinear)")
-        b = np.roll(v, -1, axis=0)
-        i, j = np.triu_indices(n, k=2)
-        keep = ~((i == 0) & (j == n - 1))  # first and last edges are neighbours
-        i, j = i[keep], j[keep]
-        crossing = _segments_intersect(v[i], b[i], v[j], b[j])
-        # neighbouring edges meet at their shared vertex; they must not fold back onto each other
-        en = np.roll(e, -1, axis=0)
-        folded = (e[:, 0] * en[:, 1] - e[:, 1] * en[:, 0] == 0.0) & ((e * en).sum(axis=1) < 0.0)
-        if np.any(crossing) or np.any(folded):
-            if np.any(crossing):
-                k = int(np.argmax(crossing))
-                where = f"edges {i[k]} and {j[k]} cross"
-            else:
-                where = f"edges {int(np.argmax(folded))} and {(int(np.argmax(folded)) + 1) % n} fold back"
-            raise ShapeError(f"{self.kind} is self-intersecting ({where})")
-        if self.area <= 1e-12 * scale * scale:
-            raise ShapeError(f"{self.kind} has zero area")
+        """Enough distinct vertices, non-zero area, no self-intersection (cached per vertex list)."""
+        vertices = self.vertices if self.user_vertices else tuple(map(tuple, self._local.tolist()))
+        problem = _polygon_problem(self.kind, vertices)
+        if problem:
+            raise ShapeError(problem)
 
     def validate(self, nx=None, ny=None):
         check_pose(self)
-        self.check_parameters()
-        self.check_polygon()
+        if self.user_vertices:
+            self.check_polygon()
         check_extent(self)
         check_in_domain(self, nx, ny)
         return self
 
-    def check_parameters(self) -> None:
-        """Parameter checks of parametric subclasses (already done on construction)."""
+    #: True when the vertices come from the user (checked by validate); parametric bodies are
+    #: simple polygons by construction once their parameters passed the constructor's checks
+    user_vertices = False
 
 
 def _vertex_tuple(vertices) -> tuple[tuple[float, float], ...]:
@@ -262,6 +269,7 @@ class Polygon(PolygonalShape):
     vertices: tuple = ()
 
     kind = "polygon"
+    user_vertices = True
 
     def __init__(self, vertices, x=0.0, y=0.0, angle=0.0):
         object.__setattr__(self, "vertices", _vertex_tuple(vertices))

@@ -84,7 +84,7 @@ def _polygon_box(shape: PolygonalShape, box):
     box_solid = (np.cumsum(counts[:, ::-1], axis=1)[:, ::-1] % 2) == 1
 
     # nodes near each boundary piece (edge index repeated over the stencil)
-    edge, mid = shape.edge_pieces(1.0)
+    edge, mid, _ = shape.edge_pieces(1.0)
     bx = np.floor(mid[:, 0]).astype(np.int64) - x0
     by = np.floor(mid[:, 1]).astype(np.int64) - y0
     jx = (bx[:, None, None] + _STENCIL[None, None, :]).repeat(len(_STENCIL), axis=1).ravel()

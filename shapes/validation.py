@@ -1,10 +1,13 @@
-"""Checks shared by every shape: finite numbers, positive sizes, minimum size, inside the domain.
+"""Checks shared by every shape: finite numbers, positive sizes, minimum size, inside the domain,
+flow directions.
 
 Each raises `ShapeError` with one line naming the offending quantity.
 """
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 from shapes.base import Shape, ShapeError
 
@@ -58,3 +61,19 @@ def check_in_domain(shape: Shape, nx: int | None, ny: int | None) -> None:
             f"{shape.kind} at ({shape.x:g}, {shape.y:g}) is not inside the domain "
             f"{nx}x{ny}: it spans x {xmin:.3g}..{xmax:.3g}, y {ymin:.3g}..{ymax:.3g}, "
             f"allowed x 0..{nx - 1}, y 0..{ny - 1}")
+
+
+def unit_direction(flow_direction) -> np.ndarray:
+    """A unit 2-vector from a direction given as (dx, dy) or as an angle in radians."""
+    try:
+        d = np.asarray(flow_direction, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ShapeError(f"flow direction must be (dx, dy) or an angle, got {flow_direction!r}") from None
+    if d.ndim == 0:
+        d = np.array([math.cos(float(d)), math.sin(float(d))])
+    if d.shape != (2,) or not np.all(np.isfinite(d)):
+        raise ShapeError(f"flow direction must be (dx, dy) or an angle, got {flow_direction!r}")
+    norm = math.hypot(d[0], d[1])
+    if norm == 0.0:
+        raise ShapeError("flow direction must not be the zero vector")
+    return d / norm

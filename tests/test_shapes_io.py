@@ -104,3 +104,8 @@ def test_examples_in_docs_parse():
         "cylinder", "plate", "wedge", "half_airfoil", "polygon"}
     doc = json.loads(blocks[1])
     assert doc["format"] == "feelflow-shape" and from_dict(doc["shape"]).kind == "half_airfoil"
+
+
+def test_save_into_missing_folder_is_a_shape_error(tmp_path):
+    with pytest.raises(ShapeError, match="cannot write shape file"):
+        save_shape(tmp_path / "no" / "such" / "body.json", Cylinder(8))

@@ -21,6 +21,7 @@ def _circle_poly(r, k=40, **pose):
 
 SHAPES = [
     Cylinder(9.0, x=20.3, y=17.8),
+    Cylinder(10.0, x=20.0, y=18.0),             # R = 5: nodes (25, 18), (23, 22) ... on the circle
     _circle_poly(6.5, x=21.7, y=18.2, angle=0.37),
     FlatPlate(12.0, 0.2, x=20.5, y=18.0, angle=0.0),
     FlatPlate(12.0, 0.3, x=20.2, y=17.9, angle=0.6),
@@ -29,6 +30,9 @@ SHAPES = [
     Wedge(12.0, math.radians(50), "downstream", x=20.1, y=18.4),
     HalfAirfoil(24.0, 4.0, x=20.4, y=18.3, angle=0.15),
     Polygon([[2.0, 3.0], [3.0, 3.0], [3.0, 4.0], [2.0, 4.0]], x=16.0, y=14.0),  # integer-aligned edges
+    FlatPlate(10.0, 2.0, x=20.0, y=18.0, angle=math.pi / 2),                   # nodes on edges and corners
+    Polygon([[0, 0], [10, 0], [10, 4], [4, 4], [4, 10], [0, 10]], x=15.0, y=12.0),  # concave, on nodes
+    Polygon([[0, 0], [6, 3], [0, 6], [3, 3]], x=18.5, y=15.0),                  # arrow: vertices on nodes
 ]
 
 
@@ -134,10 +138,14 @@ def test_lattice_invariants(shape):
         into_solid = r.solid[ty[ok], tx[ok]]
         assert np.all(r.q[i, ys[ok][into_solid], xs[ok][into_solid]] > 0), "every fluid->solid link is cut"
         cy, cx = np.nonzero(r.q[i])
-        assert np.all((cx >= x0 + 2) & (cx + C[i, 0] >= x0 + 2) & (cx < x1 - 2) & (cx + C[i, 0] < x1 - 2))
-        assert np.all((cy >= y0 + 2) & (cy + C[i, 1] >= y0 + 2) & (cy < y1 - 2) & (cy + C[i, 1] < y1 - 2))
+        for axis, (lo, hi, n, a) in enumerate(((x0, x1, nx, cx), (y0, y1, ny, cy))):
+            b = a + C[i, axis]
+            assert np.all(np.minimum(a, b) >= lo) and np.all(np.maximum(a, b) < hi)
+            assert lo == 0 or np.all(np.minimum(a, b) >= lo + 2)       # margin, unless clipped
+            assert hi == n or np.all(np.maximum(a, b) < hi - 2)
     sy, sx = np.nonzero(r.solid)
     assert np.all((sx >= x0 + 2) & (sx < x1 - 2) & (sy >= y0 + 2) & (sy < y1 - 2))
+    assert x0 >= 0 and y0 >= 0 and x1 <= nx and y1 <= ny
 
 
 def test_opposite_links_of_a_thin_plate_meet_the_same_wall():
@@ -151,3 +159,28 @@ def test_window_clipped_to_domain():
     cyl = Cylinder(6.0, x=3.0, y=3.0)
     r = rasterise(cyl, 20, 20, margin=4)
     assert r.window[0] == 0 and r.window[1] == 0 and r.window[2] <= 20
+
+
+def _random_star(rng, k):
+    th = np.sort(rng.uniform(0, 2 * math.pi, k))
+    r = rng.uniform(3.0, 9.0, k)
+    return np.column_stack([r * np.cos(th), r * np.sin(th)])
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_random_polygons_agree_with_exact_tests(seed):
+    """Random star polygons at random sub-cell poses (some snapped to nodes and right angles):
+    the mask is contains(), every link is the exact first crossing, fluid->solid links are cut."""
+    rng = np.random.default_rng(seed)
+    verts = _random_star(rng, int(rng.integers(3, 30)))
+    if seed % 3 == 0:
+        verts = np.round(verts)              # vertices on nodes: the round-off corner cases
+        verts = verts[np.any(verts != np.roll(verts, 1, axis=0), axis=1)]
+    x, y = rng.uniform(18, 26), rng.uniform(14, 22)
+    angle = rng.uniform(-math.pi, math.pi) if seed % 2 else math.pi / 2 * int(rng.integers(4))
+    if seed % 3 == 0:
+        x, y = round(x), round(y)
+    shape = Polygon(verts, x=x, y=y, angle=angle).validate(44, 36)
+    test_solid_mask_equals_contains_at_nodes(shape)
+    test_q_equals_exact_segment_test_on_every_fluid_node(shape)
+    test_lattice_invariants(shape)

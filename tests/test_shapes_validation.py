@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from shapes import Cylinder, FlatPlate, HalfAirfoil, Polygon, ShapeError, Wedge
@@ -86,3 +87,25 @@ def test_valid_shapes_pass_and_return_themselves():
     for s in (Cylinder(8, x=20, y=20), Polygon(SQUARE, x=10, y=10), FlatPlate(10, 0.2, x=20, y=20),
               Wedge(10, 1.0, "downstream", x=20, y=20), HalfAirfoil(20, 3, x=20, y=20)):
         assert s.validate(64, 48) is s
+
+
+@pytest.mark.parametrize("shape", [FlatPlate(10, 0.01), FlatPlate(3, 40), Wedge(10, 0.01), Wedge(10, 3.1),
+                                   Wedge(5, 2.0, "downstream"), HalfAirfoil(10, 0.05), HalfAirfoil(300, 30)],
+                         ids=lambda s: s.kind)
+def test_parametric_bodies_are_simple_polygons(shape):
+    """validate() trusts parametric bodies to be simple: check that they are."""
+    shape.check_polygon()
+
+
+def test_many_vertex_polygon_validates():
+    th = np.linspace(0, 2 * math.pi, 1001)[:-1]
+    Polygon(np.column_stack([100 * np.cos(th), 100 * np.sin(th)])).validate()
+    th[500] = th[10]                            # one vertex jumps back across the circle
+    with pytest.raises(ShapeError, match="self-intersecting"):
+        Polygon(np.column_stack([100 * np.cos(th), 100 * np.sin(th)])).validate()
+
+
+@pytest.mark.parametrize("direction", [(0, 0), (1, math.nan), "east", (1, 2, 3)])
+def test_bad_flow_direction(direction):
+    _refused(lambda: Cylinder(8).frontal_area(direction), "flow direction")
+    _refused(lambda: FlatPlate(8, 1).frontal_area(direction), "flow direction")
