@@ -8,7 +8,7 @@
 // Compile-time variants (defines injected by solver/gl_programs.py). llvmpipe executes both
 // sides of a divergent branch, so each region of the grid is drawn by the variant it needs:
 //   BODY  1: rule 1a (Bouzidi links with the moving-wall term) and solid nodes (body window);
-//   EDGES 1: rules 1b-1e (walls, inlet, outlet, periodic wrap) (edge rows and columns);
+//   EDGES 1: rules 1b-1e (walls, inlet, pressure outlet, periodic wrap) (edge strips);
 //   both 0: the fast path, plain streaming (rule 1f) for the interior.
 //   TRT, GUO_FORCE, SPONGE: collision operator, Guo body force, outlet sponge (per-column rates).
 //   X_PERIODIC 0/1; Y_MODE 0 no_slip, 1 free_slip, 2 periodic.
@@ -161,6 +161,16 @@ vec2 wall_velocity(vec2 xw) {  // rigid-body velocity at xw (algorithm.md, 'Link
 #endif
 
 #if EDGES
+vec2 stored_velocity(float g[9]) {  // sum c f* / sum f* of shifted populations
+    float rho = RHO0;
+    vec2 j = vec2(0.0);
+    for (int i = 0; i < Q; ++i) {
+        rho += g[i];
+        j += vec2(C[i]) * g[i];
+    }
+    return j / rho;
+}
+
 int reflect_y(int i) {  // j with C[j] = (C[i].x, -C[i].y)
     int r = 0;
     for (int j = 0; j < Q; ++j)
@@ -194,6 +204,19 @@ void main() {
     float own[9] = float[9](a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x);
 #if EDGES
     float uin = X_PERIODIC == 0 ? inflow_ramp * texelFetch(INFLOW, ivec2(x.y, 0), 0).r : 0.0;
+    // outlet velocity u_b = u(x) + (u(x) - u(x - 1)) / 2 of the stored populations
+    // (solver/inflow.py, outlet_incoming; Krueger et al. 2017, eq. 5.53)
+    vec2 u_out = vec2(0.0);
+    float usq_out = 0.0;
+    if (X_PERIODIC == 0) {
+        ivec2 xw = wrap(x - ivec2(1, 0));
+        vec4 aw = texelFetch(G0, xw, 0);
+        vec4 bw = texelFetch(G1, xw, 0);
+        vec4 cw = texelFetch(G2, xw, 0);
+        float west[9] = float[9](aw.x, aw.y, aw.z, aw.w, bw.x, bw.y, bw.z, bw.w, cw.x);
+        u_out = 1.5 * stored_velocity(own) - 0.5 * stored_velocity(west);
+        usq_out = dot(u_out, u_out);
+    }
 #endif
     for (int i = 1; i < Q; ++i) {
         int ib = OPP[i];
@@ -216,20 +239,18 @@ void main() {
         // conditions test the constant C[i] first, so the unrolled loop drops the rules a
         // direction cannot meet (llvmpipe runs both sides of a branch that is not constant)
         ivec2 s = x - ci;
-        if (Y_MODE != 2 && ((ci.y > 0 && s.y < 0) || (ci.y < 0 && s.y >= N.y))) {  // rule b: wall
-            if (Y_MODE == 0) {
-                gin[i] = own[ib];
-            } else {  // free slip: specular reflection
-                ivec2 s2 = ivec2(x.x - ci.x, x.y);
-                if (X_PERIODIC == 0 && ((ci.x > 0 && s2.x < 0) || (ci.x < 0 && s2.x >= N.x)))
-                    gin[i] = own[ib];
-                else
-                    gin[i] = pop(reflect_y(i), wrap(s2));
-            }
+        bool wall = Y_MODE != 2 && ((ci.y > 0 && s.y < 0) || (ci.y < 0 && s.y >= N.y));
+        ivec2 s2 = ivec2(x.x - ci.x, x.y);
+        // a free-slip tunnel corner keeps the inlet/outlet rule
+        bool corner = Y_MODE == 1 && X_PERIODIC == 0 && ((ci.x > 0 && s2.x < 0) || (ci.x < 0 && s2.x >= N.x));
+        if (wall && !corner) {  // rule b: channel wall
+            if (Y_MODE == 0) gin[i] = own[ib];                      // half-way bounce-back
+            else gin[i] = pop(reflect_y(i), wrap(s2));              // specular reflection
         } else if (X_PERIODIC == 0 && ci.x > 0 && s.x < 0) {  // rule c: inlet
             gin[i] = own[ib] + 6.0 * W[i] * RHO0 * (float(ci.x) * uin);
-        } else if (X_PERIODIC == 0 && ci.x < 0 && s.x >= N.x) {  // rule d: outlet, zero gradient
-            gin[i] = pop(i, wrap(ivec2(N.x - 1, s.y)));
+        } else if (X_PERIODIC == 0 && ci.x < 0 && s.x >= N.x) {  // rule d: pressure outlet
+            float cu = dot(vec2(ci), u_out);
+            gin[i] = -own[ib] + 2.0 * W[i] * RHO0 * (4.5 * cu * cu - 1.5 * usq_out);
         }  // else rules e, f: gin[i] as streamed (wrapped)
 #endif
     }

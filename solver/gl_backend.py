@@ -30,8 +30,9 @@ API for the app (a QOpenGLWidget sharing this context):
   `field_texture()` the bound framebuffer is the solver's, so a paintGL must re-bind its own
   (`ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`) and its own textures.
 - Divergence: a non-finite value in the body window (read each step that computes forces) or
-  in the tile sums of the finite check (every `check_interval` steps and at the end of each
-  `step(n)`) raises `solver.backend.SolverDiverged`, as the reference does.
+  in the tile sums of the finite check (every `check_interval` steps, default every step, read
+  back one step late so the pipeline keeps running, and at the end of each `step(n)`) raises
+  `solver.backend.SolverDiverged` with the step that produced it, as the reference does.
 """
 from __future__ import annotations
 
@@ -106,7 +107,7 @@ class GLSolver(Solver):
     #: default tuning (docs/performance.md measures each choice)
     TUNING = {"split": True, "fetch_normalized": True}
 
-    def __init__(self, config, ctx=None, check_interval: int = 64, tuning: dict | None = None):
+    def __init__(self, config, ctx=None, check_interval: int = 1, tuning: dict | None = None):
         super().__init__(config)
         if ctx is None or not isinstance(ctx, moderngl.Context):
             raise BackendError("the gl backend needs a moderngl.Context (ctx=); it never creates one")
@@ -159,6 +160,7 @@ class GLSolver(Solver):
         self._inflow_key = None
         self._draws = []
         self._field = self._check = None
+        self._pending_check = None
 
         self.inflow_speed = float(cfg.inflow_speed)
         self.inflow_capped = False
@@ -311,7 +313,7 @@ class GLSolver(Solver):
             if self.check_interval > 0 and self.time % self.check_interval == 0:
                 self._check_finite()
         if n > 0:
-            self._check_finite()
+            self._check_finite(final=True)
             self._forces = {name: (s[0] / n, s[1] / n) for name, s in sums.items()}
 
     def time_variant(self, key, draws: int) -> float:
@@ -354,18 +356,41 @@ class GLSolver(Solver):
                        body_force=tuple(float(v) for v in self.config.body_force))
         return prog, tex, fbo, vao
 
-    def _check_finite(self):
-        """Tile sums of g_0..g_3 on the GPU, read back (nx/16 x ny/16 texels)."""
+    def _issue_check(self):
+        """Queue the tile sums of the current state into one of two targets; return it."""
         if self._check is None:
             size = (-(-self.nx // CHECK_BLOCK), -(-self.ny // CHECK_BLOCK))
-            self._check = self._aux_pass("finite_check.glsl", size, {"BLOCK": CHECK_BLOCK})
-        prog, tex, fbo, vao = self._check
+            first = self._aux_pass("finite_check.glsl", size, {"BLOCK": CHECK_BLOCK})
+            tex = self.ctx.texture(size, 4, dtype="f4")
+            fbo = self.ctx.framebuffer(color_attachments=[tex])
+            self._objects += [fbo, tex]
+            self._check = (first, (first[0], tex, fbo, first[3]))
+            self._check_slot = 0
+        prog, tex, fbo, vao = self._check[self._check_slot]
+        self._check_slot = 1 - self._check_slot
         self._begin_pass(fbo, tex.size)
         self._g[self._cur][0].use(location=UNIT_G[0])
         vao.render(moderngl.TRIANGLES)
+        return fbo
+
+    def _resolve_check(self):
+        """Read the pending check (one step old, so the GPU has usually finished it)."""
+        if self._pending_check is None:
+            return
+        step, fbo = self._pending_check
+        self._pending_check = None
         sums = np.frombuffer(fbo.read(components=4, dtype="f4"), dtype="f4")
         if not np.all(np.isfinite(sums)):
-            raise SolverDiverged(self.time, "density is no longer finite")
+            raise SolverDiverged(step, "density is no longer finite")
+
+    def _check_finite(self, final=False):
+        """Divergence check of the step just done (algorithm.md, 'Divergence'): the tile sums
+        are read one step late (pipelined), and at the end of each step(n) call."""
+        fbo = self._issue_check()
+        self._resolve_check()
+        self._pending_check = (self.time, fbo)
+        if final:
+            self._resolve_check()
 
     # --- body -------------------------------------------------------------------
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
