@@ -1,7 +1,7 @@
 """Loading the GLSL programs in `shaders/`: lattice constants injected, driver lines kept true.
 
-Every file in `shaders/` is one shader stage, `#version 330 core` on line 1 (GL 3.3 core, which
-macOS's 4.1 core also runs). A line `// @LATTICE` is replaced by the D2Q9 constants of
+Every file in `shaders/` is one shader stage whose line 1 is the `#version` directive for GLSL
+330 core (GL 3.3 core, which macOS's 4.1 core also runs). A line `// @LATTICE` is replaced by the D2Q9 constants of
 `solver.lattice.glsl_constants()` (the one lattice definition, DESIGN rule 3) and by any
 compile-time `#define`s a variant asks for; a `#line` directive after the injected block puts
 the driver's line numbers back on the file's own lines, so a compile error reported by the
@@ -16,6 +16,8 @@ from solver.lattice import glsl_constants
 
 SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
 MARKER = "// @LATTICE"
+#: what line 1 of every shader must declare after `#version`
+GLSL_VERSION = "330 core"
 _DRIVER_LINE = re.compile(r"^\s*\d+:(\d+)\((\d+)\):\s*(.*)$")
 
 
@@ -31,8 +33,8 @@ def shader_source(name: str, defines: dict | None = None, directory: Path = SHAD
     except OSError as exc:
         raise ShaderError(f"{path}: cannot read shader: {exc.strerror}") from None
     lines = text.splitlines()
-    if not lines or lines[0].strip() != "#version 330 core":
-        raise ShaderError(f"{path}:1: the first line must be '#version 330 core'")
+    if not lines or lines[0].split(None, 1) != ["#version", GLSL_VERSION]:
+        raise ShaderError(f"{path}:1: the first line must be the #version directive for GLSL {GLSL_VERSION}")
     out = []
     for number, line in enumerate(lines, start=1):
         if line.strip() == MARKER:
