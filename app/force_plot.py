@@ -79,6 +79,7 @@ class ForcePlot(QWidget):
         self.plot.getAxis("bottom").setLabel("time (solver steps)")
         self.plot.getAxis("left").setLabel("force (lattice units)")
         for ax in ("bottom", "left"):
+            self.plot.getAxis(ax).enableAutoSIPrefix(False)
             f = self.plot.getAxis(ax).label.font()
             f.setPointSize(11)
             self.plot.getAxis(ax).label.setFont(f)
@@ -149,7 +150,10 @@ class ForcePlot(QWidget):
             return math.nan, math.nan
         area = sim.shape.frontal_area(tuple(drag_direction(w[-1])[0]))
         q = 0.5 * u * u * area
-        return float(np.nanmean(drag[-last:]) / q), float(np.nanmean(lift[-last:]) / q)
+        d, l_ = drag[-last:], lift[-last:]
+        if not np.isfinite(d).any():
+            return math.nan, math.nan
+        return float(np.nanmean(d) / q), float(np.nanmean(l_) / q)
 
     def _update_readout(self):
         cd, cl = self.coefficients()

@@ -8,11 +8,15 @@ import math
 import time
 
 import numpy as np
-from PySide6.QtCore import QSettings, Qt, QTimer, Signal
-from PySide6.QtGui import QAction, QKeySequence, QUndoStack
+from PySide6.QtCore import QPoint, QSettings, Qt, QTimer, Signal
+from PySide6.QtGui import QAction, QKeySequence, QPainter, QUndoStack
 from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox
 
-from app.force_plot import ForcePlot
+from app.qt_runtime import make_none_immortal
+
+make_none_immortal()  # before any Qt object: see app/qt_runtime.py
+
+from app.force_plot import ForcePlot  # noqa: E402
 from app.presets import PRESETS
 from app.shape_editor import DEFAULT_POLYGON, SetPolygon
 from app.side_panel import SidePanel
@@ -400,10 +404,19 @@ class MainWindow(QMainWindow):
         if path:
             self._try(lambda: self.save_screenshot(path), "Could not save the screenshot")
 
+    def window_image(self):
+        """The whole window as shown: QWidget.grab() misses the QPainter overlay of the GL view,
+        so the viewport's own rendering is painted over its place."""
+        image = self.grab().toImage()
+        painter = QPainter(image)
+        painter.drawImage(self.viewport.mapTo(self, QPoint(0, 0)), self.viewport.grabFramebuffer())
+        painter.end()
+        return image
+
     def save_screenshot(self, path):
         from app.files import atomic_path
 
-        image = self.grab()
+        image = self.window_image()
         with atomic_path(path, suffix=".png") as tmp:
             if not image.save(str(tmp), "PNG"):
                 raise OSError(f"cannot write {path}")

@@ -96,7 +96,7 @@ class Viewport(QOpenGLWidget):
         if self._lut is None:
             self._lut = self.ctx.texture((256, 1), 4, dtype="f1")
             self._lut.repeat_x = self._lut.repeat_y = False
-        self._lut.write(np.ascontiguousarray(table).tobytes())
+        self._lut.write(np.ascontiguousarray(table).tobytes(), alignment=4)
         self._lut_name = name
 
     def upload_field(self, rgba: np.ndarray):
@@ -107,7 +107,7 @@ class Viewport(QOpenGLWidget):
             self._own_texture = True
             self.field_texture = tex = self.ctx.texture((nx, ny), 4, dtype="f4")
             tex.repeat_x = tex.repeat_y = False
-        tex.write(np.ascontiguousarray(rgba, np.float32).tobytes())
+        tex.write(np.ascontiguousarray(rgba, np.float32).tobytes(), alignment=4)
 
     def use_texture(self, texture):
         """gl path: draw the solver's own field texture."""
@@ -134,33 +134,43 @@ class Viewport(QOpenGLWidget):
         return QPointF(r.left() + (x + 0.5) / nx * r.width(), r.bottom() - (y + 0.5) / ny * r.height())
 
     def paintGL(self):
+        painter = QPainter(self)
+        painter.beginNativePainting()   # Qt's GL state is saved; moderngl draws the field
+        try:
+            self._draw_field()
+        finally:
+            painter.endNativePainting()
+        self._paint_overlay(painter)
+        painter.end()
+        self.frames += 1
+
+    def _draw_field(self):
         ctx = self.ctx
         ctx.enable_only(moderngl.NOTHING)
         fbo = ctx.detect_framebuffer(self.defaultFramebufferObject())
         fbo.use()
         dpr = self.devicePixelRatioF()
-        ctx.viewport = (0, 0, int(self.width() * dpr), int(self.height() * dpr))
+        full = (0, 0, int(self.width() * dpr), int(self.height() * dpr))
+        ctx.viewport = full
         ctx.clear(0.16, 0.17, 0.19, 1.0)
-        if self.sim is not None and self.field_texture is not None:
-            mode = DISPLAY_MODES[self.mode]
-            self._ensure_lut(mode.colormap)
-            r = self.lattice_rect()
-            H = self.height()
-            ctx.viewport = (int(round(r.left() * dpr)), int(round((H - r.bottom()) * dpr)),
-                            int(round(r.width() * dpr)), int(round(r.height() * dpr)))
-            self.field_texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
-            self.field_texture.use(0)
-            self._lut.filter = (moderngl.LINEAR, moderngl.LINEAR)
-            self._lut.use(1)
-            self.program["field"] = 0
-            self.program["lut"] = 1
-            self.program["mode"] = mode.shader_mode
-            self.program["scale"] = self.display_scale()
-            self.program["range"] = mode.range
-            self.vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
-            ctx.viewport = (0, 0, int(self.width() * dpr), int(self.height() * dpr))
-        self._paint_overlay()
-        self.frames += 1
+        if self.sim is None or self.field_texture is None:
+            return
+        mode = DISPLAY_MODES[self.mode]
+        self._ensure_lut(mode.colormap)
+        r = self.lattice_rect()
+        ctx.viewport = (int(round(r.left() * dpr)), int(round((self.height() - r.bottom()) * dpr)),
+                        int(round(r.width() * dpr)), int(round(r.height() * dpr)))
+        self.field_texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self.field_texture.use(0)
+        self._lut.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self._lut.use(1)
+        self.program["field"] = 0
+        self.program["lut"] = 1
+        self.program["mode"] = mode.shader_mode
+        self.program["scale"] = self.display_scale()
+        self.program["range"] = mode.range
+        self.vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
+        ctx.viewport = full
 
     def display_scale(self) -> float:
         """Lattice value -> the colour bar's unit (reference speed: the wind, or half the cap)."""
@@ -174,21 +184,17 @@ class Viewport(QOpenGLWidget):
         return 1.0 / u
 
     # --- overlay ------------------------------------------------------------------------------
-    def _paint_overlay(self):
+    def _paint_overlay(self, p: QPainter):
         if self.sim is None:
             return
-        p = QPainter(self)
         p.setRenderHint(QPainter.Antialiasing)
-        try:
-            if self.mode == "tracers" and self.tracers is not None:
-                self._paint_tracers(p)
-            self._paint_body(p)
-            if self.show_arrows and self.arrow_forces:
-                self._paint_arrows(p)
-            self._paint_colour_bar(p)
-            self._paint_notes(p)
-        finally:
-            p.end()
+        if self.mode == "tracers" and self.tracers is not None:
+            self._paint_tracers(p)
+        self._paint_body(p)
+        if self.show_arrows and self.arrow_forces:
+            self._paint_arrows(p)
+        self._paint_colour_bar(p)
+        self._paint_notes(p)
 
     def body_outline_points(self, outline=None):
         pts = self.sim.shape.outline() if outline is None else outline
@@ -270,7 +276,6 @@ class Viewport(QOpenGLWidget):
 
     def _paint_colour_bar(self, p: QPainter):
         mode = DISPLAY_MODES[self.mode]
-        cmap = pg.colormap.get(mode.colormap)
         r = self.lattice_rect()
         x = self.width() - COLOUR_BAR_MARGIN + 22
         top, bottom = max(40.0, r.top() + 30), min(self.height() - 20.0, r.bottom() - 10)
@@ -278,11 +283,11 @@ class Viewport(QOpenGLWidget):
             top, bottom = 30.0, self.height() - 10.0
         bar = QRectF(x, top, 20, bottom - top)
         grad = QLinearGradient(0, bottom, 0, top)
-        for s in np.linspace(0, 1, 17):
-            c = cmap.map(float(s), mode=pg.ColorMap.QCOLOR)
-            if mode.shader_mode == 3:
-                c = QColor(int(0.7 * 245 + 0.3 * c.red()), int(0.7 * 245 + 0.3 * c.green()), int(0.7 * 245 + 0.3 * c.blue()))
-            grad.setColorAt(float(s), c)
+        table = pg.colormap.get(mode.colormap).getLookupTable(0.0, 1.0, 17, alpha=False)
+        for k, (r_, g_, b_) in enumerate(table.tolist()):
+            if mode.shader_mode == 3:  # the faded speed map of the tracer view (display.glsl)
+                r_, g_, b_ = (int(0.7 * 245 + 0.3 * c) for c in (r_, g_, b_))
+            grad.setColorAt(k / 16.0, QColor(int(r_), int(g_), int(b_)))
         p.setPen(QPen(QColor(230, 230, 230), 1))
         p.setBrush(QBrush(grad))
         p.drawRect(bar)

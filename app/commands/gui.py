@@ -47,6 +47,9 @@ def main(args) -> int:
         raise UserError("no display to open the window on (DISPLAY is not set); "
                         "use 'feelflow run' for a headless run, or run under xvfb-run")
     backend = getattr(args, "backend", None) or DEFAULT_BACKEND
+    from app.qt_runtime import make_none_immortal
+
+    make_none_immortal()
     set_surface_format()
     from PySide6.QtCore import QSettings
     from PySide6.QtWidgets import QApplication
