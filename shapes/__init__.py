@@ -1,1 +1,14 @@
-"""FeelFlow shapes package."""
+"""FeelFlow shapes: exact-geometry bodies and their rasterisation onto the D2Q9 lattice.
+
+Qt-free and solver-free (numpy only). Geometry in lattice units, angles in radians (CCW).
+"""
+from shapes.base import BodyRaster, Shape, ShapeError
+from shapes.cylinder import Cylinder
+from shapes.polygon import FlatPlate, HalfAirfoil, Polygon, PolygonalShape, Wedge
+from shapes.io import from_dict, load_shape, save_shape, to_dict
+from shapes.raster import rasterise
+
+__all__ = [
+    "BodyRaster", "Shape", "ShapeError", "Cylinder", "Polygon", "PolygonalShape", "FlatPlate",
+    "Wedge", "HalfAirfoil", "rasterise", "from_dict", "to_dict", "save_shape", "load_shape",
+]

@@ -22,10 +22,21 @@ class BackendError(RuntimeError):
     """The backend cannot run here (no GL context, unsupported feature); the message says why."""
 
 
+class SolverDiverged(RuntimeError):
+    """The flow blew up (NaN/inf density): the state is lost; reset it. `step` is where."""
+
+    def __init__(self, step: int, detail: str = ""):
+        super().__init__(f"the flow diverged at step {step}{': ' + detail if detail else ''}"
+                         " (lower the speed or raise the viscosity/resolution, then reset)")
+        self.step = step
+
+
 class Solver(ABC):
     """A D2Q9 lattice with at most one rigid body (docs/algorithm.md)."""
 
     name: str = "abstract"
+    #: True when the last set_body motion (or the inflow) was reduced to config.max_speed
+    speed_capped: bool = False
 
     def __init__(self, config: FlowConfig):
         self.config = config.validate()
@@ -61,13 +72,17 @@ class Solver(ABC):
         """Replace the state with full populations f (9, ny, nx)."""
 
     def macroscopic(self):
-        """(rho, ux, uy), each (ny, nx) float64, from the stored populations."""
+        """(rho, ux, uy), each (ny, nx) float64, from the stored post-collision populations.
+
+        With a body force F (Guo et al. 2002) the collision adds F to the momentum, so the
+        fluid velocity of the step is u = (sum_i c_i f*_i - F/2) / rho."""
         from solver.lattice import C
 
         f = self.distributions()
         rho = f.sum(axis=0)
-        ux = np.tensordot(C[:, 0].astype(float), f, axes=1) / rho
-        uy = np.tensordot(C[:, 1].astype(float), f, axes=1) / rho
+        fx, fy = self.config.body_force
+        ux = (np.tensordot(C[:, 0].astype(float), f, axes=1) - 0.5 * fx) / rho
+        uy = (np.tensordot(C[:, 1].astype(float), f, axes=1) - 0.5 * fy) / rho
         return rho, ux, uy
 
     def total_mass(self) -> float:

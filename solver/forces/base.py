@@ -23,6 +23,8 @@ class BodyWindow:
     shape: the body (a shapes.Shape at its current pose); velocity (vx, vy); omega.
     impulse: (Jx, Jy) cover/uncover momentum booked for this step.
     config: the flow configuration (inflow, viscosity, boundaries).
+    links: the window's Bouzidi body links (solver.bouzidi.BodyLinks) when the backend has
+        them already, else None (models build them with solver.bouzidi.build_links).
     fluid_in_domain: (h, w) bool, True for fluid nodes (False for solid and nothing else:
         the window never extends outside the domain; the body is kept away from its edges).
     """
@@ -37,6 +39,7 @@ class BodyWindow:
     omega: float
     impulse: tuple[float, float]
     config: FlowConfig
+    links: object = None
 
     @property
     def fluid(self) -> np.ndarray:

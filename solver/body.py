@@ -1,0 +1,160 @@
+"""The rigid body on the lattice: pose, motion, cover/uncover refill and the force window.
+
+docs/algorithm.md, 'Moving the body'. Refill after Lallemand & Luo, J. Comput. Phys. 184 (2003)
+406: an uncovered node gets f^eq(rho_new, u_body) with rho_new the mean density of its fluid
+neighbours. Shared by both backends: the gl backend reads back the body window, calls `refill`
+on it and writes the changed nodes back.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.bouzidi import BodyLinks, build_links, wall_velocity
+from solver.lattice import C, Q, RHO0, W, equilibrium
+from solver.speed_limit import cap_rigid_motion
+
+#: nodes around the raster window the force window keeps: the Bouzidi second node (1) + 1
+BASE_MARGIN = 2
+
+
+def window_margin(models) -> int:
+    """Margin of the force window: BASE_MARGIN, or more where an enabled model asks for it
+    through a `margin` attribute (e.g. the macroscopic model: ceil(contour distance) + 2)."""
+    return max([BASE_MARGIN] + [int(getattr(m, "margin", 0)) for m in models])
+
+
+def expand_box(box, margin: int, nx: int, ny: int):
+    """(x0, y0, x1, y1) half-open box grown by margin, clipped to the domain."""
+    x0, y0, x1, y1 = box
+    return (max(0, x0 - margin), max(0, y0 - margin), min(nx, x1 + margin), min(ny, y1 + margin))
+
+
+def union_box(a, b):
+    if a is None:
+        return b
+    if b is None:
+        return a
+    return (min(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]), max(a[3], b[3]))
+
+
+def body_radius(shape) -> float:
+    """Largest distance from the reference point to the bounding box: bounds |Omega| r."""
+    xmin, ymin, xmax, ymax = shape.bounding_box()
+    return max(math.hypot(px - shape.x, py - shape.y) for px in (xmin, xmax) for py in (ymin, ymax))
+
+
+def capped_motion(shape, velocity, omega, max_speed):
+    """The body motion under the Mach limit: ((vx, vy), omega, capped)."""
+    radius = body_radius(shape) if shape is not None else 0.0
+    return cap_rigid_motion(velocity, omega, radius, max_speed)
+
+
+def node_velocity(shape, velocity, omega, x0, y0, h, w):
+    """u_body at every node of a window, two (h, w) arrays."""
+    py, px = np.mgrid[y0:y0 + h, x0:x0 + w].astype(np.float64)
+    ux, uy = wall_velocity(px, py, (shape.x, shape.y), velocity, omega)
+    return np.broadcast_to(ux, (h, w)).astype(np.float64), np.broadcast_to(uy, (h, w)).astype(np.float64)
+
+
+def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, velocity, omega,
+           x0: int, y0: int):
+    """Cover, uncover and re-equilibrate the solid nodes of a window of full f* (in place).
+
+    f: (9, h, w) float64 post-collision populations; masks cut to the same window, which must
+    reach one node beyond every old and new solid node (or the domain edge).
+    Covered nodes (new & ~old) give their momentum to the body; uncovered ones (old & ~new)
+    get f^eq(rho_new, u_body) and take momentum -rho_new u_body from it; every solid node gets
+    f^eq(RHO0, u_body). `shape` gives u_body: the new body, or the old one when it is removed
+    (None: at rest). Returns (impulse (Jx, Jy), changed (h, w) bool mask of written nodes).
+    """
+    h, w = new_solid.shape
+    covered = new_solid & ~old_solid
+    uncovered = old_solid & ~new_solid
+    jx = jy = 0.0
+    if covered.any():
+        fc = f[:, covered]
+        jx += float(C[:, 0].astype(np.float64) @ fc.sum(axis=1))
+        jy += float(C[:, 1].astype(np.float64) @ fc.sum(axis=1))
+    if shape is not None:
+        ux, uy = node_velocity(shape, velocity, omega, x0, y0, h, w)
+    else:
+        ux = uy = np.zeros((h, w))
+    if uncovered.any():
+        rho = f.sum(axis=0)
+        donor = ~new_solid & ~uncovered
+        rsum = np.zeros((h, w))
+        cnt = np.zeros((h, w))
+        pad_r = np.pad(np.where(donor, rho, 0.0), 1)
+        pad_c = np.pad(donor.astype(np.float64), 1)
+        for k in range(1, Q):
+            cx, cy = int(C[k, 0]), int(C[k, 1])
+            rsum += pad_r[1 + cy:1 + cy + h, 1 + cx:1 + cx + w]
+            cnt += pad_c[1 + cy:1 + cy + h, 1 + cx:1 + cx + w]
+        rho_new = np.where(cnt > 0, rsum / np.maximum(cnt, 1), RHO0)[uncovered]
+        uxu, uyu = ux[uncovered], uy[uncovered]
+        f[:, uncovered] = equilibrium(rho_new, uxu, uyu)
+        jx -= float((rho_new * uxu).sum())
+        jy -= float((rho_new * uyu).sum())
+    if new_solid.any():
+        f[:, new_solid] = equilibrium(np.full(int(new_solid.sum()), RHO0), ux[new_solid], uy[new_solid])
+    return (jx, jy), (new_solid | uncovered)
+
+
+@dataclass
+class BodyState:
+    """The body on the grid: shape at its pose, capped motion, raster, windows and links.
+
+    window: (x0, y0, x1, y1) force window (raster window + margin, clipped to the domain);
+    links: the Bouzidi body links of that window; solid_nodes: (ny_idx, nx_idx) of solid nodes.
+    """
+
+    shape: object
+    velocity: tuple[float, float]
+    omega: float
+    capped: bool
+    raster: object
+    window: tuple[int, int, int, int]
+    links: BodyLinks
+
+    @property
+    def solid(self) -> np.ndarray:
+        return self.raster.solid
+
+    def window_slices(self):
+        x0, y0, x1, y1 = self.window
+        return slice(y0, y1), slice(x0, x1)
+
+    def window_arrays(self):
+        """(solid, q) cut to the force window."""
+        ys, xs = self.window_slices()
+        return self.raster.solid[ys, xs], self.raster.q[:, ys, xs]
+
+
+def make_body_state(shape, velocity, omega, config, margin: int, raster=None) -> BodyState:
+    """Rasterise `shape` (unless `raster` is given: a BodyRaster of this shape with any
+    window margin), cap its motion and build its links on raster.window + margin."""
+    from shapes.raster import rasterise
+
+    nx, ny = config.nx, config.ny
+    shape.validate(nx, ny)
+    vel, om, capped = capped_motion(shape, velocity, omega, config.max_speed)
+    if raster is None:
+        raster = rasterise(shape, nx, ny, 0)
+    window = expand_box(raster.window, margin, nx, ny)
+    x0, y0, x1, y1 = window
+    links = build_links(raster.q[:, y0:y1, x0:x1], raster.solid[y0:y1, x0:x1], x0, y0,
+                        (shape.x, shape.y), vel, om)
+    return BodyState(shape, vel, om, capped, raster, window, links)
+
+
+def shifted(f: np.ndarray) -> np.ndarray:
+    """g = f - w_i RHO0 for a (9, ...) array."""
+    return f - (W * RHO0).reshape((Q,) + (1,) * (f.ndim - 1))
+
+
+def unshifted(g: np.ndarray) -> np.ndarray:
+    """f = g + w_i RHO0, float64."""
+    return g.astype(np.float64) + (W * RHO0).reshape((Q,) + (1,) * (g.ndim - 1))

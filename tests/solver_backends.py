@@ -1,0 +1,15 @@
+"""Backend parametrisation for solver physics tests: numpy always, gl where it has landed."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+GL_LANDED = (Path(__file__).resolve().parents[1] / "solver" / "gl_backend.py").exists()
+
+#: use as @pytest.mark.parametrize("backend", BACKENDS)
+BACKENDS = [
+    "numpy",
+    pytest.param("gl", marks=[pytest.mark.gl,
+                              pytest.mark.skipif(not GL_LANDED, reason="solver/gl_backend.py not landed yet")]),
+]
