@@ -23,10 +23,12 @@ from app.side_panel import SidePanel
 from app.simulation import FORCE_MODELS, Params, Simulation
 from app.viewport import DISPLAY_MODES, Viewport
 from shapes.base import ShapeError
+from solver.backend import SolverDiverged  # noqa: E402
 from solver.config import ConfigError
 
 TARGET_FRAME_S = 1.0 / 34      # aim a little above 30 fps
 MAX_STEPS_PER_FRAME = 200
+MIN_STEPS_PER_FRAME = 2   # the flow keeps moving even where drawing alone takes 1/30 s
 N_TRACERS = 1500
 
 
@@ -86,7 +88,7 @@ class MainWindow(QMainWindow):
         self.timer.setInterval(0)
         self.timer.timeout.connect(self.tick)
         self.slow_timer = QTimer(self)
-        self.slow_timer.setInterval(250)
+        self.slow_timer.setInterval(500)
         self.slow_timer.timeout.connect(self.refresh_readouts)
 
     # --- settings ---------------------------------------------------------------------------
@@ -359,7 +361,7 @@ class MainWindow(QMainWindow):
         from shapes import io as shape_io
 
         try:
-            shape_io.save_shape(self.sim.shape, path)
+            shape_io.save_shape(path, self.sim.shape)
         except (OSError, ShapeError, ValueError) as exc:
             QMessageBox.warning(self, "Could not save the shape", str(exc))
 
@@ -495,7 +497,11 @@ class MainWindow(QMainWindow):
         n = self.steps_per_frame
         self._make_current()
         t0 = time.perf_counter()
-        forces = self.sim.advance(n)
+        try:
+            forces = self.sim.advance(n)
+        except SolverDiverged:
+            self._on_nan()
+            return
         t1 = time.perf_counter()
         rgba = self._upload_field()
         finite = all(math.isfinite(v) for f in forces.values() for v in f)
@@ -517,7 +523,7 @@ class MainWindow(QMainWindow):
             self._other_cost = 0.8 * self._other_cost + 0.2 * min(other, 0.2)
         self._last_tick, self._last_step_s = now, t1 - t0
         budget = TARGET_FRAME_S - self._other_cost
-        self.steps_per_frame = int(max(1, min(MAX_STEPS_PER_FRAME, budget / max(self._step_cost, 1e-6))))
+        self.steps_per_frame = int(max(MIN_STEPS_PER_FRAME, min(MAX_STEPS_PER_FRAME, budget / max(self._step_cost, 1e-6))))
         w = self._rate_window
         w[1] += n
         w[2] += 1

@@ -28,7 +28,7 @@ PRESETS = {
                          note="The wind steps up from 0.02 to 0.09; watch the log-log slope.",
                          wind_sweep=(0.02, 0.03, 0.045, 0.065, 0.09), plot_view="speed"),
     "shape_matters": Preset("Shape matters: plate, wedges, cylinder",
-                            Params(shape="flat_plate", size=24, wind=0.05, nu=0.01),
+                            Params(shape="plate", size=24, wind=0.05, nu=0.01),
                             note="Switch Shape between plate, wedge and cylinder and compare C_D."),
     "lift": Preset("Lift on the half airfoil",
                    Params(shape="half_airfoil", size=40, wind=0.05, nu=0.01),

@@ -23,8 +23,9 @@ def send_mouse(widget, kind, pos: QPointF, button=Qt.LeftButton):
     QApplication.sendEvent(widget, ev)
 
 
-def drag_body(window, dx_cells: float, dy_cells: float, moves: int = 10):
-    """Press on the body centre and drag by (dx, dy) cells; returns the generator of steps."""
+def drag_body(window, dx_cells: float, dy_cells: float, moves: int = 10, hold_ticks: int = 0):
+    """Press on the body centre, drag by (dx, dy) cells in `moves` moves and keep holding for
+    `hold_ticks` more; a generator: one mouse event per step."""
     vp, sim = window.viewport, window.sim
     start = vp.to_widget(*sim.pos)
     end = vp.to_widget(sim.pos[0] + dx_cells, sim.pos[1] + dy_cells)
@@ -32,7 +33,8 @@ def drag_body(window, dx_cells: float, dy_cells: float, moves: int = 10):
     for k in range(1, moves + 1):
         yield
         send_mouse(vp, "move", start + (end - start) * (k / moves))
-    yield
+    for _ in range(hold_ticks + 1):
+        yield
     send_mouse(vp, "release", end)
 
 
@@ -105,8 +107,8 @@ class SelfTest:
 
         # drag the body 40 cells downstream and 12 up
         before = sim.pos
-        yield from drag_body(w, 40, 12)
-        yield from self._wait(0.25 * self.seconds)
+        yield from drag_body(w, 40, 12, hold_ticks=int(0.25 * self.seconds / 0.05))
+        yield from self._wait(0.5)
         moved = math.hypot(sim.pos[0] - before[0], sim.pos[1] - before[1])
         self.results["body_moved_cells"] = moved
         if moved < 5:
@@ -114,8 +116,8 @@ class SelfTest:
 
         # switch shape and force model through the panel, as a user would
         panel = w.panel
-        panel.shape.setCurrentIndex(panel.shape.findData("flat_plate"))
-        if sim.params.shape != "flat_plate":
+        panel.shape.setCurrentIndex(panel.shape.findData("plate"))
+        if sim.params.shape != "plate":
             self.failures.append("switching the shape in the panel did not change the body")
         panel.model.setCurrentIndex(panel.model.findData("pressure"))
         if sim.params.force_model != "pressure":

@@ -34,7 +34,7 @@ WALLS = {"no_slip": "Solid walls (no slip)", "free_slip": "Slippery walls (free 
          "periodic": "No walls (periodic)"}
 
 #: distance (cells) the body's bounding box keeps from the domain edges
-EDGE_MARGIN = 6.0
+EDGE_MARGIN = 8.0
 
 
 @dataclass
@@ -199,8 +199,12 @@ class Simulation:
         """Change inflow speed, viscosity or walls, keeping the flow as it is (raises ConfigError)."""
         params = replace(self.params, **{k: v for k, v in (("wind", wind), ("nu", nu), ("wall", wall)) if v is not None})
         self.flow_config(params)  # validate first: a bad value leaves everything as it was
+        only_wind = (params.nu, params.wall) == (self.params.nu, self.params.wall)
         self.params = params
-        self._build(keep_flow=True)
+        if only_wind and hasattr(self.solver, "set_inflow_speed"):
+            self.solver.set_inflow_speed(params.wind)   # live, no rebuild
+        else:
+            self._build(keep_flow=True)
 
     def set_grid(self, grid):
         self.params = replace(self.params, grid=tuple(grid))
@@ -265,7 +269,8 @@ class Simulation:
             speed = math.hypot(*self.vel)
             chunk = n - done if speed < 1e-9 else max(1, min(n - done, int(0.5 / speed)))
             self._move_body(chunk)
-            self.solver.step(chunk)
+            self.solver.step(chunk)   # raises solver.backend.SolverDiverged when the flow blows up
+            self.capped |= bool(getattr(self.solver, "speed_capped", False))
             for name, (fx, fy) in self.solver.forces().items():
                 ax, ay = acc.get(name, (0.0, 0.0))
                 acc[name] = (ax + fx * chunk, ay + fy * chunk)

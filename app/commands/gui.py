@@ -11,7 +11,7 @@ import sys
 
 from app.cli import UserError
 
-DEFAULT_BACKEND = "gl"
+DEFAULT_BACKEND = "numpy"  # "gl" once solver/gl_backend.py lands
 
 
 def add_arguments(parser):
