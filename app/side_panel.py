@@ -159,7 +159,10 @@ class SidePanel(QScrollArea):
             self.angle.setValue(params.angle_deg)
             self.wind.setValue(params.wind)
             self.viscosity.setValue(params.nu)
-            select_data(self.grid, f"{params.grid[0]}x{params.grid[1]}")
+            key = f"{params.grid[0]}x{params.grid[1]}"
+            if self.grid.findData(key) < 0:   # a grid from a scene or settings, not a preset
+                self.grid.addItem(f"{params.grid[0]} x {params.grid[1]}", key)
+            select_data(self.grid, key)
             select_data(self.wall, params.wall)
             select_data(self.model, params.force_model)
             self.compare_all.setChecked(params.compare_all)
