@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.lattice import C, OPP, Q, RHO0, W
+from solver.lattice import C, OPP, RHO0, W
 
 
 @dataclass(frozen=True)
@@ -59,44 +59,30 @@ def build_links(q: np.ndarray, solid: np.ndarray, x0: int, y0: int, center, velo
     """
     h, w = solid.shape
     fluid = ~solid
-    parts = []
-    for i in range(1, Q):
-        ib = OPP[i]
-        iy, ix = np.nonzero((q[ib] > 0) & fluid)
-        if iy.size == 0:
-            continue
-        qq = q[ib, iy, ix].astype(np.float64)
-        cx, cy = int(C[i, 0]), int(C[i, 1])
-        fy, fx = iy + cy, ix + cx
-        inside = (fy >= 0) & (fy < h) & (fx >= 0) & (fx < w)
-        fyc, fxc = np.clip(fy, 0, h - 1), np.clip(fx, 0, w - 1)
-        second = inside & fluid[fyc, fxc] & (q[i, iy, ix] == 0)
-        # wall velocity at the crossing x + q c_ib = x - q c_i (world coordinates)
-        wx = x0 + ix - qq * cx
-        wy = y0 + iy - qq * cy
-        ux, uy = wall_velocity(wx, wy, center, velocity, omega)
-        ux = np.broadcast_to(np.asarray(ux, dtype=np.float64), qq.shape)
-        uy = np.broadcast_to(np.asarray(uy, dtype=np.float64), qq.shape)
-        cu = W[i] * RHO0 * (cx * ux + cy * uy)
-        small = qq < 0.5
-        lin = small & second          # 2q f*_ib(x) + (1-2q) f*_ib(xf) + 6 w (c.u_w)
-        big = ~small                  # 1/(2q) f*_ib(x) + (2q-1)/(2q) f*_i(x) + 3/q w (c.u_w)
-        half = small & ~second        # f*_ib(x) + 6 w (c.u_w)
-        a = np.where(lin, 2 * qq, np.where(big, 0.5 / qq, 1.0))
-        b = np.where(lin, 1 - 2 * qq, 0.0)
-        c = np.where(big, (2 * qq - 1) / (2 * qq), 0.0)
-        d = np.where(big, (3.0 / qq) * cu, 6.0 * cu)
-        fy_use = np.where(lin, fy, iy)
-        fx_use = np.where(lin, fx, ix)
-        n = iy.size
-        parts.append((np.full(n, i), np.full(n, ib), iy, ix, fy_use, fx_use, qq,
-                      np.stack([ux, uy], axis=1), a, b, c, d))
-    if not parts:
-        e_i = np.zeros(0, dtype=np.int64)
-        e_f = np.zeros(0, dtype=np.float64)
-        return BodyLinks(e_i, e_i, e_i, e_i, e_i, e_i, e_f, np.zeros((0, 2)), e_f, e_f, e_f, e_f)
-    cols = [np.concatenate(p) for p in zip(*parts)]
-    return BodyLinks(*cols)
+    mask = (q[OPP] > 0) & fluid          # mask[i]: the link of x along c_ib is cut
+    mask[0] = False
+    i, iy, ix = np.nonzero(mask)
+    ib = OPP[i]
+    qq = q[ib, iy, ix].astype(np.float64)
+    cx, cy = C[i, 0], C[i, 1]
+    fy, fx = iy + cy, ix + cx
+    inside = (fy >= 0) & (fy < h) & (fx >= 0) & (fx < w)
+    fyc, fxc = np.clip(fy, 0, h - 1), np.clip(fx, 0, w - 1)
+    second = inside & fluid[fyc, fxc] & (q[i, iy, ix] == 0)
+    # wall velocity at the crossing x + q c_ib = x - q c_i (world coordinates)
+    ux, uy = wall_velocity(x0 + ix - qq * cx, y0 + iy - qq * cy, center, velocity, omega)
+    ux = np.broadcast_to(np.asarray(ux, dtype=np.float64), qq.shape)
+    uy = np.broadcast_to(np.asarray(uy, dtype=np.float64), qq.shape)
+    cu = W[i] * RHO0 * (cx * ux + cy * uy)
+    small = qq < 0.5
+    lin = small & second          # 2q f*_ib(x) + (1-2q) f*_ib(xf) + 6 w (c.u_w)
+    big = ~small                  # 1/(2q) f*_ib(x) + (2q-1)/(2q) f*_i(x) + 3/q w (c.u_w)
+    a = np.where(lin, 2 * qq, np.where(big, 0.5 / qq, 1.0))   # else half-way: f*_ib(x) + 6 w (c.u_w)
+    b = np.where(lin, 1 - 2 * qq, 0.0)
+    c = np.where(big, (2 * qq - 1) / (2 * qq), 0.0)
+    d = np.where(big, (3.0 / qq) * cu, 6.0 * cu)
+    return BodyLinks(i, ib, iy, ix, np.where(lin, fy, iy), np.where(lin, fx, ix), qq,
+                     np.stack([ux, uy], axis=1), a, b, c, d)
 
 
 def incoming(f: np.ndarray, links: BodyLinks) -> np.ndarray:

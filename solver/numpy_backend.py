@@ -14,6 +14,7 @@ from solver.backend import Solver, SolverDiverged
 from solver.body import (BodyState, expand_box, make_body_state, refill, shifted, union_box,
                          unshifted, window_margin)
 from solver.bouzidi import incoming
+from solver.collision import Collider
 from solver.config import FlowConfig
 from solver.forces import create_model
 from solver.forces.base import BodyWindow
@@ -21,8 +22,6 @@ from solver.inflow import inflow_velocity
 from solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 from solver.speed_limit import cap_speed
 
-#: opposite pairs (i, ib) with i in the upper half plane or east
-PAIRS = ((1, 3), (2, 4), (5, 7), (6, 8))
 #: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall
 MIRROR_Y = np.array([0, 1, 4, 3, 2, 8, 7, 6, 5])
 
@@ -75,11 +74,7 @@ class NumpySolver(Solver):
         self._gin = np.empty_like(self.g)
         self._w = W.astype(self.dtype)
         op, om = relaxation_rates(cfg)
-        if not np.isscalar(op):
-            op, om = op.astype(self.dtype), om.astype(self.dtype)
-        self._omega_p, self._omega_m = op, om
-        self._force = tuple(float(v) for v in cfg.body_force)
-        self._has_force = any(v != 0.0 for v in self._force)
+        self._collide = Collider(ny, nx, self.dtype, op, om, cfg.collision == "trt", cfg.body_force)
         self._roll = []
         for i in range(Q):
             cx, cy = int(C[i, 0]), int(C[i, 1])
@@ -123,7 +118,9 @@ class NumpySolver(Solver):
             self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         self.body = new
         if new is not None:
-            sy, sx = np.nonzero(new.solid)
+            wx0, wy0, wx1, wy1 = new.raster.window  # holds every solid node
+            sy, sx = np.nonzero(new.solid[wy0:wy1, wx0:wx1])
+            sy, sx = sy + wy0, sx + wx0
             self._solid_idx = (sy, sx)
             self._solid_g = self.g[:, sy, sx].copy()
             self.speed_capped = new.capped or self.inflow_capped
@@ -208,12 +205,11 @@ class NumpySolver(Solver):
             L = b.links
             ys, xs = b.window_slices()
             gin[L.i, L.iy + b.window[1], L.ix + b.window[0]] = incoming(g[:, ys, xs], L)
-        drho = self._collide(gin)
+        total = self._collide(gin)
         if self._solid_idx is not None:
             gin[:, self._solid_idx[0], self._solid_idx[1]] = self._solid_g
         self.g, self._gin = gin, g
         self.time = t + 1
-        total = float(drho.sum())
         if not np.isfinite(total):
             raise SolverDiverged(t + 1, "density is no longer finite")
 
@@ -240,109 +236,6 @@ class NumpySolver(Solver):
                 else:
                     gin[i, row, :-1] = src[1:]
                     gin[i, row, nx - 1] = src[0] if periodic_x else g[ib, row, nx - 1]
-
-    def _collide(self, f):
-        """In place: moments, equilibrium, BGK/TRT relaxation, Guo source. Returns drho."""
-        drho = f.sum(axis=0)
-        rho = drho + RHO0
-        f1, f2, f3, f4, f5, f6, f7, f8 = (f[k] for k in range(1, 9))
-        jx = f1 - f3
-        jx += f5
-        jx -= f6
-        jx -= f7
-        jx += f8
-        jy = f2 - f4
-        jy += f5
-        jy += f6
-        jy -= f7
-        jy -= f8
-        Fx, Fy = self._force
-        if self._has_force:
-            jx += 0.5 * Fx
-            jy += 0.5 * Fy
-        ux = jx
-        ux /= rho
-        uy = jy
-        uy /= rho
-        usq = ux * ux
-        usq += uy * uy
-        usq *= 1.5
-        op, om = self._omega_p, self._omega_m
-        trt = self.config.collision == "trt"
-        w = W
-        # rest population: feq_0 - w0 RHO0 = w0 (drho - rho usq); f0 += omega+ (feq0 - f0)
-        tmp = rho * usq
-        np.subtract(drho, tmp, out=tmp)
-        tmp *= w[0]
-        f0 = f[0]
-        tmp -= f0
-        tmp *= op
-        f0 += tmp
-        if self._has_force:
-            uF = ux * Fx + uy * Fy
-            f0 += (1.0 - 0.5 * op) * (w[0] * -3.0) * uF
-        for i, ib in PAIRS:
-            cx, cy = int(C[i, 0]), int(C[i, 1])
-            if cy == 0:
-                cu = 3.0 * ux
-            elif cx == 0:
-                cu = 3.0 * uy
-            elif cx == cy:
-                cu = ux + uy
-                cu *= 3.0
-            else:
-                cu = uy - ux
-                cu *= 3.0
-            # sym = drho + rho (cu^2/2 - usq): feq+ = w sym ; anti = rho cu: feq- = w anti
-            sym = cu * cu
-            sym *= 0.5
-            sym -= usq
-            sym *= rho
-            sym += drho
-            anti = cu
-            anti *= rho
-            fi, fb = f[i], f[ib]
-            if not trt:
-                # BGK: f* = f - omega (f - feq), written as f + omega (feq - f)
-                d = sym + anti
-                d *= w[i]
-                d -= fi
-                d *= op
-                fi += d
-                np.subtract(sym, anti, out=d)
-                d *= w[i]
-                d -= fb
-                d *= op
-                fb += d
-            else:
-                # TRT: f* = f - omega+ (f+ - feq+) - omega- (f- - feq-)
-                dp = fi + fb
-                dp *= 0.5
-                sym *= w[i]
-                dp -= sym
-                dp *= op
-                dm = fi - fb
-                dm *= 0.5
-                anti *= w[i]
-                dm -= anti
-                dm *= om
-                fi -= dp
-                fi -= dm
-                fb -= dp
-                fb += dm
-            if self._has_force:
-                # Guo: S_i = w_i [3 (c_i - u) + 9 (c_i.u) c_i].F ; S+ even, S- odd in c_i
-                cF = cx * Fx + cy * Fy
-                cul = (cx * ux + cy * uy)
-                s_p = w[i] * (9.0 * cul * cF - 3.0 * uF)
-                s_m = 3.0 * w[i] * cF
-                gp = (1.0 - 0.5 * op) * s_p
-                gm = (1.0 - 0.5 * om) * s_m
-                fi += gp
-                fi += gm
-                fb += gp
-                fb -= gm
-        return drho
 
     # --- fields ---------------------------------------------------------------
     def distributions(self) -> np.ndarray:

@@ -21,6 +21,7 @@ def _circle_poly(r, k=40, **pose):
 
 SHAPES = [
     Cylinder(9.0, x=20.3, y=17.8),
+    Cylinder(10.0, x=20.0, y=18.0),             # R = 5: nodes (25, 18), (23, 22) ... on the circle
     _circle_poly(6.5, x=21.7, y=18.2, angle=0.37),
     FlatPlate(12.0, 0.2, x=20.5, y=18.0, angle=0.0),
     FlatPlate(12.0, 0.3, x=20.2, y=17.9, angle=0.6),
