@@ -1,1 +1,40 @@
-"""FeelFlow haptics package."""
+"""FeelFlow haptics: devices (serial, HID, simulated) and the safe 1 kHz force loop.
+
+Qt-free and solver-free (DESIGN.md rule 1): what crosses the boundary are the small value types
+of `haptics.types`. The API for the app:
+
+    from haptics import list_devices, open_device, ForceLoop, LoopConfig, ForceSample
+
+    for info in list_devices():          # DeviceInfo(url, name, kind, driver, details)
+        print(info.url, info.name)       # serial ports, HID devices with a driver, sim://...
+    dev = open_device("sim://haply2diy") # or serial:///dev/ttyACM0, hid://046d:c626, ...
+    dev.capabilities                     # Capabilities(dof, workspace, max_force, can_output_force, ...)
+    loop = ForceLoop(dev, LoopConfig(tunnel_rect=(x0, y0, x1, y1),    # lattice nodes
+                                     expected_peak=0.02,               # lattice force units
+                                     comfort_fraction=0.5),
+                     on_disconnect=callback)       # called from the loop thread
+    loop.start()                                   # own thread, 1 kHz, force ramps up
+    loop.submit_force(ForceSample(fx, fy, t))      # after each solver frame (lattice units)
+    bt = loop.body_target()                        # BodyTarget(x, y, vx, vy [nodes/s], t, buttons, valid)
+    loop.pause(); loop.resume()                    # app paused / running
+    loop.emergency_stop(); loop.clear_stop()       # the stop key
+    loop.status()                                  # LoopStatus: state, rate, jitter, counters
+    loop.stop(); dev.close()
+
+Units: ForceSample is in LATTICE units (tunnel axes); the loop alone converts to newtons
+(`ForceScale`: the scene's expected peak -> comfort_fraction x device maximum) and clamps to the
+device maximum every tick; drivers clamp again. Poses are metres in the device frame.
+Errors: `DeviceError` (cannot open / no answer), `DeviceDisconnected`, `BadDeviceURL`
+(one-line messages, fit for the user).
+"""
+from haptics.errors import BadDeviceURL, DeviceDisconnected, DeviceError
+from haptics.loop import ForceLoop, LoopConfig, LoopStatus
+from haptics.registry import list_devices, open_device
+from haptics.safety import SafetyConfig
+from haptics.types import BodyTarget, Capabilities, DeviceInfo, ForceSample, Pose
+
+__all__ = [
+    "BadDeviceURL", "BodyTarget", "Capabilities", "DeviceDisconnected", "DeviceError", "DeviceInfo",
+    "ForceLoop", "ForceSample", "LoopConfig", "LoopStatus", "Pose", "SafetyConfig", "list_devices",
+    "open_device",
+]

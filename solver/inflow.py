@@ -1,12 +1,18 @@
-"""Inlet velocity: smooth ramp-up times a profile (docs/algorithm.md, 'Inflow').
+"""Tunnel ends: inlet velocity (smooth ramp-up times a profile) and the pressure outlet.
 
-One definition for both backends; the gl backend feeds `inflow_velocity` into its uniforms.
+docs/algorithm.md, rules c and d and 'Inflow'. One definition for both backends; the gl backend
+feeds `inflow_velocity` into its uniforms and implements `outlet_incoming` in GLSL.
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
+
+from solver.lattice import C, OPP, RHO0, W
+
+#: the populations the outlet supplies (c_x = -1)
+OUTLET_DIRECTIONS = (3, 6, 7)
 
 
 def ramp(t: int, ramp_steps: int) -> float:
@@ -34,3 +40,27 @@ def inflow_velocity(config, t: int, speed: float | None = None) -> np.ndarray:
     """u_in,x(iy, t) = ramp(t) * profile(iy), (ny,) float64; `speed` overrides config.inflow_speed."""
     u = config.inflow_speed if speed is None else speed
     return ramp(t, config.inflow_ramp_steps) * profile(config.ny, u, config.inflow_profile)
+
+
+def outlet_incoming(g_last: np.ndarray) -> np.ndarray:
+    """Rule d, anti-bounce-back pressure outlet at x = nx - 1/2 (Krueger et al. 2017, eq. 5.53;
+    Izquierdo & Fueyo 2008): for i in OUTLET_DIRECTIONS, at the last column,
+        f_i^in = -f*_ib + 2 w_i RHO0 (1 + 9/2 (c_i.u_b)^2 - 3/2 u_b^2),
+        u_b = u(nx-1) + (u(nx-1) - u(nx-2)) / 2,  u = sum c f* / sum f*,
+    written for shifted populations: g_i^in = -g*_ib + 2 w_i RHO0 (9/2 (c_i.u_b)^2 - 3/2 u_b^2).
+
+    g_last: (9, ny, 2) shifted post-collision populations of the last two columns.
+    Returns (3, ny) in g_last's dtype, ordered as OUTLET_DIRECTIONS.
+    """
+    g = g_last.astype(np.float64)
+    rho = g.sum(axis=0) + RHO0
+    ux = np.tensordot(C[:, 0].astype(np.float64), g, axes=1) / rho
+    uy = np.tensordot(C[:, 1].astype(np.float64), g, axes=1) / rho
+    bx = 1.5 * ux[:, 1] - 0.5 * ux[:, 0]
+    by = 1.5 * uy[:, 1] - 0.5 * uy[:, 0]
+    usq = bx * bx + by * by
+    out = np.empty((len(OUTLET_DIRECTIONS), g.shape[1]), dtype=g_last.dtype)
+    for k, i in enumerate(OUTLET_DIRECTIONS):
+        cu = C[i, 0] * bx + C[i, 1] * by
+        out[k] = -g[OPP[i], :, 1] + 2.0 * W[i] * RHO0 * (4.5 * cu * cu - 1.5 * usq)
+    return out

@@ -18,7 +18,7 @@ from solver.collision import Collider
 from solver.config import FlowConfig
 from solver.forces import create_model
 from solver.forces.base import BodyWindow
-from solver.inflow import inflow_velocity
+from solver.inflow import inflow_velocity, outlet_incoming
 from solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 from solver.speed_limit import cap_speed
 
@@ -186,14 +186,8 @@ class NumpySolver(Solver):
             for (yd, xd), (ys, xs) in self._roll[i]:
                 di[yd, xd] = gi[ys, xs]
         if cfg.x_boundary == "tunnel":
-            # d: outlet, zero gradient, source clamped to the last column (y wraps; b fixes walls)
-            for i in (3, 6, 7):
-                cy = int(C[i, 1])
-                col = g[i, :, nx - 1]
-                if cy == 0:
-                    gin[i, :, nx - 1] = col
-                else:
-                    gin[i, :, nx - 1] = np.roll(col, cy)
+            # d: outlet, anti-bounce-back at x = nx - 1/2 with rho = RHO0 (pressure outlet)
+            gin[(3, 6, 7), :, nx - 1] = outlet_incoming(g[:, :, nx - 2:])
             # c: inlet, moving-wall half-way bounce-back at x = -1/2
             u_in = inflow_velocity(cfg, t, self.inflow_speed)
             for i in (1, 5, 8):
@@ -215,7 +209,7 @@ class NumpySolver(Solver):
 
     def _walls(self, g, gin) -> None:
         """Rule b: half-way bounce-back (no_slip) or specular reflection (free_slip) at
-        y = -1/2 and y = ny - 1/2."""
+        y = -1/2 and y = ny - 1/2; a free-slip tunnel corner keeps the inlet/outlet rule."""
         cfg = self.config
         nx, ny = cfg.nx, cfg.ny
         periodic_x = cfg.x_boundary == "periodic"
@@ -230,12 +224,14 @@ class NumpySolver(Solver):
                 src = g[j, row, :]
                 if cx == 0:
                     gin[i, row, :] = src
-                elif cx == 1:
+                elif cx == 1:  # tunnel corner: the inlet rule (c) already set it
                     gin[i, row, 1:] = src[:-1]
-                    gin[i, row, 0] = src[-1] if periodic_x else g[ib, row, 0]
-                else:
+                    if periodic_x:
+                        gin[i, row, 0] = src[-1]
+                else:          # tunnel corner: the outlet rule (d) already set it
                     gin[i, row, :-1] = src[1:]
-                    gin[i, row, nx - 1] = src[0] if periodic_x else g[ib, row, nx - 1]
+                    if periodic_x:
+                        gin[i, row, nx - 1] = src[0]
 
     # --- fields ---------------------------------------------------------------
     def distributions(self) -> np.ndarray:

@@ -1,0 +1,1 @@
+"""Device drivers: one class per device family, each handed a transport (haptics.transport)."""

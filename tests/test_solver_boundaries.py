@@ -1,0 +1,101 @@
+"""Domain boundaries on every backend: inflow ramp and profile, free-slip walls, tunnel ends.
+
+Inlet: moving-wall half-way bounce-back (Ladd 1994); outlet: anti-bounce-back pressure outlet
+(Krueger et al. 2017, sec. 5.3.5); walls: half-way bounce-back or specular reflection.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import make_solver
+from solver_backends import BACKENDS
+
+from solver.config import FlowConfig
+from solver.inflow import inflow_velocity, profile, ramp
+from solver.numpy_backend import relaxation_rates
+
+
+def test_ramp_is_smooth_from_zero_to_one():
+    T = 400
+    assert ramp(0, T) == 0.0 and ramp(T, T) == 1.0 and ramp(10 * T, T) == 1.0
+    assert ramp(T // 2, T) == pytest.approx(0.5)
+    assert ramp(1, T) < 1e-4          # zero slope at the start: no pressure shock
+    assert ramp(T - 1, T) > 1 - 1e-4  # and at the end
+    assert all(ramp(t, T) <= ramp(t + 1, T) for t in range(T))
+    assert ramp(0, 0) == 1.0
+
+
+def test_parabolic_profile_peak_and_mean():
+    """4 U s (H - s) / H^2 at s = iy + 1/2: discrete mean 2U/3 (1 + 1/(2 H^2)); peak U at the
+    centre when H is even (s = H/2 falls between two nodes, so the nodes get U (1 - 1/H^2))."""
+    H, U = 20, 0.04
+    p = profile(H, U, "parabolic")
+    assert p.mean() == pytest.approx(2 * U / 3 * (1 + 1 / (2 * H * H)), rel=1e-12)
+    assert p.max() == pytest.approx(U * (1 - 1 / H ** 2), rel=1e-12)
+    assert np.allclose(p, p[::-1])
+    assert np.all(profile(H, U, "uniform") == U)
+    cfg = FlowConfig(nx=40, ny=H, inflow_speed=U, inflow_profile="parabolic", inflow_ramp_steps=100)
+    assert np.allclose(inflow_velocity(cfg, 50), 0.5 * p)
+
+
+def test_sponge_raises_viscosity_towards_the_outlet():
+    cfg = FlowConfig(nx=100, ny=10, nu=0.02, collision="bgk", sponge_cells=20, sponge_strength=10.0)
+    op, _ = relaxation_rates(cfg)
+    nu = (1 / op - 0.5) / 3
+    assert np.allclose(nu[:80], 0.02)
+    assert nu[-1] == pytest.approx(0.2)           # A nu at the last column (s = 1)
+    assert nu[80] == pytest.approx(0.02 * (1 + 9 / 400))  # s = 1/L at the first sponge column
+    assert np.all(np.diff(nu[79:]) > 0)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("walls", ["free_slip", "periodic"])
+def test_uniform_stream_through_the_tunnel_is_a_fixed_point(backend, walls, request):
+    """f = f^eq(RHO0, U) everywhere is reproduced exactly by every rule: the inlet's moving-wall
+    term, the outlet's anti-bounce-back, specular walls and their corners."""
+    U = 0.05
+    cfg = FlowConfig(nx=32, ny=12, nu=0.02, x_boundary="tunnel", y_boundary=walls, inflow_speed=U,
+                     inflow_ramp_steps=0, initial_velocity=(U, 0.0))
+    s = make_solver(backend, cfg, request)
+    s.step(100)
+    rho, ux, uy = s.macroscopic()
+    tol = 1e-13 if backend == "numpy" else 1e-6
+    assert np.abs(rho - 1).max() < tol
+    assert np.abs(ux - U).max() < tol and np.abs(uy).max() < tol
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_free_slip_walls_keep_a_periodic_stream_uniform(backend, request):
+    cfg = FlowConfig(nx=16, ny=12, nu=0.02, x_boundary="periodic", y_boundary="free_slip",
+                     initial_velocity=(0.04, 0.0))
+    s = make_solver(backend, cfg, request)
+    s.step(50)
+    rho, ux, uy = s.macroscopic()
+    tol = 1e-13 if backend == "numpy" else 1e-6
+    assert np.abs(rho - 1).max() < tol and np.abs(ux - 0.04).max() < tol and np.abs(uy).max() < tol
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_channel_with_parabolic_inflow_balances_mass_and_stays_parabolic(backend, request):
+    """No-slip channel fed with the Poiseuille profile: at steady state the mass flux out equals
+    the flux in, the total mass stops changing, and the profile mid-channel is the parabola
+    (to the inlet's O(rho - RHO0) error: it imposes momentum RHO0 u_in)."""
+    ny, U = 16, 0.05
+    cfg = FlowConfig(nx=96, ny=ny, nu=0.05, x_boundary="tunnel", y_boundary="no_slip", inflow_speed=U,
+                     inflow_profile="parabolic", inflow_ramp_steps=200)
+    s = make_solver(backend, cfg, request)
+    s.step(4000)
+    m1 = s.total_mass()
+    s.step(500)
+    m2 = s.total_mass()
+    rho, ux, _ = s.macroscopic()
+    flux_in, flux_out = (rho * ux)[:, 0].sum(), (rho * ux)[:, -1].sum()
+    assert flux_out == pytest.approx(flux_in, rel=2e-3)
+    assert abs(m2 - m1) / m1 < 1e-3  # a zero-gradient outlet gained ~3e-2 here (density drift)
+    sy = np.arange(ny) + 0.5
+    exact = 4 * U * sy * (ny - sy) / ny ** 2
+    mid = ux[:, 48]
+    assert np.abs(mid - exact).max() < 0.03 * U
+    assert np.abs(rho - 1).max() < 0.03
