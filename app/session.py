@@ -22,7 +22,6 @@ import io
 import json
 import math
 import os
-import tempfile
 import zipfile
 import zlib
 from dataclasses import dataclass, field
@@ -43,17 +42,19 @@ MANIFEST = "manifest.json"
 PARAMETERS = "parameters.json"
 INPUTS = "inputs.npz"
 FORCES = "forces.npz"
+STATE = "state.npz"  # only when the recording started on a running flow (manifest "start")
 MEMBERS = (MANIFEST, PARAMETERS, INPUTS, FORCES)
 #: largest uncompressed member we read (a zip bomb is refused before it is inflated)
 MAX_MEMBER_BYTES = 1 << 30
 
 #: parameter name -> what its value is (docs/sessions.md, "Parameter changes")
-PARAMETER_NAMES = ("body", "inflow_speed", "nu", "force_models", "pause", "resume", "reset")
+PARAMETER_NAMES = ("body", "inflow_speed", "nu", "force_models", "pause", "resume", "reset", "rebuild")
 #: array name -> (dtype, trailing shape) in each .npz member
 INPUT_ARRAYS = {"seq": ("int64", ()), "step": ("int64", ()), "pose": ("float64", (3,)),
                 "velocity": ("float64", (3,))}
 FORCE_ARRAYS = {"seq": ("int64", ()), "step": ("int64", ()), "n": ("int64", ()),
                 "body": ("float64", (4,)), "values": ("float64", None)}
+STATE_ARRAYS = {"f": ("float64", None)}
 #: a commanded body or inflow speed beyond this (one cell per step) is not a lattice velocity
 MAX_LATTICE_SPEED = 1.0
 
@@ -115,7 +116,8 @@ def _shape_from_dict(d, where: str, config: FlowConfig):
     from shapes.io import from_dict
 
     try:
-        return from_dict(d).validate(config.nx, config.ny)
+        shape = from_dict(d)
+        return shape.validate(config.nx, config.ny) if config is not None else shape.validate()
     except (ShapeError, TypeError, ValueError) as exc:
         raise SessionError(f"{where}: {str(exc).splitlines()[0]}") from None
 
@@ -159,6 +161,9 @@ class SessionRecorder:
         self._parameters: list[dict] = []
         self._forces: list[tuple] = []   # (seq, step, n, (x, y, vx, vy), {model: (fx, fy)})
         self._models: list[str] = list(self.force_models)
+        #: set by SessionSolver.start_recording: how the running flow was when recording began
+        self.start: dict | None = None
+        self.state: np.ndarray | None = None  # its populations f (9, ny, nx)
 
     @classmethod
     def from_scene(cls, scene, *, scene_toml: str | None = None, backend: str | None = None,
@@ -234,7 +239,7 @@ class SessionRecorder:
                     "n": np.array([r[2] for r in self._forces], dtype=np.int64),
                     "body": np.array([r[3] for r in self._forces], dtype=np.float64).reshape(nf, 4),
                     "values": values},
-            models=tuple(self._models),
+            models=tuple(self._models), start=self.start, state=self.state,
         )
 
     def _manifest(self) -> dict:
@@ -247,7 +252,7 @@ class SessionRecorder:
         return {
             "format": FORMAT, "version": VERSION, "feelflow_version": feelflow_version(),
             "created": self.created, "backend": self.backend, "renderer": self.renderer,
-            "scene": scene,
+            "scene": scene, "start": self.start,
             "forces": {"models": list(self._models), "columns": force_columns(self._models)},
             "counts": {"inputs": len(self._inputs), "parameters": len(self._parameters),
                        "forces": len(self._forces), "steps": self.step},
@@ -269,19 +274,25 @@ def force_columns(models) -> list[str]:
 # --- the driver shared by recording and replay ------------------------------------------------
 
 class SessionSolver:
-    """A solver driven through session commands, recorded when it has a recorder.
+    """The solver as the app drives it: a backend plus the commands a session records.
 
     Drive it like a `solver.backend.Solver` (set_body, set_inflow_speed, enable_force_models,
-    step, forces, distributions, ...: anything else is passed to the wrapped backend) plus the
-    session-level commands `set_viscosity`, `reset`, `pause`, `resume`. `set_viscosity` and
-    `reset` build a new backend with `factory(config)` (default: the same backend; a `gl` solver
-    needs `factory=` or exposes its context as `.ctx`).
+    step, forces, distributions, time, ...: anything else is passed to the wrapped backend) plus
+    the session-level commands `set_viscosity`, `reset`, `rebuild`, `pause`, `resume`. While it
+    has a `recorder`, every command is recorded; `replay` feeds a recording back through these
+    same methods, which is why a replay reproduces the run. Keep one SessionSolver for the whole
+    life of the flow (it remembers the last placement); `start_recording` can then begin at
+    any moment between two `step` calls.
+
+    `set_viscosity`, `reset` and `rebuild` build a new backend with `factory(config)`
+    (default: the same backend by name, handing on the wrapped solver's `.ctx` if it has one).
     """
 
     def __init__(self, solver, recorder: SessionRecorder | None = None, *, factory=None, body=None):
         self._solver = solver
         self.recorder = recorder
         self._factory = factory or _same_backend_factory(solver)
+        self.flow_config = solver.config  # the configuration asked for (reset returns to it)
         self.geometry_shape = recorder.body if recorder is not None else body  # last known geometry
         self.shape = None            # the body as last placed (None: no body)
         self.velocity = (0.0, 0.0)   # commanded
@@ -293,11 +304,35 @@ class SessionSolver:
 
     @property
     def solver(self):
-        """The backend being driven (it changes on reset and viscosity changes)."""
+        """The backend being driven (it changes on reset, rebuild and viscosity changes)."""
         return self._solver
 
     def __getattr__(self, name):
         return getattr(self._solver, name)
+
+    @property
+    def time(self) -> int:
+        return self._solver.time
+
+    # --- recording ------------------------------------------------------------
+    def start_recording(self, **recorder_kwargs) -> SessionRecorder:
+        """Record from now on, starting from the flow as it is (its populations and time are
+        saved in the file); call it between two `step` calls. Keyword arguments go to
+        `SessionRecorder` (renderer, scene_toml, scene_source, scene_dict). Returns the recorder."""
+        rec = SessionRecorder(self._solver.config, self.shape if self.shape is not None else self.geometry_shape,
+                              self.models, backend=self._solver.name, **recorder_kwargs)
+        rec.start = {"time": int(self._solver.time), "body_placed": self.shape is not None,
+                     "velocity": list(self.velocity), "omega": self.omega,
+                     "force_models": list(self.models), "inflow_speed": self.inflow_speed}
+        rec.state = np.ascontiguousarray(self._solver.distributions(), dtype=np.float64)
+        self.recorder = rec
+        self.clock = 0
+        return rec
+
+    def stop_recording(self) -> SessionRecorder | None:
+        """Stop recording; returns the recorder (save it with `.save(path)`)."""
+        rec, self.recorder = self.recorder, None
+        return rec
 
     # --- solver commands ------------------------------------------------------
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, **kwargs) -> None:
@@ -361,34 +396,47 @@ class SessionSolver:
     def set_viscosity(self, nu: float) -> None:
         """Change the kinematic viscosity, keeping the flow: a new backend with the new config
         gets the current populations, time, inflow speed, force models and body."""
-        config = dataclasses.replace(self._solver.config, nu=float(nu))
+        config = dataclasses.replace(self.flow_config, nu=float(nu))
         try:
             config.validate()
         except ConfigError as exc:
             raise SessionError(f"viscosity: {exc}") from None
         if self.recorder is not None:
             self.recorder.record_parameter("nu", float(nu))
+        self.flow_config = config
         old = self._solver
-        # a fresh lattice starts at rest, so placing the body there books no impulse; the
-        # placement below then re-places it over the carried populations (nothing covered)
-        new = self._factory(dataclasses.replace(config, initial_velocity=(0.0, 0.0)))
-        if self.shape is not None:
-            new.set_body(self.shape, velocity=(0.0, 0.0), omega=0.0)
-        new.set_distributions(old.distributions())
-        new.time = old.time
-        self._rebuild(new)
+        new = _carry_flow(self._factory, config, old.distributions(), old.time, self.shape)
+        self._reapply(new)
         old.close()
 
     def reset(self) -> None:
-        """Start the flow again from the scene's initial state (same config, time 0); the
-        body stays where it is, with its motion, force models and inflow speed."""
+        """Start the flow again from the configuration's initial state (time 0); the body stays
+        where it is, with its motion, force models and inflow speed."""
         if self.recorder is not None:
             self.recorder.record_parameter("reset")
         old = self._solver
-        self._rebuild(self._factory(old.config))
+        self._reapply(self._factory(self.flow_config))
         old.close()
 
-    def _rebuild(self, new) -> None:
+    def rebuild(self, config: FlowConfig, keep_flow: bool = True) -> None:
+        """Replace the backend with a new one for `config` (any change: grid, walls, viscosity),
+        carrying the populations and time when `keep_flow` and the grid is the same. Nothing
+        else is re-applied: the caller places the body and enables force models again (through
+        this object, so that it is recorded)."""
+        config = config.validate()
+        if self.recorder is not None:
+            self.recorder.record_parameter("rebuild", {"config": config_to_dict(config), "keep_flow": bool(keep_flow)})
+        old = self._solver
+        new = self._factory(config)
+        if keep_flow and (config.nx, config.ny) == (old.config.nx, old.config.ny):
+            new.set_distributions(old.distributions())
+            new.time = old.time
+        self.flow_config = config
+        self.shape, self.velocity, self.omega, self.models, self.inflow_speed = None, (0.0, 0.0), 0.0, (), None
+        self._solver = new
+        old.close()
+
+    def _reapply(self, new) -> None:
         if self.models:
             new.enable_force_models(self.models)
         if self.inflow_speed is not None:
@@ -419,9 +467,21 @@ def _same_backend_factory(solver):
     return factory
 
 
+def _carry_flow(factory, config, f, time, shape):
+    """A new backend for `config` holding populations `f` at `time`, with `shape` (if any)
+    placed at rest *before* the populations arrive: a fresh lattice started at rest books no
+    cover impulse, and the caller's own placement afterwards covers no new node."""
+    new = factory(dataclasses.replace(config, initial_velocity=(0.0, 0.0)))
+    if shape is not None:
+        new.set_body(shape, velocity=(0.0, 0.0), omega=0.0)
+    new.set_distributions(f)
+    new.time = int(time)
+    return new
+
+
 def record_headless(solver, scene, *, scene_toml: str | None = None, renderer: str | None = None):
-    """For `feelflow run SCENE --record FILE`: wrap the run's solver so that everything the
-    run does to it is recorded. Returns (session_solver, recorder): hand `session_solver` to
+    """For `feelflow run SCENE --record FILE`: wrap the run's fresh solver so that everything
+    the run does to it is recorded. Returns (session_solver, recorder): hand `session_solver` to
     the motion runner instead of `solver`, then `recorder.save(FILE)` after the run."""
     recorder = SessionRecorder.from_scene(scene, scene_toml=scene_toml, backend=solver.name,
                                           renderer=renderer)
@@ -449,6 +509,8 @@ class Session:
     parameters: list
     forces: dict
     models: tuple[str, ...]
+    start: dict | None = None        # manifest "start": recording began on a running flow
+    state: np.ndarray | None = None  # then its populations f (9, ny, nx), from state.npz
     source: str = field(default="session", compare=False)
 
     @property
@@ -496,30 +558,21 @@ def _fmt(v) -> str:
 # --- files ------------------------------------------------------------------------------------
 
 def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
-    """Write `data` to a temp file next to `path`, fsync, os.replace: never half a file.
-    SessionError naming the path if it cannot (the old file, if any, is left as it was)."""
+    """Write `data` through `app.files.atomic_path` (temp file beside, fsync, os.replace): never
+    half a file. SessionError naming the path if it cannot (the old file is left as it was)."""
+    from app.files import atomic_path
+
     path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
     if path.is_dir():
         raise SessionError(f"{path}: is a directory")
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
+        with atomic_path(path, suffix=".tmp") as tmp:
+            with open(tmp, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
     except OSError as exc:
         raise SessionError(f"{path}: cannot write {what} ({exc.strerror or exc})") from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException as exc:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        if isinstance(exc, OSError):
-            raise SessionError(f"{path}: cannot write {what} ({exc.strerror or exc})") from None
-        raise
     return path
 
 
@@ -537,6 +590,8 @@ def session_bytes(session: Session) -> bytes:
         zf.writestr(PARAMETERS, json.dumps(session.parameters, indent=1, allow_nan=False) + "\n")
         zf.writestr(INPUTS, _npz_bytes(session.inputs))
         zf.writestr(FORCES, _npz_bytes(session.forces))
+        if session.state is not None:
+            zf.writestr(STATE, _npz_bytes({"f": session.state}))
     return buf.getvalue()
 
 
@@ -569,7 +624,7 @@ def load_session(path) -> Session:
         if missing:
             fail(f"not a complete session file: member {missing[0]} is missing")
         data = {}
-        for member in MEMBERS:
+        for member in MEMBERS + ((STATE,) if STATE in names else ()):
             info = zf.getinfo(member)
             if info.file_size > MAX_MEMBER_BYTES:
                 fail(f"{member} is {info.file_size} bytes uncompressed (limit {MAX_MEMBER_BYTES})")
@@ -580,9 +635,13 @@ def load_session(path) -> Session:
                 fail(f"{member} is damaged ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})")
     manifest = _json_member(data[MANIFEST], MANIFEST, fail)
     parameters = _json_member(data[PARAMETERS], PARAMETERS, fail)
+    starts = isinstance(manifest, dict) and manifest.get("start") is not None
+    if starts and STATE not in data:
+        fail(f"the recording starts on a running flow but member {STATE} is missing")
+    state = _npz_member(data[STATE], STATE, STATE_ARRAYS, fail)["f"] if starts else None
     try:
         return _validate(manifest, parameters, _npz_member(data[INPUTS], INPUTS, INPUT_ARRAYS, fail),
-                         _npz_member(data[FORCES], FORCES, FORCE_ARRAYS, fail), src)
+                         _npz_member(data[FORCES], FORCES, FORCE_ARRAYS, fail), src, state)
     except SessionError as exc:
         if str(exc).startswith(src + ": "):
             raise
@@ -620,12 +679,14 @@ def _npz_member(raw: bytes, member: str, spec: dict, fail) -> dict:
         if a.dtype != np.dtype(dtype):
             fail(f"{member}: array {name!r} must be {dtype}, got {a.dtype}")
         if trailing is None:
-            ok = a.ndim == 2
+            ok = a.ndim == (3 if spec is STATE_ARRAYS else 2)
         else:
             ok = a.shape[1:] == trailing and a.ndim == 1 + len(trailing)
         if not ok:
-            want = "(rows, columns)" if trailing is None else str(("rows",) + trailing).replace("'", "")
+            want = ("(9, ny, nx)" if spec is STATE_ARRAYS else "(rows, columns)") if trailing is None else str(("rows",) + trailing).replace("'", "")
             fail(f"{member}: array {name!r} has shape {a.shape}, expected {want}")
+        if spec is STATE_ARRAYS:
+            continue
         if rows is None:
             rows = a.shape[0]
         elif a.shape[0] != rows:
@@ -633,7 +694,7 @@ def _npz_member(raw: bytes, member: str, spec: dict, fail) -> dict:
     return arrays
 
 
-def _validate(manifest, parameters, inputs, forces, src) -> Session:
+def _validate(manifest, parameters, inputs, forces, src, state=None) -> Session:
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         raise SessionError(f"{MANIFEST}: not a FeelFlow session (expected \"format\": \"{FORMAT}\")")
     version = manifest.get("version")
@@ -674,6 +735,12 @@ def _validate(manifest, parameters, inputs, forces, src) -> Session:
     for key, n in actual.items():
         if counts.get(key) != n:
             raise SessionError(f"{MANIFEST}: counts.{key} is {counts.get(key)!r} but the file holds {n}")
+    start = _validate_start(manifest.get("start"), state, config)
+    params = _validate_parameters(parameters, config)
+    # the largest grid the session uses (a rebuild may change it)
+    grids = [(config.nx, config.ny)] + [(p["value"]["config"]["nx"], p["value"]["config"]["ny"])
+                                        for p in params if p["name"] == "rebuild"]
+    gx, gy = max(g[0] for g in grids), max(g[1] for g in grids)
 
     # inputs: finite, in range
     pose, vel = inputs["pose"], inputs["velocity"]
@@ -681,11 +748,11 @@ def _validate(manifest, parameters, inputs, forces, src) -> Session:
         bad = ~np.isfinite(a).all(axis=1)
         if bad.any():
             raise SessionError(f"{INPUTS}: input {int(np.argmax(bad))} has a non-finite {name} (NaN or inf)")
-    out = (pose[:, 0] < 0) | (pose[:, 0] > config.nx) | (pose[:, 1] < 0) | (pose[:, 1] > config.ny)
+    out = (pose[:, 0] < 0) | (pose[:, 0] > gx) | (pose[:, 1] < 0) | (pose[:, 1] > gy)
     if out.any():
         k = int(np.argmax(out))
         raise SessionError(f"{INPUTS}: input {k} puts the body at ({pose[k, 0]:g}, {pose[k, 1]:g}), "
-                           f"outside the {config.nx} x {config.ny} grid")
+                           f"outside the {gx} x {gy} grid")
     fast = np.hypot(vel[:, 0], vel[:, 1]) > MAX_LATTICE_SPEED
     if fast.any():
         raise SessionError(f"{INPUTS}: input {int(np.argmax(fast))} has a body speed above "
@@ -705,7 +772,6 @@ def _validate(manifest, parameters, inputs, forces, src) -> Session:
         raise SessionError(f"{FORCES}: row {k} covers steps {ends[k] - forces['n'][k]}..{ends[k]} "
                            f"but the previous row ended at step {starts[k]}")
 
-    params = _validate_parameters(parameters, config)
     # one order: every seq once, steps never decreasing along it
     seq_step = [(int(s), int(t)) for s, t in zip(inputs["seq"], inputs["step"])]
     seq_step += [(p["seq"], p["step"]) for p in params]
@@ -730,7 +796,37 @@ def _validate(manifest, parameters, inputs, forces, src) -> Session:
             raise SessionError(f"event {s} is stamped step {order[s][1]} but happens at step {clock}")
     return Session(manifest=manifest, config=config, body=body, backend=manifest["backend"],
                    force_models=tuple(initial_models), inputs=inputs, parameters=params,
-                   forces=forces, models=tuple(models), source=src)
+                   forces=forces, models=tuple(models), start=start, state=state, source=src)
+
+
+def _validate_start(start, state, config: FlowConfig):
+    """manifest "start" (null, or how the running flow was when recording began) and its state."""
+    from solver.forces import MODELS
+
+    if start is None:
+        return None
+    where = f"{MANIFEST}: start"
+    keys = {"time", "body_placed", "velocity", "omega", "force_models", "inflow_speed"}
+    if not isinstance(start, dict) or set(start) != keys:
+        raise SessionError(f"{where} must have exactly {', '.join(sorted(keys))}")
+    if isinstance(start["time"], bool) or not isinstance(start["time"], int) or start["time"] < 0:
+        raise SessionError(f"{where}.time must be a non-negative integer")
+    if not isinstance(start["body_placed"], bool):
+        raise SessionError(f"{where}.body_placed must be true or false")
+    v = start["velocity"]
+    if not (isinstance(v, list) and len(v) == 2 and all(_is_number(c) for c in v)) or not _is_number(start["omega"]) \
+            or math.hypot(*v) > MAX_LATTICE_SPEED:
+        raise SessionError(f"{where}: velocity and omega must be finite numbers (|v| <= 1)")
+    if not isinstance(start["force_models"], list) or not all(m in MODELS for m in start["force_models"]):
+        raise SessionError(f"{where}.force_models must list force models ({', '.join(MODELS)})")
+    u = start["inflow_speed"]
+    if u is not None and not (_is_number(u) and abs(u) <= MAX_LATTICE_SPEED):
+        raise SessionError(f"{where}.inflow_speed must be null or a number in -1..1")
+    if state.shape != (9, config.ny, config.nx):
+        raise SessionError(f"{STATE}: 'f' has shape {state.shape}, expected (9, {config.ny}, {config.nx})")
+    if not np.isfinite(state).all():
+        raise SessionError(f"{STATE}: the populations hold NaN or inf")
+    return start
 
 
 def _validate_parameters(parameters, config: FlowConfig) -> list:
@@ -761,7 +857,14 @@ def _validate_parameters(parameters, config: FlowConfig) -> list:
         if name == "force_models" and (not isinstance(v, list) or not all(m in MODELS for m in v)):
             raise SessionError(f"{where}: force_models must list force models ({', '.join(MODELS)})")
         if name == "body" and v is not None:
-            _shape_from_dict(v, f"{where}: body", config)
+            _shape_from_dict(v, f"{where}: body", None)
+        if name == "rebuild":
+            if not isinstance(v, dict) or set(v) != {"config", "keep_flow"} or not isinstance(v["keep_flow"], bool):
+                raise SessionError(f"{where}: rebuild must be {{\"config\": {{...}}, \"keep_flow\": true|false}}")
+            try:
+                config_from_dict(v["config"])
+            except SessionError as exc:
+                raise SessionError(f"{where}: rebuild {exc}") from None
         if name in ("pause", "resume", "reset") and v is not None:
             raise SessionError(f"{where}: {name} takes no value")
         out.append(dict(p))
@@ -792,11 +895,21 @@ def replay(session: Session, backend: str | None = None, *, factory=None, ctx=No
     if factory is None:
         kwargs = {"ctx": ctx} if ctx is not None else {}
         factory = lambda config: create_solver(backend, config, **kwargs)  # noqa: E731
-    solver = factory(session.config)
+    start = session.start
+    placed = session.body if start is not None and start["body_placed"] else None
+    if start is None:
+        solver = factory(session.config)
+    else:  # the flow as it was when recording began, then its placement as it was
+        solver = _carry_flow(factory, session.config, session.state, start["time"], placed)
     rec = SessionRecorder(session.config, session.body, session.force_models, backend=backend,
                           scene_toml=session.manifest["scene"].get("toml"),
                           scene_source=session.manifest["scene"].get("source"))
     driver = SessionSolver(solver, rec, factory=factory)
+    if start is not None:
+        rec.start, rec.state = start, session.state
+        driver.models, driver.inflow_speed = tuple(start["force_models"]), start["inflow_speed"]
+        driver.shape, driver.velocity, driver.omega = placed, tuple(start["velocity"]), start["omega"]
+        driver._reapply(solver)
     geometry = session.body
     diverged_at = None
     events = session.events()
@@ -815,7 +928,7 @@ def replay(session: Session, backend: str | None = None, *, factory=None, ctx=No
                         driver.set_body(None)
                         geometry = None
                     else:
-                        geometry = _shape_from_dict(value, "body", session.config)
+                        geometry = _shape_from_dict(value, "body", None)
                 elif name == "inflow_speed":
                     driver.set_inflow_speed(value)
                 elif name == "nu":
@@ -824,6 +937,9 @@ def replay(session: Session, backend: str | None = None, *, factory=None, ctx=No
                     driver.enable_force_models(value)
                 elif name == "reset":
                     driver.reset()
+                    diverged_at = None
+                elif name == "rebuild":
+                    driver.rebuild(config_from_dict(value["config"]), value["keep_flow"])
                     diverged_at = None
                 elif name == "pause":
                     driver.pause()

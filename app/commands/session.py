@@ -50,29 +50,12 @@ def _write(fn, *args):
 
 
 def _make_factory(backend: str):
-    """Backend by name; `gl` gets a standalone EGL context (DESIGN rule 2)."""
-    from solver.backend import BACKENDS, BackendError, create_solver
-
-    if backend not in BACKENDS:
-        raise UserError(f"--backend: must be one of {', '.join(sorted(BACKENDS))}, got {backend!r}")
-    kwargs = {}
-    if backend == "gl":
-        import moderngl
-
-        try:
-            kwargs["ctx"] = moderngl.create_context(standalone=True, backend="egl", require=330)
-        except Exception as exc:  # noqa: BLE001 - any EGL failure is one line for the user
-            raise UserError(f"--backend gl: no OpenGL 3.3 context through EGL ({str(exc).splitlines()[0]})") from None
+    """Backends by name for the replay, through `app.headless.make_solver` (gl gets the
+    process's EGL context); UserError (one line) when the backend cannot run here."""
+    from app.headless import make_solver
 
     def factory(config):
-        try:
-            return create_solver(backend, config, **kwargs)
-        except ModuleNotFoundError as exc:
-            if exc.name != BACKENDS[backend].split(":")[0]:
-                raise
-            raise UserError(f"--backend {backend}: this backend is not available in this version") from None
-        except BackendError as exc:
-            raise UserError(f"--backend {backend}: {str(exc).splitlines()[0]}") from None
+        return make_solver(backend, config)
     return factory
 
 
