@@ -1,0 +1,116 @@
+"""`feelflow validate`: run the physics validation cases, print a table, optionally write JSON.
+
+Cases live in `solver/validation/` (one module each); the registry is `solver.validation.CASES`.
+The exit code is 0 when every target is met, 1 otherwise.
+"""
+from __future__ import annotations
+
+import json
+import os
+import platform
+import tempfile
+from pathlib import Path
+
+from app.cli import UserError
+
+
+def add_arguments(parser):
+    from solver.validation import CASES
+
+    parser.add_argument("--case", action="append", metavar="NAME",
+                        help=f"a case to run (repeatable; default: all): {', '.join(CASES)}")
+    parser.add_argument("--resolution", default=None, metavar="N",
+                        help="cells per diameter (channel width for poiseuille, grid size for taylor-green); "
+                             "default: each case's own")
+    parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
+    parser.add_argument("--json", default=None, metavar="PATH", help="also write the results as JSON")
+    parser.add_argument("--quick", action="store_true", help="small grids and short runs (the test-suite versions)")
+
+
+def machine_description() -> str:
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as fh:
+            names = [line.split(":", 1)[1].strip() for line in fh if line.startswith("model name")]
+        if names:
+            cpu = f"{names[0]} ({len(names)} logical CPUs)"
+    except OSError:
+        pass
+    return f"{cpu}, {platform.system()} {platform.release()}, Python {platform.python_version()}"
+
+
+def _fmt(v) -> str:
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+def format_table(results) -> str:
+    """A Markdown table: one row per measured quantity that has a target, plus speed."""
+    lines = ["| case | N | quantity | value | target | met | steps | wall s | MLUPS |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in results:
+        met = r.check_results()
+        checked = {c.quantity: c for c in r.checks}
+        first = True
+        for name, value in r.quantities.items():
+            target = checked[name].describe() if name in checked else ""
+            ok = ("yes" if met[name] else "**no**") if name in checked else ""
+            speed = [str(r.steps), f"{r.wall_seconds:.1f}", f"{r.mlups:.1f}"] if first else ["", "", ""]
+            lines.append(f"| {r.name if first else ''} | {r.resolution if first else ''} | {name} | {_fmt(value)} "
+                         f"| {target} | {ok} | " + " | ".join(speed) + " |")
+            first = False
+    return "\n".join(lines)
+
+
+def write_json_atomic(path: Path, data) -> None:
+    directory = path.parent if str(path.parent) else Path(".")
+    if not directory.is_dir():
+        raise UserError(f"--json: directory {str(directory)!r} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
+    try:
+        with os.fdopen(fd, "w") as fh:
+            json.dump(data, fh, indent=2)
+            fh.write("\n")
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def main(args) -> int:
+    from app.commands.run import positive_int_option
+    from app.headless import make_solver
+    from solver.validation import CASES, case_module
+
+    names = args.case or list(CASES)
+    for name in names:
+        if name not in CASES:
+            raise UserError(f"--case: unknown case {name!r}; choose from {', '.join(CASES)}")
+    resolution = positive_int_option("--resolution", args.resolution) if args.resolution is not None else None
+    if args.json is not None and Path(args.json).is_dir():
+        raise UserError(f"--json: {args.json!r} is a directory")
+    if args.json is not None and not (Path(args.json).parent if str(Path(args.json).parent) else Path(".")).is_dir():
+        raise UserError(f"--json: directory {str(Path(args.json).parent)!r} does not exist")
+
+    def factory(config):
+        return make_solver(args.backend, config)
+
+    results = []
+    for name in names:
+        print(f"running {name} ...", flush=True)
+        result = case_module(name).run(factory, resolution=resolution, quick=args.quick, backend=args.backend)
+        results.append(result)
+        print(f"  {name}: {'targets met' if result.passed else 'TARGETS NOT MET'} "
+              f"({result.steps} steps, {result.wall_seconds:.1f} s)", flush=True)
+    machine = machine_description()
+    print(f"\nFeelFlow validation, backend {args.backend}, on {machine}\n")
+    print(format_table(results))
+    failed = [r.name for r in results if not r.passed]
+    print(f"\n{len(results) - len(failed)} of {len(results)} cases meet their targets"
+          + (f"; not met: {', '.join(failed)}" if failed else ""))
+    if args.json:
+        write_json_atomic(Path(args.json), {"machine": machine, "backend": args.backend,
+                                            "cases": [r.to_dict() for r in results]})
+    return 0 if not failed else 1

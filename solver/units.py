@@ -1,0 +1,114 @@
+"""The one place that converts between lattice units and what a student reads.
+
+Inside the solver everything is in lattice units (dx = dt = 1, rho_0 = 1). Dimensionless
+numbers need a reference length L and a reference velocity U, which the caller states:
+- Reynolds number Re = U L / nu; Mach number Ma = |u| / c_s with c_s^2 = 1/3 (seed eq. 5).
+- Force coefficients per unit span C_D = 2 F_x / (rho U^2 L), C_L = 2 F_y / (rho U^2 L)
+  (Schaefer & Turek 1996).
+- Pressure p = c_s^2 rho (ideal LBM equation of state); a pressure difference is made
+  dimensionless as dp / (rho U^2).
+- Strouhal number St = f L / U.
+- Newtons: a lattice force per unit span times `ForceScale.newtons_per_lattice_force`.
+
+Nothing else in FeelFlow hard-codes a scale.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from solver.lattice import CS2, RHO0
+
+#: speed of sound in lattice units
+CS = math.sqrt(CS2)
+
+
+def reynolds(speed: float, length: float, nu: float) -> float:
+    """Re = U L / nu."""
+    return speed * length / nu
+
+
+def viscosity_for_reynolds(re: float, speed: float, length: float) -> float:
+    """The kinematic viscosity nu = U L / Re that gives Reynolds number `re`."""
+    return speed * length / re
+
+
+def mach(speed: float) -> float:
+    """Ma = |u| / c_s."""
+    return abs(speed) / CS
+
+
+def speed_for_mach(ma: float) -> float:
+    """The lattice speed with Mach number `ma`."""
+    return ma * CS
+
+
+def tau_for_viscosity(nu: float) -> float:
+    """BGK relaxation time: nu = c_s^2 (tau - 1/2) (seed eq. 5)."""
+    return nu / CS2 + 0.5
+
+
+def pressure(rho):
+    """Lattice pressure p = c_s^2 rho."""
+    return CS2 * rho
+
+
+def dynamic_pressure(speed: float, rho: float = RHO0) -> float:
+    """q = rho U^2 / 2."""
+    return 0.5 * rho * speed * speed
+
+
+def force_coefficient(force: float, speed: float, length: float, rho: float = RHO0) -> float:
+    """C = 2 F / (rho U^2 L): drag coefficient for F_x, lift coefficient for F_y."""
+    return force / (dynamic_pressure(speed, rho) * length)
+
+
+def drag_lift_coefficients(force, speed: float, length: float, rho: float = RHO0) -> tuple[float, float]:
+    """(C_D, C_L) of a force (F_x, F_y) for a flow along +x."""
+    fx, fy = force
+    return force_coefficient(fx, speed, length, rho), force_coefficient(fy, speed, length, rho)
+
+
+def pressure_difference_coefficient(dp: float, speed: float, rho: float = RHO0) -> float:
+    """dp / (rho U^2): a pressure difference in units of rho U^2."""
+    return dp / (rho * speed * speed)
+
+
+def strouhal(frequency: float, length: float, speed: float) -> float:
+    """St = f L / U (f in 1/steps, L in cells, U in cells per step)."""
+    return frequency * length / speed
+
+
+@dataclass(frozen=True)
+class ForceScale:
+    """Lattice force (per unit span, one lattice cell deep) to newtons.
+
+    One factor, `newtons_per_lattice_force`, set either from a physical fluid (`physical`) or
+    as a gain chosen for a haptic device (`for_peak`).
+    """
+
+    newtons_per_lattice_force: float
+
+    @classmethod
+    def physical(cls, dx_m: float, dt_s: float, rho_kg_m3: float, depth_m: float) -> "ForceScale":
+        """The scale of a physical fluid: cell size dx, step dt, density rho, body span depth.
+
+        A lattice cell holds the mass rho dx^2 depth and a lattice acceleration is dx / dt^2,
+        so F = F_lattice * rho dx^3 depth / dt^2."""
+        for name, value in (("dx_m", dx_m), ("dt_s", dt_s), ("rho_kg_m3", rho_kg_m3), ("depth_m", depth_m)):
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{name}: must be a positive number, got {value!r}")
+        return cls(rho_kg_m3 * dx_m * dx_m * depth_m * dx_m / (dt_s * dt_s))
+
+    @classmethod
+    def for_peak(cls, lattice_force: float, newtons: float) -> "ForceScale":
+        """A gain that maps a lattice force magnitude to a given force in newtons (haptics)."""
+        if not (lattice_force > 0 and newtons >= 0):
+            raise ValueError("lattice_force must be > 0 and newtons >= 0")
+        return cls(newtons / lattice_force)
+
+    def newtons(self, lattice_force):
+        """The force in newtons (scalar, tuple or array)."""
+        if isinstance(lattice_force, tuple):
+            return tuple(self.newtons_per_lattice_force * c for c in lattice_force)
+        return self.newtons_per_lattice_force * lattice_force

@@ -1,0 +1,25 @@
+"""Physics validation cases (one module each), run by `feelflow validate` and the tests.
+
+`CASES` is the registry: name -> module. Each module has `NAME`, `DEFAULT_RESOLUTION`,
+`QUICK_RESOLUTION` and `run(make_solver, resolution=None, quick=False) -> CaseResult`
+(solver/validation/base.py).
+"""
+from __future__ import annotations
+
+import importlib
+
+CASES: dict[str, str] = {
+    "poiseuille": "solver.validation.poiseuille",
+    "taylor-green": "solver.validation.taylor_green",
+    "schaefer-turek-2d1": "solver.validation.schaefer_turek_2d1",
+    "schaefer-turek-2d2": "solver.validation.schaefer_turek_2d2",
+    "galilean": "solver.validation.galilean",
+    "mass": "solver.validation.mass",
+}
+
+
+def case_module(name: str):
+    """The module of a case by registry name."""
+    if name not in CASES:
+        raise KeyError(f"unknown validation case {name!r}; choose from {', '.join(CASES)}")
+    return importlib.import_module(CASES[name])

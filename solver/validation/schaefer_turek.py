@@ -1,0 +1,115 @@
+"""Schaefer & Turek (1996) 2D cylinder benchmark on the lattice: geometry, inflow, measurements.
+
+Channel 2.2 x 0.41 with D = 0.1 becomes, at D cells per diameter: walls half-way at y = -1/2
+and ny - 1/2 (H = 4.1 D cells), inlet at x = -1/2 (parabolic, peak U_m), outlet at
+x = nx - 1/2 (22 D cells), cylinder centre (2D - 1/2, 2D - 1/2) in node coordinates (physical
+(0.2, 0.2): 0.05 D below the centre line, which makes the lift non-zero). Front and back points
+(0.15, 0.2) and (0.25, 0.2) lie on the cylinder surface. Reference values:
+/work/shared/reference/benchmarks.md (Schaefer & Turek 1996, refined reference values of
+John 2004 for 2D-1).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from solver import units
+from solver.config import FlowConfig
+from solver.lattice import equilibrium
+
+#: peak inflow speed in lattice units: Ma = 0.13, compressibility error ~ Ma^2 / 3 (stated, not tuned)
+U_MAX = 0.075
+#: benchmark values in its own units (rho = 1, U_mean = 0.2 for 2D-1, 1.0 for 2D-2)
+REF_2D1 = {"cd": 5.57953523384, "cl": 0.010618948146, "dp": 0.11752016697, "u_mean": 0.2}
+INTERVALS_2D2 = {"cd_max": (3.22, 3.24), "cl_max": (0.99, 1.01), "st": (0.295, 0.305)}
+
+
+class Geometry:
+    """The benchmark at `d` cells per diameter, Reynolds number `re` (U_mean D / nu)."""
+
+    def __init__(self, d: int, re: float, u_max: float = U_MAX):
+        self.d = d
+        self.nx = 22 * d
+        self.ny = int(round(4.1 * d))
+        self.u_max = u_max
+        self.u_mean = 2.0 * u_max / 3.0
+        self.re = re
+        self.nu = units.viscosity_for_reynolds(re, self.u_mean, d)
+        self.centre = (2 * d - 0.5, 2 * d - 0.5)
+        self.front = (1.5 * d - 0.5, 2 * d - 0.5)
+        self.back = (2.5 * d - 0.5, 2 * d - 0.5)
+
+    def config(self, **overrides) -> FlowConfig:
+        kw = dict(nx=self.nx, ny=self.ny, nu=self.nu, collision="trt", x_boundary="tunnel",
+                  y_boundary="no_slip", inflow_speed=self.u_max, inflow_profile="parabolic",
+                  inflow_ramp_steps=0)
+        kw.update(overrides)
+        return FlowConfig(**kw)
+
+    def cylinder(self):
+        from shapes.cylinder import Cylinder
+
+        return Cylinder(diameter=float(self.d), x=self.centre[0], y=self.centre[1])
+
+    def profile(self) -> np.ndarray:
+        """The inlet profile (docs/algorithm.md 'Inflow'), one value per row."""
+        s = np.arange(self.ny) + 0.5
+        return 4 * self.u_max * s * (self.ny - s) / self.ny ** 2
+
+    def initial_populations(self) -> np.ndarray:
+        """Equilibrium of the inlet profile everywhere (the developed channel flow)."""
+        ux = np.repeat(self.profile()[:, None], self.nx, axis=1)
+        return equilibrium(np.ones_like(ux), ux, np.zeros_like(ux))
+
+    def start(self, make_solver, **config_overrides):
+        """A solver with the channel flow developed and the cylinder in place."""
+        solver = make_solver(self.config(**config_overrides))
+        solver.set_distributions(self.initial_populations())
+        solver.set_body(self.cylinder())
+        solver.enable_force_models(["momentum_exchange"])
+        return solver
+
+    def coefficients(self, force) -> tuple[float, float]:
+        """(C_D, C_L) with U = U_mean, L = D."""
+        return units.drag_lift_coefficients(force, self.u_mean, self.d)
+
+    def pressure_difference(self, solver) -> float:
+        """dp / (rho U_mean^2) between the front and back points (to compare with the benchmark
+        value divided by U_mean^2)."""
+        rho, _, _ = solver.macroscopic()
+        solid = self._solid(rho.shape)
+        p_front = units.pressure(surface_value(rho, solid, self.front, -1))
+        p_back = units.pressure(surface_value(rho, solid, self.back, +1))
+        return units.pressure_difference_coefficient(p_front - p_back, self.u_mean)
+
+    def _solid(self, shape):
+        y, x = np.mgrid[0:shape[0], 0:shape[1]].astype(np.float64)
+        return self.cylinder().contains(x, y)
+
+
+def reference_dp_coefficient() -> float:
+    """The benchmark's dp (2D-1) in units of rho U_mean^2."""
+    return units.pressure_difference_coefficient(REF_2D1["dp"], REF_2D1["u_mean"])
+
+
+def surface_value(field: np.ndarray, solid: np.ndarray, point, direction: int) -> float:
+    """A field at a point on the body surface: linear in y between the two rows around the
+    point, quadratic extrapolation in x from the three nearest fluid columns on the side
+    `direction` (-1: smaller x, +1: larger x). Solid nodes hold no fluid value, so the usual
+    bilinear interpolation cannot be used on the wall."""
+    x, y = point
+    j0 = int(math.floor(y))
+    wy = y - j0
+    rows = (j0, j0 + 1)
+    i = int(math.floor(x)) if direction < 0 else int(math.ceil(x))
+    xs, vs = [], []
+    while len(xs) < 3:
+        if not (0 <= i < field.shape[1]):
+            raise ValueError("no fluid columns beside the surface point")
+        if not any(solid[r, i] for r in rows):
+            xs.append(float(i))
+            vs.append((1 - wy) * field[rows[0], i] + wy * field[rows[1], i])
+        i += direction
+    coeffs = np.polyfit(np.array(xs) - x, np.array(vs), 2)
+    return float(coeffs[-1])

@@ -1,0 +1,63 @@
+"""Schaefer-Turek 2D-1: steady flow past a cylinder at Re = 20; C_D, C_L and dp.
+
+Targets (issue 2): at 20 cells per diameter C_D within 1 % of 5.5795 and dp within 2 %; at 40
+cells C_D within 0.3 %, C_L within 10 %, dp within 1 % (of the refined reference values,
+benchmarks.md). Runs from the developed channel flow until C_D, C_L and dp change by less than
+`TOL` (relative) over a block of 10 D steps: a convergence criterion, not a fixed step count.
+"""
+from __future__ import annotations
+
+from solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
+from solver.validation.schaefer_turek import REF_2D1, Geometry, reference_dp_coefficient
+
+NAME = "schaefer-turek-2d1"
+DEFAULT_RESOLUTION = 20
+QUICK_RESOLUTION = 10
+RE = 20.0
+TOL = 1e-5
+SOURCE = "Schaefer & Turek 1996; refined values John 2004"
+
+
+def targets(d: int) -> dict[str, float]:
+    """Relative tolerances of the issue's targets at this resolution (None: not checked)."""
+    if d >= 40:
+        return {"cd": 0.003, "cl": 0.10, "dp": 0.01}
+    if d >= 20:
+        return {"cd": 0.01, "dp": 0.02}
+    return {}
+
+
+def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool = False,
+        backend: str = "numpy", max_convective_times: float = 400.0) -> CaseResult:
+    d = resolution or (QUICK_RESOLUTION if quick else DEFAULT_RESOLUTION)
+    geo = Geometry(d, RE)
+    block = 10 * d
+    max_steps = int(max_convective_times * d / geo.u_mean)
+    solver = geo.start(make_solver)
+    watch = Stopwatch()
+    converged = False
+    try:
+        prev = None
+        while watch.steps < max_steps:
+            watch.step(solver, block)
+            cd, cl = geo.coefficients(solver.forces()["momentum_exchange"])
+            dp = geo.pressure_difference(solver)
+            now = (cd, cl, dp)
+            if prev is not None and (abs(cd - prev[0]) < TOL * abs(cd) and abs(cl - prev[1]) < TOL * abs(cd)
+                                     and abs(dp - prev[2]) < TOL * abs(dp)):
+                converged = True
+                break
+            prev = now
+    finally:
+        solver.close()
+    dp_ref = reference_dp_coefficient()
+    result = CaseResult(NAME, backend, d, quantities={
+        "cd": cd, "cl": cl, "dp": dp * REF_2D1["u_mean"] ** 2,  # in the benchmark's units
+        "cd_rel_error": cd / REF_2D1["cd"] - 1, "cl_rel_error": cl / REF_2D1["cl"] - 1,
+        "dp_rel_error": dp / dp_ref - 1, "converged": float(converged),
+        "re": RE, "u_max_lattice": geo.u_max, "tau": geo.config().tau})
+    for quantity, rel in targets(d).items():
+        result.checks.append(Check(f"{quantity}_rel_error", -rel, rel, SOURCE))
+    result.checks.append(Check("converged", 1.0, 1.0, f"steady within {TOL:g} per {block} steps"))
+    result.notes = f"U_m = {geo.u_max} (Ma {geo.u_max * 3 ** 0.5:.3f}), TRT, {geo.nx} x {geo.ny}"
+    return watch.fill(result)

@@ -1,0 +1,144 @@
+"""`feelflow run` and `feelflow validate` as a user meets them: real subprocesses.
+
+Errors: exit 2, exactly one line on stderr, no traceback. A run writes the documented CSV.
+"""
+import csv
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+SMALL = """
+[grid]
+nx = 64
+ny = 32
+
+[flow]
+nu = 0.05
+inflow_speed = 0.04
+inflow_ramp_steps = 20
+
+[body]
+kind = "cylinder"
+diameter = 8
+x = 20
+y = 16.3
+
+[[motion]]
+steps = 30
+move = "stop"
+
+[[motion]]
+steps = 30
+velocity = [0.02, 0.01]
+
+[output]
+forces = ["momentum_exchange", "momentum_exchange_classic"]
+interval = 20
+"""
+
+
+def feelflow(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "app", *map(str, args)], cwd=cwd or ROOT,
+                          capture_output=True, text=True, timeout=300)
+
+
+def assert_one_line_error(result, *fragments, code=2):
+    assert result.returncode == code, (result.returncode, result.stderr)
+    lines = result.stderr.strip("\n").split("\n")
+    assert len(lines) == 1, result.stderr
+    assert "Traceback" not in result.stderr
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+
+
+def write(tmp_path, text, name="scene.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_missing_scene_file(tmp_path):
+    assert_one_line_error(feelflow("run", tmp_path / "missing.toml"), "missing.toml: no such scene file")
+
+
+def test_bad_value_names_the_key(tmp_path):
+    scene = write(tmp_path, SMALL.replace("diameter = 8", "diameter = -3"))
+    assert_one_line_error(feelflow("run", scene), "scene.toml: body.diameter: must be a positive number, got -3")
+
+
+def test_unknown_key(tmp_path):
+    scene = write(tmp_path, SMALL.replace("[flow]", "[flow]\nviscosty = 0.1"))
+    assert_one_line_error(feelflow("run", scene), "flow.viscosty: unknown key")
+
+
+def test_not_toml(tmp_path):
+    scene = write(tmp_path, "grid = [\n")
+    assert_one_line_error(feelflow("run", scene), "scene.toml: not valid TOML")
+
+
+@pytest.mark.parametrize("steps", ["-5", "0", "ten", "1.5"])
+def test_bad_steps_option(tmp_path, steps):
+    scene = write(tmp_path, SMALL)
+    assert_one_line_error(feelflow("run", scene, "--steps", steps), "--steps: must be a positive integer")
+
+
+def test_bad_backend_and_output_directory(tmp_path):
+    scene = write(tmp_path, SMALL)
+    assert_one_line_error(feelflow("run", scene, "--backend", "cuda"), "--backend: must be one of gl, numpy")
+    assert_one_line_error(feelflow("run", scene, "--out", tmp_path / "no" / "f.csv"), "--out: directory")
+
+
+def test_validate_rejects_unknown_case_and_bad_resolution():
+    assert_one_line_error(feelflow("validate", "--case", "wind"), "--case: unknown case 'wind'")
+    assert_one_line_error(feelflow("validate", "--case", "taylor-green", "--resolution", "x"),
+                          "--resolution: must be a positive integer")
+
+
+def test_run_writes_the_documented_csv(tmp_path):
+    scene = write(tmp_path, SMALL)
+    out = tmp_path / "forces.csv"
+    result = feelflow("run", scene, "--out", out)
+    assert result.returncode == 0, result.stderr
+    rows = list(csv.reader(out.open()))
+    assert rows[0] == ["step", "x", "y", "vx", "vy", "fx_momentum_exchange", "fy_momentum_exchange",
+                       "fx_momentum_exchange_classic", "fy_momentum_exchange_classic"]
+    data = [[float(v) for v in r] for r in rows[1:]]
+    assert [r[0] for r in data] == [20, 40, 60]  # one row per interval, the last one shorter
+    # the body rests for 30 steps, then moves at (0.02, 0.01): after 60 steps it moved 30 steps
+    assert data[-1][1:5] == pytest.approx([20 + 0.6, 16.3 + 0.3, 0.02, 0.01])
+    assert data[0][1:5] == pytest.approx([20, 16.3, 0.0, 0.0])
+    assert data[-1][5] > 0  # the stream pushes the body downstream
+    assert not list(tmp_path.glob(".forces.csv.*"))  # no temporary file left behind
+
+
+def test_run_steps_option_overrides_the_scene(tmp_path):
+    scene = write(tmp_path, SMALL)
+    out = tmp_path / "f.csv"
+    assert feelflow("run", scene, "--steps", "40", "--out", out).returncode == 0
+    assert [r[0] for r in list(csv.reader(out.open()))[1:]] == ["20", "40"]
+
+
+def test_divergence_is_one_line_and_exit_1(tmp_path):
+    text = SMALL.replace("nu = 0.05", "nu = 0.000001\ncollision = \"bgk\"").replace(
+        "inflow_speed = 0.04", "inflow_speed = 0.095").replace("inflow_ramp_steps = 20", "inflow_ramp_steps = 0")
+    scene = write(tmp_path, text.replace("[output]", "[run]\nsteps = 3000\n\n[output]"))
+    result = feelflow("run", scene, "--out", tmp_path / "f.csv")
+    assert_one_line_error(result, "diverged", code=1)
+
+
+def test_validate_prints_a_table_and_writes_json(tmp_path):
+    import json
+
+    out = tmp_path / "v.json"
+    result = feelflow("validate", "--case", "taylor-green", "--quick", "--json", out)
+    assert result.returncode == 0, result.stderr
+    assert "| taylor-green | 32 |" in result.stdout and "| nu_rel_error |" in result.stdout
+    data = json.loads(out.read_text())
+    case = data["cases"][0]
+    assert case["name"] == "taylor-green" and case["backend"] == "numpy" and case["resolution"] == 32
+    assert case["steps"] > 0 and case["wall_seconds"] > 0 and case["mlups"] > 0
+    assert abs(case["quantities"]["nu_rel_error"]) < 0.01 and case["passed"] is True

@@ -1,0 +1,75 @@
+"""Physics validation (solver/validation/): quick versions in the default run, full ones `slow`.
+
+Each case measures against physics (analytic solutions, convergence order, published
+benchmarks, Galilean invariance, conservation); the targets are issue 2's.
+"""
+import pytest
+
+from solver.validation import CASES, case_module
+from tests.conftest import make_solver
+
+BACKENDS = ["numpy", pytest.param("gl", marks=pytest.mark.gl)]
+
+
+def factory(backend, request):
+    if backend == "gl":
+        pytest.importorskip("solver.gl_backend", reason="the gl backend is not built yet")
+    return lambda config: make_solver(backend, config, request)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_poiseuille_converges_with_order_two(backend, request):
+    r = case_module("poiseuille").run(factory(backend, request), quick=True, backend=backend)
+    assert r.quantities["steady"] == 1.0
+    assert 1.8 <= r.quantities["order"] <= 2.2, r.quantities
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_taylor_green_decay_gives_viscosity(backend, request):
+    r = case_module("taylor-green").run(factory(backend, request), quick=True, backend=backend)
+    assert abs(r.quantities["nu_rel_error"]) < 0.01, r.quantities
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_galilean_invariance_of_the_force(backend, request):
+    r = case_module("galilean").run(factory(backend, request), quick=True, backend=backend)
+    assert abs(r.quantities["towed_vs_fixed"]) < 0.03, r.quantities
+    assert r.quantities["comoving_vs_fixed"] < 0.02, r.quantities
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_mass_drift_of_a_moving_body_is_small(backend, request):
+    r = case_module("mass").run(factory(backend, request), quick=True, backend=backend)
+    assert abs(r.quantities["mass_drift"]) < 1e-3, r.quantities
+
+
+def test_surface_value_extrapolates_a_quadratic_exactly():
+    import numpy as np
+
+    from solver.validation.schaefer_turek import surface_value
+
+    y, x = np.mgrid[0:6, 0:10].astype(float)
+    field = 1 + 0.1 * x + 0.02 * x ** 2 + 0.3 * y
+    solid = x >= 6
+    assert surface_value(field, solid, (5.6, 2.5), -1) == pytest.approx(1 + 0.56 + 0.02 * 5.6 ** 2 + 0.75)
+
+
+def test_every_case_result_has_the_reported_fields(request):
+    r = case_module("taylor-green").run(factory("numpy", request), resolution=16)
+    d = r.to_dict()
+    for key in ("name", "backend", "resolution", "quantities", "steps", "wall_seconds", "mlups", "passed"):
+        assert key in d
+    assert d["steps"] > 0 and d["wall_seconds"] > 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(CASES))
+def test_full_case_meets_its_targets(name, request):
+    r = case_module(name).run(factory("numpy", request), backend="numpy")
+    assert r.passed, r.to_dict()
+
+
+@pytest.mark.slow
+def test_schaefer_turek_2d1_at_40_cells(request):
+    r = case_module("schaefer-turek-2d1").run(factory("numpy", request), resolution=40)
+    assert r.passed, r.to_dict()
