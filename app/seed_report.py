@@ -266,6 +266,8 @@ def _export(plot_widget, path: Path, width=900):
 
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png", dir=path.parent)
     os.close(fd)
+    plot_widget.show()  # lay the plot out (title, axes) before rendering it
+    QtWidgets.QApplication.processEvents()
     try:
         exporter = ImageExporter(plot_widget.getPlotItem())
         exporter.parameters()["width"] = width
@@ -282,7 +284,7 @@ def _export(plot_widget, path: Path, width=900):
 def _plot(pg, title, xlabel, ylabel, size=(900, 520)):
     w = pg.PlotWidget()
     w.resize(*size)
-    w.setTitle(title)
+    w.setTitle(title, size="11pt")
     w.setLabel("bottom", xlabel)
     w.setLabel("left", ylabel)
     w.showGrid(x=True, y=True, alpha=0.3)
@@ -305,6 +307,11 @@ def make_plots(parts: dict, res: dict, folder: Path) -> list[str]:
             for key, run in runs.items():
                 w.plot(run["step"], _forces(run, m)[:, 0], pen=pg.mkPen(dcol[key], width=2, style=dash[key]),
                        name=f"D = {run['reference_length']:g}")
+            vals = np.concatenate([_forces(run, m)[:, 0] for run in runs.values()])
+            if vals.size:  # the start of each moving phase is a spike: show the plateaus
+                lo, hi = np.percentile(vals, [3, 97])
+                pad = 0.15 * (hi - lo) + 1e-12
+                w.setYRange(lo - pad, hi + pad)
             first = next(iter(runs.values()))
             for b in np.cumsum(first["phases"])[:-1]:
                 w.addItem(pg.InfiniteLine(pos=float(b), angle=90,
