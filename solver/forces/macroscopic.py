@@ -18,7 +18,8 @@ This model knows nothing of the flow around the body except one mean velocity: i
 like |U|^2 by construction, and it separates shapes only through the coefficients it is given.
 Sampling at d -> 0 reads the wall velocity V (no-slip), so U -> 0: the seed's first failure.
 The sampling contour must lie inside the body window: `margin` (ceil(d) + 2 cells) tells the
-backends how far the window must extend beyond the body.
+backends how far the window must extend beyond the body. Where the window is clipped by the
+domain's edge (a body near a wall), the contour points beyond it are left out.
 """
 from __future__ import annotations
 
@@ -28,6 +29,7 @@ import numpy as np
 
 from solver.forces.base import BodyWindow, ForceModel
 from solver.forces.sampling import bilinear_stencil, moments_at
+from solver.lattice import RHO0
 
 #: kind -> (C_D, source). Wedges depend on which way they face (see `drag_coefficient`).
 DRAG_COEFFICIENTS: dict[str, tuple[float, str]] = {
@@ -104,9 +106,12 @@ class MacroscopicDrag(ForceModel):
             lengths = np.asarray(lengths, dtype=np.float64)
             stencil = bilinear_stencil(window, pts[:, 0] + self.distance * normals[:, 0],
                                        pts[:, 1] + self.distance * normals[:, 1])
-            self._geom = (stencil, stencil.nodes(), lengths / lengths.sum())
+            weight = lengths * stencil.valid  # points beyond a clipped window are left out
+            self._geom = (stencil, stencil.nodes(), weight / weight.sum() if weight.sum() > 0 else None)
             self._key = key
         stencil, nodes, weight = self._geom
+        if weight is None:  # the whole contour lies beyond the domain: nothing to sample
+            return RHO0, window.velocity[0], window.velocity[1]
         rho, ux, uy = moments_at(window, nodes)
         return tuple(float(np.dot(stencil.apply(a), weight)) for a in (rho, ux, uy))
 
