@@ -111,8 +111,9 @@ def test_macroscopic_lift_points_to_the_curved_side():
     for ux in (0.02, -0.02):
         fx, fy = model.formula(foil, 1.0, ux, 0.0)
         assert fy > 0 and np.sign(fx) == np.sign(ux)
-        # C_L / C_D = (2 pi t / c) / 0.6
-        assert fy / abs(fx) == pytest.approx(2 * math.pi * 8.0 / 40.0 / 0.6, rel=1e-9)
+        # F_y / F_x = (C_L c) / (C_D A): C_L = 2 pi t / c on the chord, C_D = 0.6 on the frontal width
+        area = foil.frontal_area((1.0, 0.0))
+        assert fy / abs(fx) == pytest.approx((2 * math.pi * 8.0 / 40.0 * 40.0) / (0.6 * area), rel=1e-9)
     upside_down = foil.moved(angle=math.pi)
     assert model.formula(upside_down, 1.0, 0.02, 0.0)[1] < 0
     assert create_model("macroscopic").formula(Cylinder(10.0, x=50, y=50), 1.0, 0.02, 0.0)[1] == 0.0
