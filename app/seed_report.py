@@ -144,7 +144,7 @@ def run_part(part: str, scenes_dir: Path, backend: str, quick: bool, phase_steps
 
 def save_part(folder: Path, data: dict) -> None:
     folder.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(folder / f"data-{data['part']}.json", json.dumps(data, indent=0))
+    write_text_atomic(folder / f"data-{data['part']}.json", json.dumps(data, separators=(",", ":")))
 
 
 def load_parts(folder: Path) -> dict:
@@ -280,6 +280,7 @@ def _export(plot_widget, path: Path, width=900):
         exporter = ImageExporter(plot_widget.getPlotItem())
         exporter.parameters()["width"] = width
         exporter.export(tmp)
+        os.chmod(tmp, 0o644)
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
@@ -376,6 +377,7 @@ def write_text_atomic(path: Path, text: str) -> None:
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
+        os.chmod(tmp, 0o644)  # mkstemp makes it private; a report is for reading
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
