@@ -246,6 +246,7 @@ def test_screenshot_shows_the_body_where_it_is(window, qtbot, tmp_path):
 
     sim = window.sim
     window.panel.hold_still.setChecked(True)
+    window.panel.arrows.setChecked(False)      # the arrows start at the body centre
     sim.pos = (40.0, 30.0)
     window.sim.set_shape()
     window.viewport.update()
@@ -377,3 +378,23 @@ def test_seed_protocol_moves_the_body_with_the_stream(window, qtbot):
     sim.runner.t = 2500 - 5           # skip the first (stopped) phase: the script is a plain object
     qtbot.waitUntil(lambda: sim.pos[0] > x0 + 1, timeout=20000)
     assert sim.script_phase()[2] == "moving with the stream"
+
+
+@pytest.mark.gl
+def test_gl_backend_runs_in_the_widgets_own_context(qtbot, tmp_path):
+    from PySide6.QtCore import QSettings
+
+    from app.main_window import MainWindow
+    from app.selftest import field_is_alive
+    from app.simulation import Params
+
+    w = MainWindow(backend="gl", settings=QSettings(str(tmp_path / "s.ini"), QSettings.IniFormat),
+                   params=Params(grid=GRID, size=12))
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitUntil(lambda: w.sim is not None and w.sim.solver.time > 20, timeout=30000)
+    assert w.sim.solver.name == "gl" and w.sim.solver.ctx is w.viewport.ctx
+    assert w.viewport.field_texture is w.sim.solver.field_texture()
+    ok, why = field_is_alive(w)
+    assert ok, why
+    w.timer.stop()
