@@ -227,3 +227,15 @@ def test_an_impossible_event_is_refused_at_replay(good, tmp_path):
     with pytest.raises(SessionError, match=r"event \d+ \(input at step \d+\) cannot be replayed") as info:
         replay(s)
     assert "\n" not in str(info.value)
+
+
+def test_saved_file_gets_the_usual_permissions(good, tmp_path):
+    path, rec = good
+    umask = os.umask(0o022)
+    os.umask(umask)
+    fresh = tmp_path / "fresh.ffsession"
+    rec.save(fresh)
+    assert fresh.stat().st_mode & 0o777 == 0o666 & ~umask
+    fresh.chmod(0o640)
+    rec.save(fresh)  # overwriting keeps the file's mode
+    assert fresh.stat().st_mode & 0o777 == 0o640
