@@ -431,35 +431,33 @@ class MainWindow(QMainWindow):
 
     # --- presets ------------------------------------------------------------------------------
     def apply_preset(self, key):
-        preset = PRESETS[key]
+        """Load the lesson's scene file and set the window up as the lesson needs."""
+        from app.cli import UserError
+        from app.scene import load_scene
+
+        lesson = PRESETS[key]
         if self.sim is None:
-            return
-        self._make_current()
-        params = preset.params.__class__(**{**preset.params.__dict__, "grid": self.sim.params.grid})
-        self.sim.params = params
-        self.sim.protocol = None
-        self.sim.sweep = None
+            return False
         try:
-            self.sim.set_grid(params.grid)
-        except (ConfigError, ShapeError) as exc:
-            self._refuse("This preset cannot run here", exc)
-            return
-        if preset.offset_y:
-            self.sim.pos = (self.sim.pos[0], self.sim.pos[1] + preset.offset_y)
-            self.sim.set_shape()
-        self.set_hold_still(preset.hold_still)
-        if preset.wind_sweep:
-            self.sim.start_sweep(preset.wind_sweep, preset.hold_steps)
-        if preset.protocol:
-            self.sim.start_protocol()
-        self.set_display_mode(preset.display)
-        i = self.plot.view.findData(preset.plot_view)
-        self.plot.view.setCurrentIndex(i)
+            scene = load_scene(lesson.path)
+            self._make_current()
+            self.sim.load_scene(scene)
+        except (UserError, ConfigError, ShapeError, ValueError) as exc:
+            self._refuse("This lesson cannot run here", exc)
+            return False
+        if self.sim.params.shape == "polygon":
+            self.undo.clear()
+        self.set_hold_still(lesson.hold_still and self.sim.runner is None)
+        if lesson.wind_sweep:
+            self.sim.start_sweep(lesson.wind_sweep, lesson.hold_steps)
+        self.set_display_mode(lesson.display)
+        self.plot.view.setCurrentIndex(self.plot.view.findData(lesson.plot_view))
         self.viewport.tracers = None
         self.panel.show_params(self.sim.params, self.display_mode)
         self._after_rebuild()
         self.set_paused(False)
-        self.statusBar().showMessage(f"{preset.title}: {preset.note}", 15000)
+        self.statusBar().showMessage(f"{lesson.title}: {lesson.note}", 20000)
+        return True
 
     # --- input devices ------------------------------------------------------------------------
     def set_input(self, url):
@@ -588,6 +586,8 @@ class MainWindow(QMainWindow):
         if sim is None:
             return
         p = sim.params
+        if abs(self.panel.wind.value() - p.wind) > 5e-4:   # a sweep or a lesson changed it
+            self.panel.show_params(p, self.display_mode)
         self.panel.show_numbers(sim.reynolds(), sim.mach(), sim.config.mach_limit)
         t, drag, lift = sim.history.drag_lift(p.force_model)
         if len(t) and p.force_model in sim.history.forces:

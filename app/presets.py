@@ -1,47 +1,44 @@
-"""Lessons from the Presets menu: each sets the scene and, where the lesson needs it, runs a
-script (a wind-speed sweep, the seed's stop/with/against protocol)."""
+"""Lessons from the Presets menu. The physics of each is a scene file in scenes/presets/
+(app/scene.py format: grid, flow, body, motion script, force models); this table adds only how
+the window presents it: title, display mode, plot view, a note, and a wind-speed sweep where the
+lesson needs one (scene files have no time-varying wind)."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import pathlib
+from dataclasses import dataclass
 
-from app.simulation import Params
+PRESET_DIR = pathlib.Path(__file__).resolve().parents[1] / "scenes" / "presets"
 
 
 @dataclass(frozen=True)
-class Preset:
+class Lesson:
     title: str
-    params: Params
+    scene: str                 # file name in scenes/presets/
     display: str = "speed"
+    plot_view: str = "time"
     note: str = ""
     wind_sweep: tuple = ()     # wind speeds held `hold_steps` each (body held still)
-    protocol: bool = False     # the seed's stop / with / against protocol
+    hold_steps: int = 2000
     hold_still: bool = True
-    plot_view: str = "time"
-    hold_steps: int = 1500
-    offset_y: float = 0.0      # cells off the centre line (breaks symmetry for shedding)
-    extra: dict = field(default_factory=dict)
+
+    @property
+    def path(self) -> pathlib.Path:
+        return PRESET_DIR / self.scene
 
 
 PRESETS = {
-    "drag_speed": Preset("Drag grows with speed",
-                         Params(shape="cylinder", size=20, wind=0.02, nu=0.005),
-                         note="The wind steps up from 0.02 to 0.09; watch the log-log slope.",
-                         wind_sweep=(0.02, 0.03, 0.045, 0.065, 0.09), plot_view="speed"),
-    "shape_matters": Preset("Shape matters: plate, wedges, cylinder",
-                            Params(shape="plate", size=24, wind=0.05, nu=0.01),
-                            note="Switch Shape between plate, wedge and cylinder and compare C_D."),
-    "lift": Preset("Lift on the half airfoil",
-                   Params(shape="half_airfoil", size=40, wind=0.05, nu=0.01),
-                   note="The flat side faces down: the lift arrow points up."),
-    "vortex_street": Preset("Vortex street behind a cylinder",
-                            Params(shape="cylinder", size=20, wind=0.06, nu=0.006),
-                            display="vorticity", offset_y=1.0,
-                            note="Re about 200: the wake starts to swing after a few thousand steps."),
-    "protocol": Preset("The seed's experiment: stopped, with, against the stream",
-                       Params(shape="cylinder", size=24, wind=0.04, nu=0.02, compare_all=True),
-                       protocol=True, hold_still=False,
-                       note="Four phases of 3000 steps: stopped, with the stream, stopped, against it."),
-    "models": Preset("Force models compared",
-                     Params(shape="cylinder", size=24, wind=0.05, nu=0.01, compare_all=True),
-                     note="All three force models on one plot."),
+    "drag_speed": Lesson("Drag grows with speed", "drag_speed.toml", plot_view="speed",
+                         wind_sweep=(0.02, 0.03, 0.045, 0.065, 0.09),
+                         note="The wind steps up from 0.02 to 0.09; the log-log plot fits drag ~ U^n."),
+    "shape_matters": Lesson("Shape matters: plate, wedges, cylinder", "shape_matters.toml", display="pressure",
+                            note="Switch Shape between plate, wedges and cylinder and compare C_D."),
+    "lift": Lesson("Lift on the half airfoil", "lift.toml", display="pressure",
+                   note="Flat side down: the blue lift arrow points up."),
+    "vortex_street": Lesson("Vortex street behind a cylinder", "vortex_street.toml", display="vorticity",
+                            note="Re 200: the wake starts to swing after a few thousand steps."),
+    "seed_protocol": Lesson("The seed's experiment: stopped, with, against the stream", "seed_protocol.toml",
+                            hold_still=False,
+                            note="Four phases of 2500 steps: stopped, with the stream, stopped, against it."),
+    "models": Lesson("Force models compared", "models_compared.toml",
+                     note="All three force models on one plot: dashed lines are lift."),
 }

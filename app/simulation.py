@@ -10,8 +10,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from app.coupling import AngleSpring, SpringDamper
+from solver import units
 from solver.backend import create_solver
 from solver.config import FlowConfig
+from solver.motion import MotionRunner
 
 #: grid presets offered in the side panel: label -> (nx, ny)
 GRID_PRESETS = {
@@ -32,6 +34,14 @@ FORCE_MODELS = {
 #: y-boundaries offered as "wall type": config value -> label
 WALLS = {"no_slip": "Solid walls (no slip)", "free_slip": "Slippery walls (free slip)",
          "periodic": "No walls (periodic)"}
+
+def default_base_config(grid) -> FlowConfig:
+    """What the panel does not edit: TRT, float32, an outlet sponge, a slow start of the wind
+    (a fast ramp excites a long slosh of the whole tunnel: about +-60 % of U for 1000 steps,
+    +-6 % for 2000, measured at 256 x 128)."""
+    nx, ny = grid
+    return FlowConfig(nx=nx, ny=ny, dtype="float32", inflow_ramp_steps=2000, sponge_cells=32)
+
 
 #: distance (cells) the body's bounding box keeps from the domain edges
 EDGE_MARGIN = 8.0
@@ -107,28 +117,21 @@ def drag_direction(wind):
     return out
 
 
-class Protocol:
-    """The seed's experiment run automatically: stopped, with the stream, stopped, against it
-    (SEED-NOTES 'Experiments'), each phase `phase_steps` long, body speed = inflow speed."""
-
-    PHASES = ("stopped", "moving with the stream", "stopped", "moving against the stream")
-
-    def __init__(self, speed: float, phase_steps: int = 3000, start: int = 0):
-        self.speed, self.phase_steps, self.start = speed, phase_steps, start
-
-    def phase(self, time: int) -> int | None:
-        k = (time - self.start) // self.phase_steps
-        return int(k) if 0 <= k < 4 else None
-
-    def velocity(self, time: int):
-        k = self.phase(time)
-        return None if k is None else ((0.0, self.speed, 0.0, -self.speed)[k], 0.0)
+def phase_name(velocity, wind: float) -> str:
+    """Plain words for a scripted phase (SEED-NOTES 'Experiments')."""
+    vx, vy = velocity
+    if vx == 0.0 and vy == 0.0:
+        return "stopped"
+    if wind and vy == 0.0:
+        return "moving with the stream" if vx * wind > 0 else "moving against the stream"
+    return f"moving at ({vx:.3f}, {vy:.3f})"
 
 
 class Simulation:
     """Owns the solver and the body; `advance(n)` runs n steps and records one force sample."""
 
-    def __init__(self, params: Params | None = None, backend: str = "numpy", ctx=None, shape_factory=None):
+    def __init__(self, params: Params | None = None, backend: str = "numpy", ctx=None, shape_factory=None,
+                 base_config: FlowConfig | None = None):
         from app.bodies import make_shape
 
         self.params = params or Params()
@@ -140,7 +143,8 @@ class Simulation:
         self.hold_still = False
         self.target = None           # where the mouse pulls the body, or None
         self.angle_target = math.radians(self.params.angle_deg)
-        self.protocol: Protocol | None = None
+        self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
+        self.base_config = base_config or default_base_config(self.params.grid)
         self.sweep = None            # (wind speeds, steps each, first step): a wind-speed sweep
         self.capped = False          # the Mach cap limited the body's speed in the last frame
         self.solver = None
@@ -148,10 +152,12 @@ class Simulation:
 
     # --- construction --------------------------------------------------------------------
     def flow_config(self, params: Params | None = None) -> FlowConfig:
+        """The base configuration (scene or default) with what the panel edits."""
         p = params or self.params
         nx, ny = p.grid
-        return FlowConfig(nx=nx, ny=ny, nu=p.nu, inflow_speed=p.wind, y_boundary=p.wall,
-                          dtype="float32", inflow_ramp_steps=300).validate()
+        base = self.base_config
+        return replace(base, nx=nx, ny=ny, nu=p.nu, inflow_speed=p.wind, y_boundary=p.wall,
+                       sponge_cells=min(base.sponge_cells, nx // 4)).validate()
 
     def _build(self, keep_flow: bool):
         config = self.flow_config()
@@ -170,6 +176,11 @@ class Simulation:
         if old is not None:
             old.close()
         self.solver = solver
+        if self.runner is not None:
+            if keep_flow:
+                self.runner.solver = solver
+            else:
+                self.runner = None
         self.config = config
         self.coupling = SpringDamper(max_speed=config.max_speed)
         if not keep_flow or not hasattr(self, "shape"):
@@ -236,8 +247,44 @@ class Simulation:
         k = (self.solver.time - start) // hold
         return k if k < len(speeds) else None
 
-    def start_protocol(self, phase_steps: int = 3000):
-        self.protocol = Protocol(self.params.wind, phase_steps, start=self.solver.time)
+    def start_script(self, script):
+        """Drive the body through a solver.motion.MotionScript (mouse and hold-still ignored)."""
+        self.shape = self.shape.moved(*self.pos, self.angle)
+        self.runner = MotionRunner(self.solver, self.shape, script)
+
+    def script_phase(self):
+        """(phase index, count, words) of the running script, or None."""
+        r = self.runner
+        if r is None:
+            return None
+        start = 0
+        for k, phase in enumerate(r.script.phases):
+            if r.t < start + phase.steps:
+                return k, len(r.script.phases), phase_name(phase.velocity, self.params.wind)
+            start += phase.steps
+        return None
+
+    def load_scene(self, scene):
+        """Take grid, flow, body, pose and motion from an app.scene.Scene."""
+        from app.bodies import params_for_shape
+
+        kind, size, verts = params_for_shape(scene.body)
+        cfg = scene.config
+        models = [m for m in scene.force_models if m in FORCE_MODELS] or [self.params.force_model]
+        self.base_config = cfg
+        self.params = replace(self.params, grid=(cfg.nx, cfg.ny), shape=kind, size=size or self.params.size,
+                              angle_deg=math.degrees(scene.body.angle), wind=cfg.inflow_speed, nu=cfg.nu,
+                              wall=cfg.y_boundary, force_model=models[0], compare_all=len(models) > 1)
+        self.polygon = verts
+        self.runner = None
+        self.sweep = None
+        self._build(keep_flow=False)
+        self.pos = (scene.body.x, scene.body.y)
+        self.shape = self.shape.moved(*self.pos, self.angle)
+        self._clamp_pose()
+        self.solver.set_body(self.shape, (0.0, 0.0), 0.0)
+        if scene.motion.phases:
+            self.start_script(scene.motion)
 
     # --- mouse ----------------------------------------------------------------------------
     def hit(self, x: float, y: float, tolerance: float = 2.0) -> bool:
@@ -265,6 +312,15 @@ class Simulation:
         done = 0
         acc = {}
         self.capped = False
+        if self.runner is not None:
+            acc = {k: (fx * n, fy * n) for k, (fx, fy) in self.runner.advance(n).items()}
+            r = self.runner
+            self.pos, self.shape = r.position, r.shape
+            self.vel = r.script.velocity_at(r.t - 1)
+            if r.t >= r.script.total_steps:
+                self.runner = None
+                self.vel = (0.0, 0.0)
+            done = n
         while done < n:
             speed = math.hypot(*self.vel)
             chunk = n - done if speed < 1e-9 else max(1, min(n - done, int(0.5 / speed)))
@@ -281,13 +337,7 @@ class Simulation:
 
     def _move_body(self, steps: int):
         old = (self.pos, self.angle)
-        scripted = self.protocol.velocity(self.solver.time) if self.protocol else None
-        if self.protocol and scripted is None:
-            self.protocol = None
-        if scripted is not None:
-            self.vel = scripted
-            self.pos = (self.pos[0] + scripted[0] * steps, self.pos[1] + scripted[1] * steps)
-        elif self.hold_still:
+        if self.hold_still:
             self.vel = (0.0, 0.0)
         else:
             self.pos, self.vel, capped = self.coupling.advance(self.pos, self.vel, self.target, steps)
@@ -318,10 +368,11 @@ class Simulation:
 
     # --- what the window shows -----------------------------------------------------------
     def reynolds(self) -> float:
-        return self.params.wind * self.params.size / self.params.nu
+        """Re of the wind over the body size (solver/units.py)."""
+        return units.reynolds(self.params.wind, self.params.size, self.params.nu)
 
     def mach(self) -> float:
-        return self.params.wind / math.sqrt(1.0 / 3.0)
+        return units.mach(self.params.wind)
 
     def field_rgba(self) -> np.ndarray:
         """(ny, nx, 4) float32: rho, ux, uy, vorticity (numpy path; the gl backend has a texture)."""

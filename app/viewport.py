@@ -15,9 +15,10 @@ import moderngl
 import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QBrush, QColor, QFont, QLinearGradient, QPainter, QPainterPath, QPen, QPolygonF
+from PySide6.QtGui import QBrush, QColor, QFont, QLinearGradient, QPainter, QPen, QPolygonF
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
 
+from solver import units
 from solver.lattice import glsl_constants
 
 SHADERS = pathlib.Path(__file__).resolve().parents[1] / "shaders"
@@ -43,7 +44,7 @@ BODY_FILL = QColor(225, 225, 225)
 BODY_EDGE = QColor(20, 20, 20)
 DRAG_COLOUR = QColor(230, 40, 40)
 LIFT_COLOUR = QColor(40, 120, 255)
-COLOUR_BAR_MARGIN = 118  # pixels on the right kept for the colour bar
+COLOUR_BAR_MARGIN = 132  # pixels on the right kept for the colour bar
 
 
 def load_shader(name: str) -> str:
@@ -180,7 +181,7 @@ class Viewport(QOpenGLWidget):
         if mode == 1:
             return sim.params.size / u
         if mode == 2:
-            return 1.0 / (0.5 * u * u)
+            return 1.0 / units.dynamic_pressure(u)   # C_p = (p - p0) / (rho U^2 / 2)
         return 1.0 / u
 
     # --- overlay ------------------------------------------------------------------------------
@@ -239,19 +240,19 @@ class Viewport(QOpenGLWidget):
         p.setPen(QPen(Qt.black, 1.5))
         p.setBrush(QBrush(colour))
         p.drawPolygon(tip)
-        self._label(p, QPointF(end.x() + 8 * ux - 4, end.y() + 8 * uy + (16 if uy > 0.5 else -6 if uy < -0.5 else 5)),
-                    label, colour)
+        self._label(p, QPointF(end.x() + 10 * ux - 4, end.y() + 10 * uy + (16 if uy > 0.5 else -8 if uy < -0.5 else 5)),
+                    label, QColor(255, 255, 255), box=colour.darker(130))
 
-    def _label(self, p, at: QPointF, text, colour=QColor(255, 255, 255), size=13):
+    def _label(self, p, at: QPointF, text, colour=QColor(255, 255, 255), size=15, box=QColor(0, 0, 0, 160)):
+        """Bold text on a dark translucent box, readable on any colour of the field."""
         font = QFont(self.font())
         font.setPixelSize(size)
         font.setBold(True)
         p.setFont(font)
-        path = QPainterPath()
-        path.addText(at, font, text)
-        p.setPen(QPen(QColor(0, 0, 0, 220), 3.5))
-        p.setBrush(Qt.NoBrush)
-        p.drawPath(path)
+        rect = p.fontMetrics().boundingRect(text).adjusted(-4, -2, 4, 2).translated(int(at.x()), int(at.y()))
+        p.setPen(Qt.NoPen)
+        p.setBrush(box)
+        p.drawRoundedRect(QRectF(rect), 4, 4)
         p.setPen(colour)
         p.drawText(at, text)
 
@@ -275,6 +276,22 @@ class Viewport(QOpenGLWidget):
             self._arrow(p, centre, vec, colour, key)
 
     def _paint_colour_bar(self, p: QPainter):
+        """The colour bar, drawn once per mode and size into a pixmap, then blitted each frame."""
+        key = (self.mode, self.width(), self.height(), self.sim.config.nx, self.sim.config.ny)
+        if getattr(self, "_bar_key", None) != key:
+            from PySide6.QtGui import QPixmap
+
+            pixmap = QPixmap(COLOUR_BAR_MARGIN, self.height())
+            pixmap.fill(QColor(41, 43, 48))
+            painter = QPainter(pixmap)
+            painter.setRenderHint(QPainter.Antialiasing)
+            painter.translate(-(self.width() - COLOUR_BAR_MARGIN), 0)
+            self._draw_colour_bar(painter)
+            painter.end()
+            self._bar_pixmap, self._bar_key = pixmap, key
+        p.drawPixmap(self.width() - COLOUR_BAR_MARGIN, 0, self._bar_pixmap)
+
+    def _draw_colour_bar(self, p: QPainter):
         mode = DISPLAY_MODES[self.mode]
         r = self.lattice_rect()
         x = self.width() - COLOUR_BAR_MARGIN + 22
@@ -292,13 +309,13 @@ class Viewport(QOpenGLWidget):
         p.setBrush(QBrush(grad))
         p.drawRect(bar)
         font = QFont(self.font())
-        font.setPixelSize(13)
+        font.setPixelSize(15)
         p.setFont(font)
         lo, hi = mode.range
         for v in np.linspace(lo, hi, 5):
             y = bottom - (v - lo) / (hi - lo) * (bottom - top)
             p.drawLine(QPointF(x + 20, y), QPointF(x + 25, y))
-            p.drawText(QPointF(x + 28, y + 5), f"{v:g}")
+            p.drawText(QPointF(x + 28, y + 5), f"{v:g}".replace("-", "\u2212"))
         font.setBold(True)
         p.setFont(font)
         p.drawText(QRectF(x - 22, 4, COLOUR_BAR_MARGIN - 2, top - 8), Qt.AlignLeft | Qt.AlignBottom | Qt.TextWordWrap,
@@ -312,10 +329,13 @@ class Viewport(QOpenGLWidget):
             notes.append(("speed limit reached (Mach %.2f)" % sim.config.mach_limit, QColor(255, 170, 40)))
         if sim.hold_still:
             notes.append(("holding still", QColor(255, 255, 255)))
-        if sim.protocol is not None:
-            k = sim.protocol.phase(sim.solver.time)
-            if k is not None:
-                notes.append((f"protocol: {sim.protocol.PHASES[k]} ({k + 1}/4)", QColor(255, 255, 255)))
+        phase = sim.script_phase()
+        if phase is not None:
+            k, count, words = phase
+            notes.append((f"scripted motion: {words} (phase {k + 1} of {count})", QColor(255, 255, 255)))
+        stage = sim.sweep_stage()
+        if stage is not None:
+            notes.append((f"wind {sim.params.wind:.3f} (speed {stage + 1} of {len(sim.sweep[0])})", QColor(255, 255, 255)))
         for i, (text, colour) in enumerate(notes):
             self._label(p, QPointF(r.left() + 10, r.top() + 24 + 20 * i), text, colour, size=15)
 
