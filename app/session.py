@@ -557,6 +557,11 @@ def _fmt(v) -> str:
 
 # --- files ------------------------------------------------------------------------------------
 
+#: the process umask (read once: os.umask can only be read by setting it)
+_UMASK = os.umask(0o022)
+os.umask(_UMASK)
+
+
 def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
     """Write `data` through `app.files.atomic_path` (temp file beside, fsync, os.replace): never
     half a file. SessionError naming the path if it cannot (the old file is left as it was)."""
@@ -566,7 +571,9 @@ def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
     if path.is_dir():
         raise SessionError(f"{path}: is a directory")
     try:
+        mode = path.stat().st_mode & 0o777 if path.exists() else 0o666 & ~_UMASK
         with atomic_path(path, suffix=".tmp") as tmp:
+            os.chmod(tmp, mode)  # mkstemp makes 0600; a saved file gets the usual permissions
             with open(tmp, "wb") as fh:
                 fh.write(data)
                 fh.flush()
@@ -717,7 +724,7 @@ def _validate(manifest, parameters, inputs, forces, src, state=None) -> Session:
     from solver.forces import MODELS
 
     initial_models = scene.get("force_models", [])
-    if not isinstance(initial_models, list) or not all(m in MODELS for m in initial_models):
+    if not isinstance(initial_models, list) or not all(isinstance(m, str) and m in MODELS for m in initial_models):
         raise SessionError(f"{MANIFEST}: scene.force_models must list force models ({', '.join(MODELS)})")
     for key in ("toml", "source"):
         if scene.get(key) is not None and not isinstance(scene[key], str):
@@ -817,7 +824,7 @@ def _validate_start(start, state, config: FlowConfig):
     if not (isinstance(v, list) and len(v) == 2 and all(_is_number(c) for c in v)) or not _is_number(start["omega"]) \
             or math.hypot(*v) > MAX_LATTICE_SPEED:
         raise SessionError(f"{where}: velocity and omega must be finite numbers (|v| <= 1)")
-    if not isinstance(start["force_models"], list) or not all(m in MODELS for m in start["force_models"]):
+    if not isinstance(start["force_models"], list) or not all(isinstance(m, str) and m in MODELS for m in start["force_models"]):
         raise SessionError(f"{where}.force_models must list force models ({', '.join(MODELS)})")
     u = start["inflow_speed"]
     if u is not None and not (_is_number(u) and abs(u) <= MAX_LATTICE_SPEED):
@@ -854,7 +861,7 @@ def _validate_parameters(parameters, config: FlowConfig) -> list:
                 dataclasses.replace(config, nu=float(v)).validate()
             except ConfigError as exc:
                 raise SessionError(f"{where}: {exc}") from None
-        if name == "force_models" and (not isinstance(v, list) or not all(m in MODELS for m in v)):
+        if name == "force_models" and (not isinstance(v, list) or not all(isinstance(m, str) and m in MODELS for m in v)):
             raise SessionError(f"{where}: force_models must list force models ({', '.join(MODELS)})")
         if name == "body" and v is not None:
             _shape_from_dict(v, f"{where}: body", None)
@@ -952,6 +959,11 @@ def replay(session: Session, backend: str | None = None, *, factory=None, ctx=No
                     diverged_at = driver.clock
             if progress is not None:
                 progress(k + 1, len(events))
+    except SessionError:
+        raise
+    except ValueError as exc:  # ShapeError, ConfigError: the file asks for something impossible
+        raise SessionError(f"{session.source}: event {k} ({ev[0]} at step {ev[1]}) cannot be replayed: "
+                           f"{str(exc).splitlines()[0]}") from None
     finally:
         driver.close()
     replayed = rec.session()

@@ -211,3 +211,31 @@ def test_atomic_write_keeps_the_old_file_when_writing_fails(good, tmp_path, monk
     load_session(target)
     with pytest.raises(SessionError, match="cannot write"):
         rec.save(tmp_path / "no" / "such" / "dir.ffsession")
+
+
+def test_an_impossible_event_is_refused_at_replay(good, tmp_path):
+    """An input that puts the body across the domain edge loads (it is on the grid) but cannot
+    be replayed: one line naming the event."""
+    from app.session import replay
+
+    path, _ = good
+    data = members(path)
+    a = arrays(data[INPUTS])
+    a["pose"][4, 0] = 1.0  # the cylinder's centre one cell from the inlet
+    write_members(tmp_path / "edge.ffsession", {**data, INPUTS: npz(a)})
+    s = load_session(tmp_path / "edge.ffsession")
+    with pytest.raises(SessionError, match=r"event \d+ \(input at step \d+\) cannot be replayed") as info:
+        replay(s)
+    assert "\n" not in str(info.value)
+
+
+def test_saved_file_gets_the_usual_permissions(good, tmp_path):
+    path, rec = good
+    umask = os.umask(0o022)
+    os.umask(umask)
+    fresh = tmp_path / "fresh.ffsession"
+    rec.save(fresh)
+    assert fresh.stat().st_mode & 0o777 == 0o666 & ~umask
+    fresh.chmod(0o640)
+    rec.save(fresh)  # overwriting keeps the file's mode
+    assert fresh.stat().st_mode & 0o777 == 0o640

@@ -12,6 +12,8 @@ from app.session import (SessionRecorder, SessionSolver, export_csv, force_colum
                          record_headless, replay)
 from session_scenes import MODELS, drive_moving_cylinder, small_config, start_body
 from solver.backend import create_solver
+from solver_backends import BACKENDS
+from conftest import make_solver
 
 
 def record(tmp_path, extras=True, steps=40):
@@ -106,20 +108,55 @@ def test_recorded_playback_and_csv_export(tmp_path):
     assert int(rows[-1][0]) == s.steps and math.isclose(float(rows[-1][1]), frames[-1][1][0])
 
 
-def test_record_headless_wraps_a_run(tmp_path):
-    """What `feelflow run --record` does: the runner drives the wrapped solver."""
-    class Scene:
-        config, body, force_models, backend, source = small_config(), start_body(), MODELS, "numpy", "t.toml"
+SCENE_TOML = """
+[grid]
+nx = 64
+ny = 32
+[flow]
+nu = 0.05
+inflow_speed = 0.03
+inflow_ramp_steps = 10
+[body]
+kind = "plate"
+length = 8
+thickness = 2
+x = 24
+y = 16.2
+angle = 10
+[[motion]]
+steps = 10
+move = "stop"
+[[motion]]
+steps = 20
+move = "against"
+[output]
+forces = ["momentum_exchange", "pressure"]
+interval = 5
+"""
 
-    solver = create_solver("numpy", Scene.config)
-    ss, rec = record_headless(solver, Scene, scene_toml="[grid]\nnx = 64\n")
-    ss.enable_force_models(Scene.force_models)
-    ss.set_body(Scene.body, velocity=(0.0, 0.0))
-    ss.step(5)
+
+def test_record_headless_records_a_scripted_run(tmp_path):
+    """What `feelflow run SCENE --record FILE` does: the scene's motion runner drives the
+    wrapped solver; the file replays to the same forces."""
+    import tomllib
+
+    from app.scene import scene_from_dict
+    from solver.motion import MotionRunner
+
+    scene = scene_from_dict(tomllib.loads(SCENE_TOML), "plate.toml")
+    solver = create_solver("numpy", scene.config)
+    ss, rec = record_headless(solver, scene, scene_toml=SCENE_TOML)
+    ss.enable_force_models(scene.force_models)
+    runner = MotionRunner(ss, scene.body, scene.motion)
+    while runner.t < scene.steps:
+        runner.advance(scene.output_interval)
     rec.save(tmp_path / "h.ffsession")
     s = load_session(tmp_path / "h.ffsession")
-    assert s.manifest["scene"]["source"] == "t.toml" and s.manifest["scene"]["toml"].startswith("[grid]")
-    assert replay(s).max_deviation == 0.0
+    assert s.manifest["scene"]["source"] == "plate.toml" and s.manifest["scene"]["toml"] == SCENE_TOML
+    assert s.steps == scene.steps and len(s.inputs["step"]) >= 20  # placed before every moving step
+    assert s.inputs["velocity"][-1, 0] == -0.03
+    result = replay(s)
+    assert result.max_force > 1e-3 and result.max_deviation == 0.0
 
 
 @pytest.mark.parametrize("bad", [{"step": 3}, {"n": 0}])
@@ -130,3 +167,19 @@ def test_recorder_refuses_inconsistent_steps(bad):
             rec.record_forces(bad["n"], {})
         else:
             rec.record_input(20, 16, step=bad["step"])
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_replay_on_the_recording_backend_is_exact(backend, request, tmp_path):
+    """Both backends replay their own recordings bit for bit (float32 storage, the GUI's)."""
+    cfg = small_config(dtype="float32")
+    factory = lambda c: make_solver(backend, c, request)  # noqa: E731
+    rec = SessionRecorder(cfg, start_body(), MODELS, backend=backend)
+    drive_moving_cylinder(SessionSolver(factory(cfg), rec, factory=factory), steps=30)
+    rec.save(tmp_path / "b.ffsession")
+    s = load_session(tmp_path / "b.ffsession")
+    result = replay(s, factory=factory)
+    assert result.max_force > 1e-3 and result.max_deviation == 0.0
+    if backend == "gl":  # the other backend follows the same algorithm to float32 rounding
+        other = replay(s, "numpy")
+        assert 0 < other.relative_deviation < 1e-4

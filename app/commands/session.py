@@ -76,7 +76,9 @@ def info(args) -> int:
           f"{c.collision}, inflow {c.inflow_speed:g} ({c.inflow_profile}), walls {c.y_boundary}")
     print(f"  body      {body_text}")
     print(f"  forces    {', '.join(s.models) or 'none'}")
-    print(f"  recorded  {counts['steps']} steps: {counts['inputs']} input samples, "
+    start = "from the scene's initial flow" if s.start is None else \
+        f"from a running flow at solver step {s.start['time']} (state saved)"
+    print(f"  recorded  {counts['steps']} steps {start}: {counts['inputs']} input samples, "
           f"{counts['parameters']} parameter changes, {counts['forces']} force rows")
     return 0
 
