@@ -83,6 +83,8 @@ class Viewport(QOpenGLWidget):
         self.program = self.ctx.program(vertex_shader=load_shader("display_vertex.glsl"),
                                         fragment_shader=load_shader("display.glsl"))
         self.vao = self.ctx.vertex_array(self.program, [])
+        self._align_texture = self.ctx.texture((1, 1), 4, dtype="f1")
+        self._sampler = self.ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False)
         self._lut = None
         self._lut_name = None
         self.contextReady.emit(self.ctx)
@@ -140,6 +142,9 @@ class Viewport(QOpenGLWidget):
         try:
             self._draw_field()
         finally:
+            # moderngl leaves GL_UNPACK_ALIGNMENT at 1 after the solver's uploads; Qt's glyph
+            # cache assumes the default 4 (garbled text otherwise): a 1-texel write restores it
+            self._align_texture.write(b"\0\0\0\0", alignment=4)
             painter.endNativePainting()
         self._paint_overlay(painter)
         painter.end()
@@ -161,8 +166,8 @@ class Viewport(QOpenGLWidget):
         r = self.lattice_rect()
         ctx.viewport = (int(round(r.left() * dpr)), int(round((self.height() - r.bottom()) * dpr)),
                         int(round(r.width() * dpr)), int(round(r.height() * dpr)))
-        self.field_texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
         self.field_texture.use(0)
+        self._sampler.use(0)          # smooth, without changing the solver's own texture
         self._lut.filter = (moderngl.LINEAR, moderngl.LINEAR)
         self._lut.use(1)
         self.program["field"] = 0
