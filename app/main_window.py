@@ -29,7 +29,7 @@ from solver.config import ConfigError
 TARGET_FRAME_S = 1.0 / 34      # aim a little above 30 fps
 MAX_STEPS_PER_FRAME = 200
 MIN_STEPS_PER_FRAME = 2   # the flow keeps moving even where drawing alone takes 1/30 s
-N_TRACERS = 1500
+N_TRACERS = 900
 
 
 class MainWindow(QMainWindow):
@@ -64,7 +64,7 @@ class MainWindow(QMainWindow):
         pdock.setWidget(self.plot)
         pdock.setFeatures(QDockWidget.DockWidgetMovable)
         self.addDockWidget(Qt.BottomDockWidgetArea, pdock)
-        self.resizeDocks([pdock], [260], Qt.Vertical)
+        self.resizeDocks([pdock], [230], Qt.Vertical)
 
         self.status = {k: QLabel() for k in ("steps", "mlups", "fps", "re", "ma", "renderer")}
         for label in self.status.values():
@@ -146,7 +146,8 @@ class MainWindow(QMainWindow):
         self.plot.sim = self.sim
         self.viewport.mode = self.display_mode
         self.panel.show_params(self.sim.params, self.display_mode)
-        self.status["renderer"].setText(f"{self.viewport.renderer()} ({self.backend} solver)")
+        self.status["renderer"].setText(f"{self.viewport.renderer().split(' (')[0]}, {self.backend} solver")
+        self.status["renderer"].setToolTip(self.viewport.renderer())
         self._upload_field()
         self.refresh_devices()
         self.timer.start()
@@ -643,7 +644,7 @@ class MainWindow(QMainWindow):
         k = int(bad.sum())
         if k:
             pts[bad] = np.c_[rng.uniform(0, 3, k), rng.uniform(0, ny - 1, k)]
-        tail = pts - u * 60
+        tail = pts - u * 30   # a short streak: where the particle was 30 steps ago
         self.viewport.tracers = (pts, tail)
 
     def refresh_readouts(self):
