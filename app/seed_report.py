@@ -114,14 +114,18 @@ def run_scene(scene, backend: str, log=print) -> dict:
 PARTS = ("protocol", "shapes", "sweep", "lift")
 
 
-def run_part(part: str, scenes_dir: Path, backend: str, quick: bool, phase_steps, log=print) -> dict:
-    """Run one part's experiments; JSON-ready raw series plus how they were run."""
+def run_part(part: str, scenes_dir: Path, backend: str, quick: bool, phase_steps, log=print,
+             keys=None) -> dict:
+    """Run one part's experiments (for the protocol: the diameters in `keys`, default all);
+    JSON-ready raw series plus how they were run."""
     q = QUICK if quick else {}
     over = {"ramp": q.get("ramp"), "interval": 10 if quick else None}
     runs: dict = {}
     t0 = time.perf_counter()
     if part == "protocol":
         for key, name in PROTOCOL:
+            if keys and key not in keys:
+                continue
             scene = load_scene_with(scenes_dir / name, phase_steps=q.get("phase_steps", phase_steps), **over)
             runs[key] = run_scene(scene, backend, log)
     elif part == "shapes":
@@ -143,20 +147,45 @@ def run_part(part: str, scenes_dir: Path, backend: str, quick: bool, phase_steps
 
 
 def save_part(folder: Path, data: dict) -> None:
+    """Store a part; the protocol one file per diameter (data-protocol-d16.json ...), so that
+    diameters can be run (or rerun) by separate processes."""
     folder.mkdir(parents=True, exist_ok=True)
+    if data["part"] == "protocol":
+        for key, run in data["runs"].items():
+            one = dict(data, runs={key: run}, wall_s=run["wall_s"])
+            write_text_atomic(folder / f"data-protocol-{key}.json", json.dumps(one, separators=(",", ":")))
+        return
     write_text_atomic(folder / f"data-{data['part']}.json", json.dumps(data, separators=(",", ":")))
 
 
+def _read_json(path: Path) -> dict:
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as exc:
+        raise UserError(f"{path}: not valid JSON ({exc.msg}); run that part again") from None
+
+
 def load_parts(folder: Path) -> dict:
-    """part -> stored data, for the parts that have been run."""
+    """part -> stored data, for the parts that have been run (protocol diameters merged; each
+    protocol run keeps how it was run in `provenance`)."""
     parts = {}
     for part in PARTS:
+        if part == "protocol":
+            runs, provenance = {}, {}
+            for key, _ in PROTOCOL:
+                path = folder / f"data-protocol-{key}.json"
+                if path.exists():
+                    one = _read_json(path)
+                    runs[key] = one["runs"][key]
+                    provenance[key] = one
+            if runs:
+                first = next(iter(provenance.values()))
+                parts[part] = dict(first, runs=runs, provenance=provenance,
+                                   wall_s=sum(p["wall_s"] for p in provenance.values()))
+            continue
         path = folder / f"data-{part}.json"
         if path.exists():
-            try:
-                parts[part] = json.loads(path.read_text(encoding="utf-8"))
-            except json.JSONDecodeError as exc:
-                raise UserError(f"{path}: not valid JSON ({exc.msg}); run that part again") from None
+            parts[part] = _read_json(path)
     return parts
 
 
@@ -417,7 +446,10 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
         "Forces in lattice units per step, means over the last half of each phase or run. "
         "Parts not run yet are left out.\n")
     for part in PARTS:
-        if part in parts:
+        if part == "protocol" and part in parts:
+            for key, prov in parts[part]["provenance"].items():
+                add(f"- protocol {key}: {_provenance(prov)}")
+        elif part in parts:
             add(f"- {part}: {_provenance(parts[part])}")
     add("\n## Runs\n")
     L += _runs_table(parts)
