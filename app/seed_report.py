@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from app.cli import UserError
+from solver.lattice import CS2
 
 MODELS = ("momentum_exchange", "momentum_exchange_classic", "macroscopic", "pressure")
 REFERENCE = "momentum_exchange"
@@ -207,13 +208,23 @@ def _forces(run: dict, model: str) -> np.ndarray:
     return np.asarray(run["forces"][model], dtype=np.float64).reshape(-1, 2)
 
 
+def acoustic_period(run: dict) -> float:
+    """Period of the tunnel's quarter-wave acoustic mode, 4 nx / c_s steps (README, 'Solver'):
+    the inlet and the outlet both reflect sound, and every start, stop and ramp rings it."""
+    return 4.0 * run["nx"] / math.sqrt(CS2)
+
+
 def tail_mean(run: dict, model: str, start: int, end: int) -> np.ndarray:
-    """Mean force over the rows whose step lies in the last half of [start, end]; nan for a run
-    that diverged (its rows stop early and end in the blow-up)."""
+    """Mean force at the end of [start, end]: over the longest whole number of acoustic periods
+    that fits in its last half (a ringing mode then averages out), else over the last half;
+    nan for a run that diverged (its rows stop early and end in the blow-up)."""
     if run.get("diverged_at") is not None:
         return np.array([math.nan, math.nan])
     steps = np.asarray(run["step"])
-    sel = (steps > start + (end - start) // 2) & (steps <= end)
+    half = (end - start) // 2
+    period = acoustic_period(run)
+    length = int(round(math.floor(half / period) * period)) if half >= period else half
+    sel = (steps > end - length) & (steps <= end)
     f = _forces(run, model)
     if not sel.any():
         return np.array([math.nan, math.nan])
@@ -223,6 +234,24 @@ def tail_mean(run: dict, model: str, start: int, end: int) -> np.ndarray:
 def phase_means(run: dict, model: str) -> list[np.ndarray]:
     bounds = np.concatenate([[0], np.cumsum(run["phases"])])
     return [tail_mean(run, model, int(bounds[k]), int(bounds[k + 1])) for k in range(len(run["phases"]))]
+
+
+#: the protocol plots show a running mean over this many steps: the impulsive starts and stops
+#: ring the tunnel's acoustic modes, whose force swings exceed the drag at U = 0.01
+PLOT_SMOOTH_STEPS = 1000
+
+
+def running_mean(run: dict, model: str, steps: int):
+    """(step, F_x) averaged over `steps` steps (centred, whole windows only)."""
+    step = np.asarray(run["step"], dtype=np.float64)
+    fx = _forces(run, model)[:, 0]
+    if len(step) < 2:
+        return step, fx
+    k = max(1, int(round(steps / (step[1] - step[0]))))
+    if k <= 1 or len(fx) < k:
+        return step, fx
+    kernel = np.ones(k) / k
+    return np.convolve(step, kernel, mode="valid"), np.convolve(fx, kernel, mode="valid")
 
 
 def power_fit(x, y) -> tuple[float, float]:
@@ -340,12 +369,15 @@ def make_plots(parts: dict, res: dict, folder: Path) -> list[str]:
     if "protocol" in parts:
         runs = parts["protocol"]["runs"]
         for m in MODELS:
-            w = _plot(pg, f"{m}: F_x over the seed protocol (stop | with | stop | against)", "step",
-                      "F_x (lattice units per step)")
+            w = _plot(pg, f"{m}: F_x over the seed protocol (stop | with | stop | against), "
+                          f"running mean over {PLOT_SMOOTH_STEPS} steps", "step", "F_x (lattice units per step)")
+            curves = []
             for key, run in runs.items():
-                w.plot(run["step"], _forces(run, m)[:, 0], pen=pg.mkPen(dcol[key], width=2, style=dash[key]),
+                steps, fx = running_mean(run, m, PLOT_SMOOTH_STEPS)
+                curves.append(fx)
+                w.plot(steps, fx, pen=pg.mkPen(dcol[key], width=2, style=dash[key]),
                        name=f"D = {run['reference_length']:g}")
-            vals = np.concatenate([_forces(run, m)[:, 0] for run in runs.values()])
+            vals = np.concatenate(curves)
             if vals.size:  # the start of each moving phase is a spike: show the plateaus
                 lo, hi = np.percentile(vals, [3, 97])
                 pad = 0.15 * (hi - lo) + 1e-12
@@ -443,7 +475,8 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
     add("Models (docs/force-models.md): `momentum_exchange` (the reference: Galilean-invariant momentum exchange), "
         "`momentum_exchange_classic` (the seed's), `macroscopic` (drag equation with tabulated C_D, velocity sampled "
         "4 cells off the wall), `pressure` (seed eq. 24 with beta = rho_0/6, i.e. the lattice pressure; no shear). "
-        "Forces in lattice units per step, means over the last half of each phase or run. "
+        "Forces in lattice units per step; means at the end of each phase or run, over the longest whole number "
+        "of periods of the tunnel's acoustic mode (4 nx / c_s steps) within its last half (else the last half). "
         "Parts not run yet are left out.\n")
     for part in PARTS:
         if part == "protocol" and part in parts:
@@ -543,6 +576,9 @@ def verdict(m: str, res: dict) -> str:
     if "shapes" in res:
         ref_order = sorted(res["shapes"][REFERENCE], key=lambda k: -res["shapes"][REFERENCE][k]["drag"])
         order = sorted(res["shapes"][m], key=lambda k: -res["shapes"][m][k]["drag"])
+        if m != REFERENCE:
+            rel = [res["shapes"][m][k]["drag"] / res["shapes"][REFERENCE][k]["drag"] for k in ref_order]
+            parts.append("drag / reference drag: " + ", ".join(f"{k} {_g(r, 2)}" for k, r in zip(ref_order, rel)))
         parts.append("shape ordering " + (f"{' > '.join(order)}" if m == REFERENCE else
                                           "matches the reference" if order == ref_order else
                                           f"**differs from the reference** ({' > '.join(order)})"))
