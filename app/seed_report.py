@@ -277,8 +277,8 @@ def analyse(parts: dict) -> dict:
             per_d = {}
             for key, run in runs.items():
                 f = [float(p[0]) for p in phase_means(run, m)]
-                per_d[key] = {"phases": f, "zero_rel_frac": f[1] / f[2] if f[2] else math.nan,
-                              "against_over_stopped": f[3] / f[2] if f[2] else math.nan,
+                per_d[key] = {"phases": f, "zero_rel_frac": _ratio(f[1], f[2]),
+                              "against_over_stopped": _ratio(f[3], f[2]),
                               "reynolds": run["reynolds"], "diameter": run["reference_length"]}
             out["protocol"][m] = per_d
             d = [v["diameter"] for v in per_d.values()]
@@ -300,7 +300,7 @@ def analyse(parts: dict) -> dict:
             for key, run in parts["shapes"]["runs"].items():
                 fx = float(tail_mean(run, m, 0, run["steps"])[0])
                 u, w = run["inflow_speed"], run["reference_length"]
-                shapes[key] = {"drag": fx, "cd": 2 * fx / (u * u * w), "reynolds": run["reynolds"]}
+                shapes[key] = {"drag": fx, "cd": _ratio(2 * fx, u * u * w), "reynolds": run["reynolds"]}
             out["shapes"][m] = shapes
     if "lift" in parts:
         run = parts["lift"]["runs"]["half_airfoil"]
@@ -308,7 +308,7 @@ def analyse(parts: dict) -> dict:
         for m in MODELS:
             fx, fy = (float(c) for c in tail_mean(run, m, 0, run["steps"]))
             u, chord = run["inflow_speed"], run["body"].get("chord", run["reference_length"])
-            out["lift"][m] = {"fx": fx, "fy": fy, "cl_chord": 2 * fy / (u * u * chord),
+            out["lift"][m] = {"fx": fx, "fy": fy, "cl_chord": _ratio(2 * fy, u * u * chord),
                               "reynolds_chord": u * chord / run["nu"]}
     return out
 
@@ -554,6 +554,10 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
     return "\n".join(L)
 
 
+def _ratio(a: float, b: float) -> float:
+    return a / b if b else math.nan
+
+
 def verdict(m: str, res: dict) -> str:
     """One measured summary per model; the thresholds are stated in the words."""
     parts = []
@@ -577,7 +581,7 @@ def verdict(m: str, res: dict) -> str:
         ref_order = sorted(res["shapes"][REFERENCE], key=lambda k: -res["shapes"][REFERENCE][k]["drag"])
         order = sorted(res["shapes"][m], key=lambda k: -res["shapes"][m][k]["drag"])
         if m != REFERENCE:
-            rel = [res["shapes"][m][k]["drag"] / res["shapes"][REFERENCE][k]["drag"] for k in ref_order]
+            rel = [_ratio(res["shapes"][m][k]["drag"], res["shapes"][REFERENCE][k]["drag"]) for k in ref_order]
             parts.append("drag / reference drag: " + ", ".join(f"{k} {_g(r, 2)}" for k, r in zip(ref_order, rel)))
         parts.append("shape ordering " + (f"{' > '.join(order)}" if m == REFERENCE else
                                           "matches the reference" if order == ref_order else
