@@ -49,11 +49,23 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    if args.selftest:
+    if args.selftest or args.command is None:
         args.command = "gui"
-    if args.command is None:
-        args.command = "gui"
-        args = parser.parse_args(["gui", *(argv if argv is not None else sys.argv[1:])])
+    if not hasattr(args, "_module") and not hasattr(args, "_missing"):
+        # no sub-command on the line (`feelflow`, `feelflow --selftest`): the gui's defaults
+        try:
+            module = importlib.import_module("app.commands.gui")
+        except ModuleNotFoundError as exc:
+            if exc.name != "app.commands.gui":
+                raise
+            args._missing = "gui"
+        else:
+            sub = argparse.ArgumentParser()
+            module.add_arguments(sub)
+            for key, value in vars(sub.parse_args([])).items():
+                if not hasattr(args, key):
+                    setattr(args, key, value)
+            args._module = module
     if getattr(args, "_missing", None):
         print(f"feelflow: '{args.command}' is not available in this version", file=sys.stderr)
         return 2

@@ -1,6 +1,7 @@
 """Finding and opening devices by URL.
 
-  serial:///dev/ttyACM0[?driver=haply2diy|hapkit]   a serial port (driver guessed from USB ids)
+  serial:///dev/ttyACM0[?driver=haply2diy|hapkit][&baud=N]   a serial port (driver guessed
+                                                    from USB ids; baud defaults to the firmware's)
   hid://VID:PID[?driver=spacemouse|diyhid]          a HID device (hex ids)
   sim://haply2diy | sim://hapkit | sim://spacemouse | sim://diyhid   simulators (no hardware)
   loop://?driver=hapkit                             pyserial's loopback, for tests
@@ -105,7 +106,11 @@ def open_device(url: str):
             raise BadDeviceURL(f"no port in {url} (expected serial:///dev/ttyACM0)")
         if driver_name is None:
             driver_name = _guess_serial_driver(port)
-        dev = drivers[driver_name](SerialTransport(port), url)
+        try:
+            baud = int(q.get("baud", drivers[driver_name].baudrate))
+        except ValueError:
+            raise BadDeviceURL(f"baud must be a whole number in {url}") from None
+        dev = drivers[driver_name](SerialTransport(port, baud), url)
     elif u.scheme == "loop":
         dev = drivers[driver_name or "hapkit"](SerialTransport("loop://"), url)
     elif u.scheme == "hid":

@@ -92,7 +92,10 @@ def test_moving_body_mass_bookkeeping(backend, request):
             covered, uncovered = new & ~old, old & ~new
             rho_after, _, _ = s.macroscopic()
             expected = np.sum(1.0 - rho[covered]) + np.sum(rho_after[uncovered] - 1.0)
-            assert s.total_mass() - before == pytest.approx(expected, abs=1e-12)
+            # gl stores float32: each rewritten node rounds its 9 populations (<= 2e-7 in all)
+            changed = int(covered.sum() + uncovered.sum())
+            tol = 1e-12 if backend == "numpy" else 2e-7 * max(changed, 1)
+            assert s.total_mass() - before == pytest.approx(expected, abs=tol)
             refill_change += s.total_mass() - before
             events += int(covered.sum() + uncovered.sum())
         dev = max(dev, float(np.abs(rho - 1).max()))

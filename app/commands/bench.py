@@ -18,6 +18,8 @@ def add_arguments(parser):
                         help="haptics: the device to run the loop against (default: a simulator)")
     parser.add_argument("--seconds", type=float, default=None, help="how long to measure")
     parser.add_argument("--quick", action="store_true", help="solver: fewer steps (smoke test)")
+    parser.add_argument("--variants", action="store_true",
+                        help="solver: compare the gl backend's tuning variants (docs/performance.md)")
 
 
 def main(args) -> int:

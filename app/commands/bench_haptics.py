@@ -158,7 +158,7 @@ def run(url: str, seconds: float) -> dict:
 
 def _fmt(d, key):
     v = d.get(key) if d else None
-    return "n/a" if v is None else f"{v:.2f}"
+    return "n/a" if v is None else f"{v:.2f} ms"
 
 
 def main(args) -> int:
@@ -171,11 +171,11 @@ def main(args) -> int:
     print(f"haptic loop on {r['device']} ({r['device_name']}), {r['seconds']:.1f} s; {r['machine']}")
     print(f"  rate            {r['rate_hz']:.1f} Hz ({(r['rate_hz'] / 1000 - 1) * 100:+.2f} % of 1 kHz), "
           f"{r['ticks']} ticks, {r['overruns']} overruns, loop thread {r['scheduling']}")
-    print(f"  period jitter   median {_fmt(j, 'median')} ms, p99 {_fmt(j, 'p99')} ms, max {_fmt(j, 'max')} ms")
-    print(f"  pose -> body    first motion {_fmt(pl['first_motion'], 'median')} ms, "
-          f"half step {_fmt(pl['half_step'], 'median')} ms (median)")
-    print(f"  force -> device first response {_fmt(fl['first_response'], 'median')} ms, "
-          f"half step {_fmt(fl['half_step'], 'median')} ms (median)")
+    print(f"  period jitter   median {_fmt(j, 'median')}, p99 {_fmt(j, 'p99')}, max {_fmt(j, 'max')}")
+    print(f"  pose -> body    first motion {_fmt(pl['first_motion'], 'median')}, "
+          f"half step {_fmt(pl['half_step'], 'median')} (median of steps)")
+    print(f"  force -> device first response {_fmt(fl['first_response'], 'median')}, "
+          f"half step {_fmt(fl['half_step'], 'median')} (median of steps)")
     dev_max = r["largest_force_at_device_N"]
     print(f"  largest force   {r['largest_force_commanded_N']:.3f} N commanded"
           + (f", {dev_max:.3f} N at the device" if dev_max is not None else "")

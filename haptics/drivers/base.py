@@ -32,6 +32,7 @@ class Device(ABC):
     #: a long silence as a disconnect); False for devices that report only on change.
     continuous = True
     driver_name = "abstract"
+    baudrate = 115200  # serial drivers: the firmware's speed (native-USB boards ignore it)
 
     def __init__(self, transport, url: str = ""):
         self.transport = transport

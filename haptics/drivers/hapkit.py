@@ -11,6 +11,7 @@ from haptics.types import Capabilities, Pose
 
 class Hapkit(Device):
     driver_name = "hapkit"
+    baudrate = 1_000_000  # the paddle sketch's speed: a FORCE + a STATE frame every ms need it
     continuous = True
 
     def __init__(self, transport, url: str = ""):

@@ -26,6 +26,12 @@ class PtyDevice:
         return b""
 
     def _run(self) -> None:
+        # A real board has its own processor; give the simulated one a real-time slot when
+        # allowed, so it is not descheduled while holding the GIL the force loop needs.
+        try:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(9))
+        except (OSError, AttributeError):
+            pass
         while not self._stop.is_set():
             fd = self._master
             if fd is None:

@@ -1,0 +1,284 @@
+"""`feelflow bench [solver] [--json PATH] [--quick] [--variants]`: solver speed, both backends.
+
+In one process, the same scenes on the numpy and the gl backend (EGL standalone context):
+an empty periodic box and a tunnel with a moving cylinder (moved every 10 steps as the window
+does per frame, the reference force computed every step), at 256x128, 512x256 and 1024x512.
+For each: MLUPS (million lattice-node updates per second), steps per second and, for gl, the
+renderer. It also measures this machine's memory-copy bandwidth (numpy copy, bytes read +
+written per second) and reports each MLUPS as a fraction of the D2Q9 bound, 72 bytes per node
+and step (9 float32 read + 9 written). GPU work is timed up to `glFinish`.
+
+`--variants` instead compares the gl backend's tuning choices on the moving-cylinder tunnel,
+interleaved in the same run, and the llvmpipe thread count in subprocesses
+(docs/performance.md). Figures from a shared machine are indicative.
+"""
+from __future__ import annotations
+
+import json
+import os
+import platform
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+GRIDS = ((256, 128), (512, 256), (1024, 512))
+SCENES = ("box", "tunnel")
+BYTES_PER_NODE_STEP = 72
+MOVE_EVERY = 10
+
+
+def machine() -> dict:
+    cpu = platform.processor() or "?"
+    try:
+        with open("/proc/cpuinfo") as fh:
+            names = [line.split(":", 1)[1].strip() for line in fh if line.startswith("model name")]
+        cpu = names[0] if names else cpu
+    except OSError:
+        pass
+    return {"cpu": cpu, "cores": os.cpu_count(), "system": f"{platform.system()} {platform.release()}",
+            "python": platform.python_version(), "numpy": np.__version__,
+            "LP_NUM_THREADS": os.environ.get("LP_NUM_THREADS", "(default)")}
+
+
+def copy_bandwidth(megabytes: int, repeats: int = 5) -> float:
+    """Bytes read + written per second by numpy.copyto on a large float32 array, best of runs."""
+    n = megabytes * 2**20 // 4
+    src = np.ones(n, dtype=np.float32)
+    dst = np.empty_like(src)
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        np.copyto(dst, src)
+        best = min(best, time.perf_counter() - t0)
+    return 2 * src.nbytes / best
+
+
+def scene_config(scene: str, nx: int, ny: int):
+    from solver.config import FlowConfig
+
+    if scene == "box":
+        return FlowConfig(nx=nx, ny=ny, nu=0.02, collision="trt", dtype="float32", x_boundary="periodic",
+                          y_boundary="periodic", initial_velocity=(0.03, 0.01))
+    return FlowConfig(nx=nx, ny=ny, nu=0.02, collision="trt", dtype="float32", x_boundary="tunnel",
+                      y_boundary="no_slip", inflow_speed=0.05, inflow_ramp_steps=200, sponge_cells=nx // 16)
+
+
+class SceneRun:
+    """One scene on one solver: `advance(n)` runs n steps the way the window drives them."""
+
+    def __init__(self, scene, solver):
+        from shapes import Cylinder
+
+        self.scene, self.solver = scene, solver
+        cfg = solver.config
+        self.k = 0
+        if scene == "tunnel":
+            self.d = cfg.ny / 8
+            self.x, self.y0 = cfg.nx / 4, cfg.ny / 2
+            self.cylinder = Cylinder
+            solver.enable_force_models(["momentum_exchange"])
+            self._move()
+
+    def _move(self):
+        cfg = self.solver.config
+        amp, period = cfg.ny / 8, 2000
+        phase = 2 * np.pi * self.k / period
+        y = self.y0 + amp * np.sin(phase)
+        vy = amp * 2 * np.pi / period * np.cos(phase)
+        self.solver.set_body(self.cylinder(self.d, x=self.x, y=y), velocity=(0.0, vy))
+
+    def advance(self, n: int):
+        done = 0
+        while done < n:
+            chunk = min(MOVE_EVERY, n - done)
+            self.solver.step(chunk)
+            self.k += chunk
+            done += chunk
+            if self.scene == "tunnel":
+                self._move()
+        finish = getattr(self.solver, "finish", None)
+        if finish is not None:
+            finish()
+
+
+def measure(run: SceneRun, seconds: float, warmup: int = 20) -> dict:
+    """Steps until `seconds` of wall time; MLUPS per wall second and per CPU second (all
+    threads of this process: llvmpipe's too), the latter steadier on a shared machine."""
+    run.advance(warmup)  # shader compile, first draw, caches
+    cfg = run.solver.config
+    steps, elapsed, cpu, chunk = 0, 0.0, 0.0, MOVE_EVERY
+    while elapsed < seconds:
+        t0, c0 = time.perf_counter(), time.process_time()
+        run.advance(chunk)
+        elapsed += time.perf_counter() - t0
+        cpu += time.process_time() - c0
+        steps += chunk
+        chunk = min(chunk * 2, 400)
+    nodes = cfg.nx * cfg.ny * steps / 1e6
+    return {"steps": steps, "seconds": round(elapsed, 4), "mlups": round(nodes / elapsed, 2),
+            "steps_per_s": round(steps / elapsed, 1), "mlups_per_cpu_s": round(nodes / max(cpu, 1e-9), 2)}
+
+
+def _gl_context():
+    import moderngl
+
+    try:
+        return moderngl.create_context(standalone=True, backend="egl", require=330), None
+    except Exception as exc:  # report it, keep the numpy figures
+        return None, f"no EGL OpenGL 3.3 context: {exc}"
+
+
+def run_bench(quick: bool, seconds: float | None):
+    from solver.backend import create_solver
+
+    seconds = seconds if seconds is not None else (0.3 if quick else 2.0)
+    bandwidth = copy_bandwidth(64 if quick else 512)
+    bound = bandwidth / BYTES_PER_NODE_STEP / 1e6
+    ctx, gl_error = _gl_context()
+    renderer = ctx.info.get("GL_RENDERER") if ctx else None
+    rows = []
+    for scene in SCENES:
+        for nx, ny in GRIDS:
+            for backend in ("numpy", "gl"):
+                row = {"scene": scene, "backend": backend, "grid": f"{nx}x{ny}", "nx": nx, "ny": ny}
+                if backend == "gl" and ctx is None:
+                    row["error"] = gl_error
+                    rows.append(row)
+                    continue
+                cfg = scene_config(scene, nx, ny)
+                solver = create_solver(backend, cfg, **({"ctx": ctx} if backend == "gl" else {}))
+                row.update(measure(SceneRun(scene, solver), seconds))
+                row["fraction_of_bound"] = round(row["mlups"] / bound, 4)
+                if backend == "gl":
+                    row["renderer"] = renderer
+                solver.close()
+                rows.append(row)
+                print(_format_row(row), flush=True)
+    return {"machine": machine(), "renderer": renderer, "copy_bandwidth_gb_s": round(bandwidth / 1e9, 2),
+            "d2q9_bound_mlups": round(bound, 1), "bytes_per_node_step": BYTES_PER_NODE_STEP,
+            "seconds_per_case": seconds, "results": rows, "speedups": _speedups(rows)}
+
+
+def _speedups(rows):
+    out = {}
+    for r in rows:
+        if r["backend"] == "gl" and "mlups" in r:
+            ref = next((x for x in rows if x["backend"] == "numpy" and x["scene"] == r["scene"]
+                        and x["grid"] == r["grid"] and "mlups" in x), None)
+            if ref:
+                out[f"{r['scene']} {r['grid']}"] = round(r["mlups"] / ref["mlups"], 2)
+    return out
+
+
+def _format_row(r) -> str:
+    if "error" in r:
+        return f"{r['scene']:7s} {r['grid']:>9s} {r['backend']:6s} unavailable: {r['error']}"
+    return (f"{r['scene']:7s} {r['grid']:>9s} {r['backend']:6s} {r['mlups']:8.1f} MLUPS "
+            f"{r['steps_per_s']:9.1f} steps/s  {100 * r['fraction_of_bound']:5.1f} % of bound")
+
+
+# --- tuning variants (docs/performance.md) ---------------------------------------------------
+VARIANTS = {
+    "one program, texelFetch (no regions)": {"split": False, "fetch_normalized": False},
+    "regions, texelFetch": {"split": True, "fetch_normalized": False},
+    "regions, texture() + REPEAT (default)": {},
+}
+#: step variants (body, edges, sponge) whose cost per node the variants run measures
+REGION_VARIANTS = {"interior (fast path)": (0, 0, 0), "interior + sponge rates": (0, 0, 1),
+                   "edges: walls, inlet, outlet": (0, 1, 1), "body window": (1, 0, 1),
+                   "everything (body + edges)": (1, 1, 1)}
+
+
+def _stats(values):
+    return {"best": max(values), "median": float(np.median(values)), "samples": values}
+
+
+def run_variants(quick: bool, seconds: float | None):
+    """Interleaved rounds of every tuning variant on the moving-cylinder tunnel (MLUPS per wall
+    and per CPU second), the cost per node of each step variant, the force readback's cost,
+    and the llvmpipe thread count (subprocesses)."""
+    from shapes import Cylinder
+    from solver.gl_backend import GLSolver
+
+    seconds = seconds if seconds is not None else (0.3 if quick else 1.0)
+    rounds = 2 if quick else 5
+    nx, ny = 512, 256
+    ctx, err = _gl_context()
+    if ctx is None:
+        raise SystemExit(f"feelflow: {err}")
+    runs = {}
+    for name, tuning in VARIANTS.items():
+        runs[name] = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx, tuning=tuning))
+    no_force = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx))
+    no_force.solver.enable_force_models([])
+    runs["default, no force model (no window readback)"] = no_force
+    runs["empty periodic box (default)"] = SceneRun("box", GLSolver(scene_config("box", nx, ny), ctx=ctx))
+    wall = {name: [] for name in runs}
+    per_cpu = {name: [] for name in runs}
+    for run in runs.values():
+        run.advance(20)
+    for _ in range(rounds):
+        for name, run in runs.items():
+            m = measure(run, seconds, warmup=0)
+            wall[name].append(m["mlups"])
+            per_cpu[name].append(m["mlups_per_cpu_s"])
+    probe = GLSolver(scene_config("tunnel", nx, ny), ctx=ctx)
+    probe.set_body(Cylinder(ny / 8, x=nx / 4, y=ny / 2))
+    draws = 20 if quick else 60
+    cost = {name: [] for name in REGION_VARIANTS}
+    for key in REGION_VARIANTS.values():
+        probe.time_variant(key, 3)  # compile
+    for _ in range(rounds):
+        for name, key in REGION_VARIANTS.items():
+            cost[name].append(nx * ny * draws / probe.time_variant(key, draws) / 1e6)
+    result = {"grid": f"{nx}x{ny}", "renderer": ctx.info.get("GL_RENDERER"), "machine": machine(),
+              "variants": {n: {"wall": _stats(wall[n]), "per_cpu_s": _stats(per_cpu[n])} for n in runs},
+              "step_variants_full_grid_mlups": {n: _stats(v) for n, v in cost.items()}}
+    threads = {}
+    for lp in ("1", "2", "4"):
+        env = {**os.environ, "LP_NUM_THREADS": lp}
+        code = ("import json; from app.commands.bench_solver import _gl_context, SceneRun, scene_config, measure; "
+                "from solver.gl_backend import GLSolver; ctx, _ = _gl_context(); "
+                f"r = SceneRun('tunnel', GLSolver(scene_config('tunnel', {nx}, {ny}), ctx=ctx)); "
+                f"print(json.dumps(measure(r, {seconds * rounds})))")
+        out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+        threads[lp] = json.loads(out.stdout.strip().splitlines()[-1])["mlups"] if out.returncode == 0 else None
+    result["lp_num_threads_wall_mlups"] = threads
+    return result
+
+
+def main(args) -> int:
+    quick = bool(getattr(args, "quick", False))
+    seconds = getattr(args, "seconds", None)
+    if getattr(args, "variants", False):
+        result = run_variants(quick, seconds)
+        print(f"gl tuning variants, moving-cylinder tunnel {result['grid']}, {result['renderer']}")
+        print(f"  {'variant':48s} {'MLUPS (wall) best/median':>26s} {'per CPU-s best/median':>24s}")
+        for name, v in result["variants"].items():
+            w, c = v["wall"], v["per_cpu_s"]
+            print(f"  {name:48s} {w['best']:12.1f} {w['median']:9.1f} {c['best']:14.1f} {c['median']:9.1f}")
+        print("  step variant drawn over the whole grid (MLUPS, best/median):")
+        for name, v in result["step_variants_full_grid_mlups"].items():
+            print(f"    {name:46s} {v['best']:12.1f} {v['median']:9.1f}")
+        for lp, mlups in result["lp_num_threads_wall_mlups"].items():
+            print(f"  LP_NUM_THREADS={lp:2s} (moving tunnel, wall MLUPS) {mlups if mlups is not None else 'failed'}")
+    else:
+        m = machine()
+        print(f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}, Python {m['python']}, "
+              f"numpy {m['numpy']}, LP_NUM_THREADS {m['LP_NUM_THREADS']}")
+        result = run_bench(quick, seconds)
+        print(f"renderer: {result['renderer']}")
+        print(f"memory copy bandwidth: {result['copy_bandwidth_gb_s']} GB/s (read + write) -> D2Q9 bound "
+              f"{result['d2q9_bound_mlups']} MLUPS at {BYTES_PER_NODE_STEP} bytes per node and step")
+        for key, ratio in result["speedups"].items():
+            print(f"gl / numpy, {key}: {ratio}x")
+    if getattr(args, "json", None):
+        from pathlib import Path
+
+        path = Path(args.json)
+        tmp = path.with_name(path.name + ".tmp")
+        tmp.write_text(json.dumps(result, indent=2))
+        os.replace(tmp, path)
+    return 0

@@ -1,0 +1,239 @@
+"""The live force plot (pyqtgraph): drag and lift against time for the force model in use (or
+all models), C_D / C_L readouts, and "drag against relative speed" on log-log axes with the
+fitted exponent (the U^2 lesson: shared/reference/benchmarks.md, 'Low-Re drag').
+"""
+from __future__ import annotations
+
+import csv
+import io
+import math
+
+import numpy as np
+import pyqtgraph as pg
+import pyqtgraph.exporters
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import (QCheckBox, QComboBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget)
+
+from app.files import atomic_path, write_text_atomic
+from app.simulation import FORCE_MODELS, drag_direction
+
+MODEL_COLOURS = {"momentum_exchange": ((220, 40, 40), (40, 110, 240)),
+                 "macroscopic": ((230, 140, 20), (20, 170, 190)),
+                 "pressure": ((150, 60, 190), (40, 160, 60))}
+
+
+def fit_power_law(speed, drag, bins: int = 12):
+    """Bin |drag| by relative speed (log bins), fit log F = n log U + c. Returns
+    (bin speeds, bin drags, exponent n or None when the speeds do not span a factor 1.5)."""
+    speed, drag = np.asarray(speed, float), np.asarray(drag, float)
+    ok = np.isfinite(speed) & np.isfinite(drag) & (speed > 1e-4) & (drag > 0)
+    speed, drag = speed[ok], drag[ok]
+    if len(speed) < 3:
+        return np.array([]), np.array([]), None
+    edges = np.geomspace(speed.min(), speed.max() * 1.0001, bins + 1)
+    idx = np.digitize(speed, edges) - 1
+    us, fs = [], []
+    for k in range(bins):
+        sel = idx == k
+        if sel.sum() >= 3:
+            us.append(speed[sel].mean())
+            fs.append(drag[sel].mean())
+    us, fs = np.array(us), np.array(fs)
+    if len(us) < 3 or us.max() / us.min() < 1.5:
+        return us, fs, None
+    n, _ = np.polyfit(np.log(us), np.log(fs), 1)
+    return us, fs, float(n)
+
+
+class ForcePlot(QWidget):
+    """Shows `sim.history`; `refresh()` redraws (the window calls it a few times a second)."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.sim = None
+        self.paused = False
+        self._frozen = None
+        self.view = QComboBox()
+        self.view.addItem("Drag and lift against time", "time")
+        self.view.addItem("Drag against relative speed (log-log)", "speed")
+        self.pause_box = QCheckBox("Pause plot")
+        self.clear_button = QPushButton("Clear")
+        self.csv_button = QPushButton("Export CSV\u2026")
+        self.png_button = QPushButton("Export PNG\u2026")
+        self.readout = QLabel("C<sub>D</sub> = \u2013   C<sub>L</sub> = \u2013")
+        self.readout.setTextFormat(Qt.RichText)
+        font = self.readout.font()
+        font.setPointSizeF(font.pointSizeF() * 1.35)
+        font.setBold(True)
+        self.readout.setFont(font)
+        bar = QHBoxLayout()
+        for w in (self.view, self.pause_box, self.clear_button, self.csv_button, self.png_button):
+            bar.addWidget(w)
+        bar.addStretch(1)
+        bar.addWidget(self.readout)
+
+        pg.setConfigOptions(antialias=True, background="w", foreground="k")
+        self.plot = pg.PlotWidget()
+        self.plot.showGrid(x=True, y=True, alpha=0.3)
+        self.legend = self.plot.addLegend(offset=(10, 5))
+        self.plot.getAxis("bottom").setLabel("time (solver steps)")
+        self.plot.getAxis("left").setLabel("force (lattice units)")
+        for ax in ("bottom", "left"):
+            self.plot.getAxis(ax).enableAutoSIPrefix(False)
+            f = self.plot.getAxis(ax).label.font()
+            f.setPointSize(11)
+            self.plot.getAxis(ax).label.setFont(f)
+        self.curves = {}
+        self.scatter = pg.ScatterPlotItem(size=9, brush=pg.mkBrush(220, 40, 40), pen=pg.mkPen("k"))
+        self.fit_line = pg.PlotCurveItem(pen=pg.mkPen((40, 40, 40), width=2, style=Qt.DashLine))
+        self.fit_text = pg.TextItem(anchor=(0, 0), color="k")
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(4, 4, 4, 4)
+        layout.addLayout(bar)
+        layout.addWidget(self.plot, 1)
+        self.view.currentIndexChanged.connect(self._switch_view)
+        self.pause_box.toggled.connect(self._pause)
+        self.clear_button.clicked.connect(self.clear)
+
+    # --- state -----------------------------------------------------------------------------
+    def _pause(self, on):
+        self.paused = on
+        if not on:
+            self.refresh()
+
+    def clear(self):
+        if self.sim is not None:
+            self.sim.history.clear()
+        self.refresh(force=True)
+
+    def _switch_view(self):
+        self.plot.clear()
+        self.curves.clear()
+        self.legend = self.plot.addLegend(offset=(10, 5))
+        speed_view = self.view.currentData() == "speed"
+        self.plot.setLogMode(speed_view, speed_view)
+        if speed_view:
+            self.plot.addItem(self.scatter)
+            self.plot.addItem(self.fit_line)
+            self.plot.addItem(self.fit_text)
+            self.plot.getAxis("bottom").setLabel("relative speed |U - V| (lattice units)")
+            self.plot.getAxis("left").setLabel("drag (lattice units)")
+        else:
+            self.plot.getAxis("bottom").setLabel("time (solver steps)")
+            self.plot.getAxis("left").setLabel("force (lattice units)")
+        self.refresh(force=True)
+
+    def models_shown(self):
+        sim = self.sim
+        return list(FORCE_MODELS) if sim.params.compare_all else [sim.params.force_model]
+
+    # --- drawing ---------------------------------------------------------------------------
+    def refresh(self, force: bool = False):
+        if self.sim is None or (self.paused and not force):
+            return
+        self._update_readout()
+        if self.view.currentData() == "speed":
+            self._draw_speed_view()
+        else:
+            self._draw_time_view()
+
+    def coefficients(self, model=None, last: int = 30):
+        """(C_D, C_L) of the last `last` samples: F / (1/2 rho0 U_rel^2 A), A = frontal width."""
+        sim = self.sim
+        model = model or sim.params.force_model
+        t, drag, lift = sim.history.drag_lift(model)
+        if len(t) == 0:
+            return math.nan, math.nan
+        w = np.asarray(sim.history.wind[-last:], float)
+        u = float(np.hypot(w[:, 0], w[:, 1]).mean())
+        if u < 0.005:
+            return math.nan, math.nan
+        area = sim.shape.frontal_area(tuple(drag_direction(w[-1])[0]))
+        q = 0.5 * u * u * area
+        d, l_ = drag[-last:], lift[-last:]
+        if not np.isfinite(d).any():
+            return math.nan, math.nan
+        return float(np.nanmean(d) / q), float(np.nanmean(l_) / q)
+
+    def _update_readout(self):
+        cd, cl = self.coefficients()
+
+        def fmt(v):
+            return "\u2013" if not math.isfinite(v) else f"{v:.2f}"
+        self.readout.setText(f"C<sub>D</sub> = {fmt(cd)} &nbsp; C<sub>L</sub> = {fmt(cl)}")
+
+    def _curve(self, key, pen, name):
+        if key not in self.curves:
+            self.curves[key] = self.plot.plot([], [], pen=pen, name=name)
+        return self.curves[key]
+
+    def _draw_time_view(self):
+        sim = self.sim
+        shown = self.models_shown()
+        for key in list(self.curves):
+            if key[0] not in shown:
+                self.plot.removeItem(self.curves.pop(key))
+                self.legend.removeItem(self._name(key))
+        for model in shown:
+            t, drag, lift = sim.history.drag_lift(model)
+            cd, cl = MODEL_COLOURS.get(model, ((0, 0, 0), (90, 90, 90)))
+            self._curve((model, "drag"), pg.mkPen(cd, width=2.5), self._name((model, "drag"))).setData(t, drag, connect="finite")
+            self._curve((model, "lift"), pg.mkPen(cl, width=2.5, style=Qt.DashLine if len(shown) > 1 else Qt.SolidLine),
+                        self._name((model, "lift"))).setData(t, lift, connect="finite")
+
+    def _name(self, key):
+        model, what = key
+        return f"{what}" if not self.sim.params.compare_all else f"{what}, {FORCE_MODELS[model].split(' (')[0].lower()}"
+
+    def speed_drag(self):
+        sim = self.sim
+        _, drag, _ = sim.history.drag_lift(sim.params.force_model)
+        w = np.asarray(sim.history.wind, float).reshape(-1, 2)
+        return np.hypot(w[:, 0], w[:, 1]), drag
+
+    def _draw_speed_view(self):
+        us, fs, n = fit_power_law(*self.speed_drag())
+        self.scatter.setData(us, fs)
+        if n is not None:
+            c = np.mean(np.log(fs) - n * np.log(us))
+            xs = np.geomspace(us.min(), us.max(), 20)
+            self.fit_line.setData(xs, np.exp(c) * xs ** n)
+            self.fit_text.setText(f"drag \u221d U^{n:.2f}")
+            self.fit_text.setPos(math.log10(us.min()), math.log10(fs.max()))
+        else:
+            self.fit_line.setData([], [])
+            self.fit_text.setText("move the body at several speeds\n(or run the preset 'drag grows with speed')")
+            if len(us):
+                self.fit_text.setPos(math.log10(us.min()), math.log10(fs.max()))
+        self.fitted_exponent = n
+
+    # --- export ---------------------------------------------------------------------------
+    def csv_text(self) -> str:
+        sim = self.sim
+        h = sim.history
+        models = [m for m in FORCE_MODELS if m in h.forces]
+        out = io.StringIO()
+        w = csv.writer(out)
+        w.writerow(["step", "body_vx", "body_vy", "wind_x", "wind_y"]
+                   + [f"{m}_{q}" for m in models for q in ("fx", "fy", "drag", "lift")])
+        cols = []
+        for m in models:
+            _, drag, lift = h.drag_lift(m)
+            f = np.full((len(h), 2), np.nan)
+            s = np.asarray(h.forces[m], float)
+            f[len(h) - len(s):] = s
+            cols.append(np.c_[f, drag, lift])
+        for i in range(len(h)):
+            row = [h.time[i], *h.body_velocity[i], *h.wind[i]]
+            for c in cols:
+                row += [f"{v:.8g}" for v in c[i]]
+            w.writerow(row)
+        return out.getvalue()
+
+    def export_csv(self, path):
+        write_text_atomic(path, self.csv_text())
+
+    def export_png(self, path):
+        exporter = pyqtgraph.exporters.ImageExporter(self.plot.plotItem)
+        with atomic_path(path, suffix=".png") as tmp:
+            exporter.export(str(tmp))

@@ -1,0 +1,606 @@
+"""The FeelFlow window: the wind-tunnel viewport in the middle, the side panel, the live force
+plot below, presets, status bar, keyboard shortcuts, remembered settings, and the frame loop
+with adaptive stepping (as many solver steps per frame as keep the window at >= 30 fps).
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from PySide6.QtCore import QPoint, QSettings, Qt, QTimer, Signal
+from PySide6.QtGui import QAction, QKeySequence, QPainter, QUndoStack
+from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox
+
+from app.qt_runtime import make_none_immortal
+
+make_none_immortal()  # before any Qt object: see app/qt_runtime.py
+
+from app.force_plot import ForcePlot  # noqa: E402
+from app.presets import PRESETS
+from app.shape_editor import DEFAULT_POLYGON, SetPolygon
+from app.side_panel import SidePanel
+from app.simulation import FORCE_MODELS, Params, Simulation
+from app.viewport import DISPLAY_MODES, Viewport
+from shapes.base import ShapeError
+from solver.backend import SolverDiverged  # noqa: E402
+from solver.config import ConfigError
+
+TARGET_FRAME_S = 1.0 / 34      # aim a little above 30 fps
+MAX_STEPS_PER_FRAME = 200
+MIN_STEPS_PER_FRAME = 2   # the flow keeps moving even where drawing alone takes 1/30 s
+N_TRACERS = 1500
+
+
+class MainWindow(QMainWindow):
+    simulationReady = Signal()
+
+    def __init__(self, backend: str = "gl", settings: QSettings | None = None, params: Params | None = None):
+        super().__init__()
+        self.setWindowTitle("FeelFlow \u2013 a wind tunnel you can touch")
+        self.backend = backend
+        self.settings = settings or QSettings("FeelFlow", "FeelFlow")
+        self.sim: Simulation | None = None
+        self.paused = False
+        self.steps_per_frame = 4
+        self._step_cost = 2e-3       # seconds per solver step (running estimate)
+        self._other_cost = 5e-3      # seconds per frame outside stepping
+        self._last_tick = None
+        self._rate_window = [time.perf_counter(), 0, 0]   # start, steps, frames
+        self.rates = {"steps_per_s": 0.0, "fps": 0.0, "mlups": 0.0}
+        self.tracer_rng = np.random.default_rng(1)
+        self.undo = QUndoStack(self)
+        self.input_device = None
+
+        self.viewport = Viewport()
+        self.setCentralWidget(self.viewport)
+        self.panel = SidePanel()
+        self.plot = ForcePlot()
+        dock = QDockWidget("Controls", self)
+        dock.setWidget(self.panel)
+        dock.setFeatures(QDockWidget.DockWidgetMovable)
+        self.addDockWidget(Qt.RightDockWidgetArea, dock)
+        pdock = QDockWidget("Forces", self)
+        pdock.setWidget(self.plot)
+        pdock.setFeatures(QDockWidget.DockWidgetMovable)
+        self.addDockWidget(Qt.BottomDockWidgetArea, pdock)
+        self.resizeDocks([pdock], [260], Qt.Vertical)
+
+        self.status = {k: QLabel() for k in ("steps", "mlups", "fps", "re", "ma", "renderer")}
+        for label in self.status.values():
+            self.statusBar().addPermanentWidget(label)
+        self._build_menus()
+
+        self.params = params or self._params_from_settings()
+        self.display_mode = self.settings.value("display_mode", "speed")
+        if self.display_mode not in DISPLAY_MODES:
+            self.display_mode = "speed"
+        self.panel.show_params(self.params, self.display_mode)
+        self._connect_panel()
+        self.viewport.contextReady.connect(self._on_context)
+        self.viewport.polygonEdited.connect(self.edit_polygon)
+        geometry = self.settings.value("geometry")
+        if geometry is not None:
+            self.restoreGeometry(geometry)
+        else:
+            self.resize(1280, 820)
+        self.timer = QTimer(self)
+        self.timer.setInterval(0)
+        self.timer.timeout.connect(self.tick)
+        self.slow_timer = QTimer(self)
+        self.slow_timer.setInterval(500)
+        self.slow_timer.timeout.connect(self.refresh_readouts)
+
+    # --- settings ---------------------------------------------------------------------------
+    def _params_from_settings(self) -> Params:
+        d = Params()
+        s = self.settings
+
+        def get(key, default, kind):
+            try:
+                return kind(s.value(key, default))
+            except (TypeError, ValueError):
+                return default
+        grid = str(s.value("grid", f"{d.grid[0]}x{d.grid[1]}"))
+        try:
+            grid = tuple(int(v) for v in grid.split("x"))
+        except ValueError:
+            grid = d.grid
+        return Params(grid=grid if len(grid) == 2 else d.grid, shape=get("shape", d.shape, str),
+                      size=get("size", d.size, float), angle_deg=get("angle_deg", d.angle_deg, float),
+                      wind=get("wind", d.wind, float), nu=get("nu", d.nu, float), wall=get("wall", d.wall, str),
+                      force_model=get("force_model", d.force_model, str),
+                      compare_all=str(s.value("compare_all", "false")).lower() == "true")
+
+    def save_settings(self):
+        s, p = self.settings, self.params_now()
+        s.setValue("grid", f"{p.grid[0]}x{p.grid[1]}")
+        for key in ("shape", "size", "angle_deg", "wind", "nu", "wall", "force_model"):
+            s.setValue(key, getattr(p, key))
+        s.setValue("compare_all", "true" if p.compare_all else "false")
+        s.setValue("display_mode", self.display_mode)
+        s.setValue("geometry", self.saveGeometry())
+        s.sync()
+
+    def params_now(self) -> Params:
+        return self.sim.params if self.sim is not None else self.params
+
+    def closeEvent(self, ev):
+        self.save_settings()
+        self.timer.stop()
+        self.slow_timer.stop()
+        if self.input_device is not None:
+            self._close_device()
+        super().closeEvent(ev)
+
+    # --- start ------------------------------------------------------------------------------
+    def _on_context(self, ctx):
+        try:
+            self.sim = Simulation(self.params, backend=self.backend, ctx=ctx)
+        except (ConfigError, ShapeError) as exc:   # remembered settings that no longer work
+            self.statusBar().showMessage(f"Remembered settings ignored ({exc}); using the defaults.", 8000)
+            self.sim = Simulation(Params(), backend=self.backend, ctx=ctx)
+        if self.sim.params.shape == "polygon" and self.sim.polygon is None:
+            self._install_default_polygon()
+        self.viewport.sim = self.sim
+        self.plot.sim = self.sim
+        self.viewport.mode = self.display_mode
+        self.panel.show_params(self.sim.params, self.display_mode)
+        self.status["renderer"].setText(f"{self.viewport.renderer()} ({self.backend} solver)")
+        self._upload_field()
+        self.timer.start()
+        self.slow_timer.start()
+        self.refresh_readouts()
+        self.simulationReady.emit()
+
+    # --- menus and keys ---------------------------------------------------------------------
+    def _action(self, menu, text, slot, shortcut=None, checkable=False):
+        act = QAction(text, self)
+        if shortcut:
+            act.setShortcut(QKeySequence(shortcut))
+            act.setShortcutContext(Qt.ApplicationShortcut)
+        act.setCheckable(checkable)
+        act.triggered.connect(slot)
+        menu.addAction(act)
+        return act
+
+    def _build_menus(self):
+        bar = self.menuBar()
+        f = bar.addMenu("&File")
+        self._action(f, "Load shape\u2026", self.load_shape_dialog)
+        self._action(f, "Save shape\u2026", self.save_shape_dialog)
+        f.addSeparator()
+        self._action(f, "Export forces as CSV\u2026", self.export_csv_dialog)
+        self._action(f, "Export plot as PNG\u2026", self.export_png_dialog)
+        self._action(f, "Save screenshot\u2026", self.screenshot_dialog)
+        f.addSeparator()
+        self._action(f, "Quit", self.close, "Ctrl+Q")
+        e = bar.addMenu("&Edit")
+        undo = self.undo.createUndoAction(self, "Undo")
+        undo.setShortcut(QKeySequence("Ctrl+Z"))
+        redo = self.undo.createRedoAction(self, "Redo")
+        redo.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])
+        e.addAction(undo)
+        e.addAction(redo)
+        r = bar.addMenu("&Run")
+        self.pause_action = self._action(r, "Pause / run", self.toggle_pause, "Space", checkable=True)
+        self._action(r, "Reset flow", self.reset_flow, "R")
+        v = bar.addMenu("&View")
+        self._action(v, "Full screen", self.toggle_fullscreen, "F11")
+        v.addSeparator()
+        for key, mode in DISPLAY_MODES.items():
+            self._action(v, mode.label, lambda _=False, k=key: self.set_display_mode(k))
+        p = bar.addMenu("&Presets")
+        for key, preset in PRESETS.items():
+            self._action(p, preset.title, lambda _=False, k=key: self.apply_preset(k))
+
+    def toggle_pause(self, _=None):
+        self.set_paused(not self.paused)
+
+    def set_paused(self, paused: bool):
+        self.paused = paused
+        self.pause_action.setChecked(paused)
+        self.statusBar().showMessage("Paused (space to run)" if paused else "Running", 2000)
+
+    def toggle_fullscreen(self):
+        self.showNormal() if self.isFullScreen() else self.showFullScreen()
+
+    def reset_flow(self):
+        if self.sim is None:
+            return
+        self._make_current()
+        self.sim.reset_flow()
+        self.viewport.tracers = None
+        self._upload_field()
+        self.refresh_readouts()
+
+    # --- panel ------------------------------------------------------------------------------
+    def _connect_panel(self):
+        p = self.panel
+        p.shapeChanged.connect(self.set_shape_kind)
+        p.sizeChanged.connect(lambda v: self._apply_shape(size=v))
+        p.angleChanged.connect(lambda v: self._apply_shape(angle_deg=v))
+        p.holdStillToggled.connect(self.set_hold_still)
+        p.editToggled.connect(self.set_editing)
+        p.save_shape.clicked.connect(self.save_shape_dialog)
+        p.load_shape.clicked.connect(self.load_shape_dialog)
+        p.windChanged.connect(lambda v: self._apply_flow(wind=v))
+        p.viscosityChanged.connect(lambda v: self._apply_flow(nu=v))
+        p.wallChanged.connect(lambda v: self._apply_flow(wall=v))
+        p.gridChanged.connect(self.set_grid)
+        p.forceModelChanged.connect(lambda m: self._with_sim(lambda s: s.set_force_models(selected=m)))
+        p.compareAllToggled.connect(lambda on: self._with_sim(lambda s: s.set_force_models(compare_all=on)))
+        p.displayModeChanged.connect(self.set_display_mode)
+        p.arrowsToggled.connect(lambda on: setattr(self.viewport, "show_arrows", on))
+        p.inputChanged.connect(self.set_input)
+
+    def _with_sim(self, fn):
+        if self.sim is not None:
+            self._make_current()
+            fn(self.sim)
+            self.refresh_readouts()
+            self.plot.refresh(force=True)
+
+    def _refuse(self, title, exc):
+        QMessageBox.warning(self, title, str(exc))
+        self.panel.show_params(self.sim.params, self.display_mode)
+
+    def _apply_shape(self, **changes):
+        if self.sim is None:
+            return False
+        self._make_current()
+        try:
+            self.sim.set_shape(**changes)
+        except (ShapeError, ConfigError, ValueError) as exc:
+            self._refuse("This shape cannot be used", exc)
+            return False
+        self.panel.show_params(self.sim.params, self.display_mode)
+        self.viewport.update()
+        return True
+
+    def set_shape_kind(self, kind):
+        if self.sim is None:
+            return
+        if kind == "polygon" and self.sim.polygon is None:
+            self._install_default_polygon()
+            return
+        self._apply_shape(kind=kind)
+        if kind != "polygon":
+            self.set_editing(False)
+
+    def _install_default_polygon(self):
+        size = self.sim.params.size
+        verts = [(x * size, y * size) for x, y in DEFAULT_POLYGON]
+        self._make_current()
+        try:
+            self.sim.set_shape(kind="polygon", polygon=verts)
+        except (ShapeError, ValueError) as exc:
+            self._refuse("This shape cannot be used", exc)
+        self.panel.show_params(self.sim.params, self.display_mode)
+
+    def _apply_flow(self, **changes):
+        if self.sim is None:
+            return
+        self._make_current()
+        try:
+            self.sim.set_flow(**changes)
+        except ConfigError as exc:
+            self._refuse("This flow setting cannot be used", exc)
+            return
+        self._after_rebuild()
+
+    def set_grid(self, grid):
+        if self.sim is None:
+            return
+        self._make_current()
+        try:
+            self.sim.set_grid(grid)
+        except (ConfigError, ShapeError) as exc:
+            self._refuse("This grid cannot be used", exc)
+            return
+        self.viewport.tracers = None
+        self._after_rebuild()
+
+    def _after_rebuild(self):
+        self._upload_field()
+        self.refresh_readouts()
+        self.viewport.update()
+
+    def set_hold_still(self, on):
+        if self.sim is not None:
+            self.sim.hold_still = bool(on)
+        self.panel.hold_still.setChecked(bool(on))
+
+    def set_display_mode(self, mode):
+        self.display_mode = mode
+        self.viewport.mode = mode
+        if mode != "tracers":
+            self.viewport.tracers = None
+        self.panel.show_params(self.params_now(), mode)
+        self.viewport.update()
+
+    # --- polygon editor ---------------------------------------------------------------------
+    def set_editing(self, on):
+        self.viewport.editing = bool(on) and self.sim is not None and self.sim.params.shape == "polygon"
+        self.panel.edit.setChecked(self.viewport.editing)
+        if self.viewport.editing:
+            self.set_hold_still(True)
+        self.viewport.update()
+
+    def check_polygon(self, verts):
+        """Build and validate the polygon without installing it; raises ShapeError."""
+        sim = self.sim
+        shape = sim.make_shape(sim.params.__class__(**{**sim.params.__dict__, "shape": "polygon"}), verts,
+                               *sim.pos, sim.angle)
+        return shape.validate(sim.config.nx, sim.config.ny)
+
+    def edit_polygon(self, verts, text="edit polygon"):
+        """Push an undoable polygon edit, or refuse it with a dialog (the previous shape stays)."""
+        try:
+            self.check_polygon(verts)
+        except (ShapeError, ValueError) as exc:
+            QMessageBox.warning(self, "This polygon cannot be used", f"{exc}\nThe previous shape is kept.")
+            self.viewport.update()
+            return False
+        self.undo.push(SetPolygon(self._install_polygon, self.sim.polygon, verts, text))
+        return True
+
+    def _install_polygon(self, verts):
+        self._make_current()
+        self.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in verts])
+        self.panel.show_params(self.sim.params, self.display_mode)
+        self.viewport.update()
+
+    # --- files --------------------------------------------------------------------------------
+    def save_shape_dialog(self):
+        path, _ = QFileDialog.getSaveFileName(self, "Save shape", "shape.json", "Shapes (*.json)")
+        if path:
+            self.save_shape(path)
+
+    def save_shape(self, path):
+        from shapes import io as shape_io
+
+        try:
+            shape_io.save_shape(path, self.sim.shape)
+        except (OSError, ShapeError, ValueError) as exc:
+            QMessageBox.warning(self, "Could not save the shape", str(exc))
+
+    def load_shape_dialog(self):
+        path, _ = QFileDialog.getOpenFileName(self, "Load shape", "", "Shapes (*.json)")
+        if path:
+            self.load_shape(path)
+
+    def load_shape(self, path):
+        from shapes import io as shape_io
+
+        try:
+            shape = shape_io.load_shape(path)
+        except (OSError, ShapeError, ValueError) as exc:
+            QMessageBox.warning(self, "Could not load the shape", f"{exc}\nThe previous shape is kept.")
+            return False
+        return self.install_loaded_shape(shape)
+
+    def install_loaded_shape(self, shape):
+        from app.bodies import params_for_shape
+
+        kind, size, verts = params_for_shape(shape)
+        if kind == "polygon":
+            if self.sim.params.shape != "polygon":
+                self._make_current()
+                self.sim.params = self.sim.params.__class__(**{**self.sim.params.__dict__, "shape": "polygon"})
+            return self.edit_polygon(verts, "load shape")
+        return self._apply_shape(kind=kind, size=size)
+
+    def export_csv_dialog(self):
+        path, _ = QFileDialog.getSaveFileName(self, "Export forces", "forces.csv", "CSV (*.csv)")
+        if path:
+            self._try(lambda: self.plot.export_csv(path), "Could not export the forces")
+
+    def export_png_dialog(self):
+        path, _ = QFileDialog.getSaveFileName(self, "Export plot", "forces.png", "PNG (*.png)")
+        if path:
+            self._try(lambda: self.plot.export_png(path), "Could not export the plot")
+
+    def screenshot_dialog(self):
+        path, _ = QFileDialog.getSaveFileName(self, "Save screenshot", "feelflow.png", "PNG (*.png)")
+        if path:
+            self._try(lambda: self.save_screenshot(path), "Could not save the screenshot")
+
+    def window_image(self):
+        """The whole window as shown: QWidget.grab() misses the QPainter overlay of the GL view,
+        so the viewport's own rendering is painted over its place."""
+        image = self.grab().toImage()
+        painter = QPainter(image)
+        painter.drawImage(self.viewport.mapTo(self, QPoint(0, 0)), self.viewport.grabFramebuffer())
+        painter.end()
+        return image
+
+    def save_screenshot(self, path):
+        from app.files import atomic_path
+
+        image = self.window_image()
+        with atomic_path(path, suffix=".png") as tmp:
+            if not image.save(str(tmp), "PNG"):
+                raise OSError(f"cannot write {path}")
+
+    def _try(self, fn, title):
+        try:
+            fn()
+        except OSError as exc:
+            QMessageBox.warning(self, title, str(exc))
+
+    # --- presets ------------------------------------------------------------------------------
+    def apply_preset(self, key):
+        """Load the lesson's scene file and set the window up as the lesson needs."""
+        from app.cli import UserError
+        from app.scene import load_scene
+
+        lesson = PRESETS[key]
+        if self.sim is None:
+            return False
+        try:
+            scene = load_scene(lesson.path)
+            self._make_current()
+            self.sim.load_scene(scene)
+        except (UserError, ConfigError, ShapeError, ValueError) as exc:
+            self._refuse("This lesson cannot run here", exc)
+            return False
+        if self.sim.params.shape == "polygon":
+            self.undo.clear()
+        self.set_hold_still(lesson.hold_still and self.sim.runner is None)
+        if lesson.wind_sweep:
+            self.sim.start_sweep(lesson.wind_sweep, lesson.hold_steps)
+        self.set_display_mode(lesson.display)
+        self.plot.view.setCurrentIndex(self.plot.view.findData(lesson.plot_view))
+        self.viewport.tracers = None
+        self.panel.show_params(self.sim.params, self.display_mode)
+        self._after_rebuild()
+        self.set_paused(False)
+        self.statusBar().showMessage(f"{lesson.title}: {lesson.note}", 20000)
+        return True
+
+    # --- input devices ------------------------------------------------------------------------
+    def set_input(self, url):
+        if url == "mouse":
+            self._close_device()
+            self.panel.input_note.setText("")
+
+    def _close_device(self):
+        self.input_device = None
+
+    # --- frame loop ---------------------------------------------------------------------------
+    def _make_current(self):
+        if self.backend == "gl":
+            self.viewport.makeCurrent()
+
+    def _upload_field(self):
+        if self.sim is None:
+            return None
+        if self.backend == "gl":
+            self.viewport.use_texture(self.sim.solver.field_texture())
+            return None
+        rgba = self.sim.field_rgba()
+        self.viewport.makeCurrent()
+        self.viewport.upload_field(rgba)
+        return rgba
+
+    def tick(self):
+        now = time.perf_counter()
+        if self.sim is None:
+            return
+        if self.paused:
+            self.viewport.update()
+            self._last_tick = None
+            return
+        n = self.steps_per_frame
+        self._make_current()
+        t0 = time.perf_counter()
+        try:
+            forces = self.sim.advance(n)
+        except SolverDiverged:
+            self._on_nan()
+            return
+        t1 = time.perf_counter()
+        rgba = self._upload_field()
+        finite = all(math.isfinite(v) for f in forces.values() for v in f)
+        if rgba is not None:
+            finite = finite and bool(np.isfinite(rgba[..., :3]).all())
+        elif self.viewport.frames % 15 == 0:
+            finite = finite and self._gl_field_finite()
+        if not finite:
+            self._on_nan()
+            return
+        if self.display_mode == "tracers":
+            self._advance_tracers(rgba, n)
+        self._arrows(forces)
+        self.viewport.update()
+        # adaptive stepping: cost per step and the rest of the frame, smoothed
+        self._step_cost = 0.8 * self._step_cost + 0.2 * (t1 - t0) / n
+        if self._last_tick is not None:
+            other = max(0.0, (now - self._last_tick) - self._last_step_s)
+            self._other_cost = 0.8 * self._other_cost + 0.2 * min(other, 0.2)
+        self._last_tick, self._last_step_s = now, t1 - t0
+        budget = TARGET_FRAME_S - self._other_cost
+        self.steps_per_frame = int(max(MIN_STEPS_PER_FRAME, min(MAX_STEPS_PER_FRAME, budget / max(self._step_cost, 1e-6))))
+        w = self._rate_window
+        w[1] += n
+        w[2] += 1
+        if now - w[0] >= 1.0:
+            dt = now - w[0]
+            nodes = self.sim.config.nx * self.sim.config.ny
+            self.rates = {"steps_per_s": w[1] / dt, "fps": w[2] / dt, "mlups": w[1] * nodes / dt / 1e6}
+            self._rate_window = [now, 0, 0]
+
+    def _gl_field_finite(self) -> bool:
+        data = np.frombuffer(self.sim.solver.field_texture().read(), np.float32)
+        return bool(np.isfinite(data).all())
+
+    def _on_nan(self):
+        self.set_paused(True)
+        self.viewport.update()
+        answer = QMessageBox.question(
+            self, "The simulation became unstable",
+            "The flow became unstable and stopped (the numbers grew without bound).\n"
+            "This happens when the flow is too fast for the grid or the viscosity is too low.\n\n"
+            "Reset the flow and continue?", QMessageBox.Reset | QMessageBox.Cancel, QMessageBox.Reset)
+        if answer == QMessageBox.Reset:
+            self.reset_flow()
+            self.set_paused(False)
+
+    def _arrows(self, forces):
+        f = forces.get(self.sim.params.force_model)
+        if f is None:
+            self.viewport.arrow_forces = None
+            return
+        w = self.sim.relative_wind()
+        s = math.hypot(*w)
+        ax, ay = (w[0] / s, w[1] / s) if s > 1e-9 else (1.0, 0.0)
+        drag = f[0] * ax + f[1] * ay
+        lift = -f[0] * ay + f[1] * ax
+        self.viewport.arrow_forces = {"drag": (drag * ax, drag * ay), "lift": (-lift * ay, lift * ax)}
+
+    def _advance_tracers(self, rgba, n):
+        sim = self.sim
+        nx, ny = sim.config.nx, sim.config.ny
+        if rgba is None:
+            rgba = np.frombuffer(sim.solver.field_texture().read(), np.float32).reshape(ny, nx, 4)
+        rng = self.tracer_rng
+        if self.viewport.tracers is None or len(self.viewport.tracers[0]) != N_TRACERS:
+            pts = np.c_[rng.uniform(0, nx - 1, N_TRACERS), rng.uniform(0, ny - 1, N_TRACERS)]
+        else:
+            pts = self.viewport.tracers[0]
+        ix = np.clip(np.rint(pts[:, 0]).astype(int), 0, nx - 1)
+        iy = np.clip(np.rint(pts[:, 1]).astype(int), 0, ny - 1)
+        u = rgba[iy, ix, 1:3].astype(float)
+        pts = pts + u * n
+        bad = (pts[:, 0] < 0) | (pts[:, 0] > nx - 1) | (pts[:, 1] < 0) | (pts[:, 1] > ny - 1) \
+            | sim.shape.contains(pts[:, 0], pts[:, 1]) | ~np.isfinite(pts).all(axis=1)
+        k = int(bad.sum())
+        if k:
+            pts[bad] = np.c_[rng.uniform(0, 3, k), rng.uniform(0, ny - 1, k)]
+        tail = pts - u * 60
+        self.viewport.tracers = (pts, tail)
+
+    def refresh_readouts(self):
+        sim = self.sim
+        if sim is None:
+            return
+        p = sim.params
+        if abs(self.panel.wind.value() - p.wind) > 5e-4:   # a sweep or a lesson changed it
+            self.panel.show_params(p, self.display_mode)
+        self.panel.show_numbers(sim.reynolds(), sim.mach(), sim.config.mach_limit)
+        t, drag, lift = sim.history.drag_lift(p.force_model)
+        if len(t) and p.force_model in sim.history.forces:
+            d, l = np.nanmean(drag[-30:]), np.nanmean(lift[-30:])
+            self.panel.drag.setText(f"{d:.4g} (lattice units)")
+            self.panel.lift.setText(f"{l:.4g} (lattice units)")
+        else:
+            self.panel.drag.setText("\u2013")
+            self.panel.lift.setText("\u2013")
+        self.plot.refresh()
+        r = self.rates
+        self.status["steps"].setText(f"{r['steps_per_s']:.0f} steps/s")
+        self.status["mlups"].setText(f"{r['mlups']:.1f} MLUPS")
+        self.status["fps"].setText(f"{r['fps']:.0f} fps")
+        self.status["re"].setText(f"Re {sim.reynolds():.0f}")
+        self.status["ma"].setText(f"Ma {sim.mach():.3f}")

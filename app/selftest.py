@@ -1,0 +1,155 @@
+"""`feelflow --selftest`: open the real window, run the default scene, drag the body with
+synthetic mouse events, switch shape and force model, save a screenshot, print frames per
+second and solver steps per second; exit 0 only if everything worked (non-blank field, body
+moved, plot has data)."""
+from __future__ import annotations
+
+import math
+import sys
+import time
+
+import numpy as np
+from PySide6.QtCore import QEvent, QPointF, Qt, QTimer
+from PySide6.QtGui import QMouseEvent
+from PySide6.QtWidgets import QApplication
+
+
+def send_mouse(widget, kind, pos: QPointF, button=Qt.LeftButton):
+    """Deliver a synthetic mouse event to `widget` (what a real press/move/release does)."""
+    types = {"press": QEvent.MouseButtonPress, "move": QEvent.MouseMove, "release": QEvent.MouseButtonRelease}
+    buttons = Qt.NoButton if kind == "release" else button
+    ev = QMouseEvent(types[kind], pos, widget.mapToGlobal(pos), Qt.NoButton if kind == "move" else button,
+                     buttons, Qt.NoModifier)
+    QApplication.sendEvent(widget, ev)
+
+
+def drag_body(window, dx_cells: float, dy_cells: float, moves: int = 10, hold_ticks: int = 0):
+    """Press on the body centre, drag by (dx, dy) cells in `moves` moves and keep holding for
+    `hold_ticks` more; a generator: one mouse event per step."""
+    vp, sim = window.viewport, window.sim
+    start = vp.to_widget(*sim.pos)
+    end = vp.to_widget(sim.pos[0] + dx_cells, sim.pos[1] + dy_cells)
+    send_mouse(vp, "press", start)
+    for k in range(1, moves + 1):
+        yield
+        send_mouse(vp, "move", start + (end - start) * (k / moves))
+    for _ in range(hold_ticks + 1):
+        yield
+    send_mouse(vp, "release", end)
+
+
+def field_is_alive(window) -> tuple[bool, str]:
+    """Non-blank: finite everywhere and the speed varies across the tunnel."""
+    sim = window.sim
+    if window.backend == "gl":
+        nx, ny = sim.config.nx, sim.config.ny
+        window._make_current()
+        f = np.frombuffer(sim.solver.field_texture().read(), np.float32).reshape(ny, nx, 4)
+    else:
+        f = sim.field_rgba()
+    if not np.isfinite(f).all():
+        return False, "the field has non-finite values"
+    speed = np.hypot(f[..., 1], f[..., 2])
+    if speed.std() < 1e-4 or speed.max() < 1e-3:
+        return False, f"the field is blank (speed max {speed.max():.2g}, std {speed.std():.2g})"
+    return True, f"speed max {speed.max():.3f}"
+
+
+class SelfTest:
+    """Drives the window from a timer; `exit_code` is set when the application quits."""
+
+    def __init__(self, window, seconds: float = 8.0, screenshot: str | None = None, out=sys.stdout):
+        self.window, self.seconds, self.screenshot, self.out = window, max(4.0, seconds), screenshot, out
+        self.exit_code = 1
+        self.failures = []
+        self.results = {}
+        self._gen = self._script()
+        self._timer = QTimer()
+        self._timer.setInterval(50)
+        self._timer.timeout.connect(self._next)
+        self._timer.start()
+        self._deadline = time.monotonic() + self.seconds + 60
+
+    def _next(self):
+        try:
+            next(self._gen)
+        except StopIteration:
+            self._finish()
+        except Exception as exc:  # a broken selftest must still end and say why
+            self.failures.append(f"selftest error: {type(exc).__name__}: {exc}")
+            self._finish()
+        if time.monotonic() > self._deadline:
+            self.failures.append("selftest timed out")
+            self._finish()
+
+    def _wait(self, seconds):
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            yield
+
+    def _script(self):
+        w = self.window
+        while w.sim is None:
+            yield
+        yield from self._wait(1.0)                      # warm-up: shader compile, adaptive stepping
+        sim = w.sim
+        measure = 0.45 * self.seconds
+        s0, f0, t0 = sim.solver.time, w.viewport.frames, time.perf_counter()
+        yield from self._wait(measure)
+        dt = time.perf_counter() - t0
+        steps, frames = sim.solver.time - s0, w.viewport.frames - f0
+        nodes = sim.config.nx * sim.config.ny
+        self.results.update(grid=f"{sim.config.nx}x{sim.config.ny}", fps=frames / dt, steps_per_s=steps / dt,
+                            mlups=steps * nodes / dt / 1e6, steps_per_frame=steps / max(1, frames))
+        ok, why = field_is_alive(w)
+        if not ok:
+            self.failures.append(why)
+
+        # drag the body 40 cells downstream and 12 up
+        before = sim.pos
+        yield from drag_body(w, 40, 12, hold_ticks=int(0.25 * self.seconds / 0.05))
+        yield from self._wait(0.5)
+        moved = math.hypot(sim.pos[0] - before[0], sim.pos[1] - before[1])
+        self.results["body_moved_cells"] = moved
+        if moved < 5:
+            self.failures.append(f"the body moved only {moved:.1f} cells when dragged")
+
+        # switch shape and force model through the panel, as a user would
+        panel = w.panel
+        panel.shape.setCurrentIndex(panel.shape.findData("plate"))
+        if sim.params.shape != "plate":
+            self.failures.append("switching the shape in the panel did not change the body")
+        panel.model.setCurrentIndex(panel.model.findData("pressure"))
+        if sim.params.force_model != "pressure":
+            self.failures.append("switching the force model in the panel did not change the model")
+        n0 = len(sim.history)
+        yield from self._wait(0.2 * self.seconds)
+        _, drag, _ = sim.history.drag_lift("pressure")
+        fresh = drag[n0:]
+        if len(fresh) == 0 or not np.isfinite(fresh).any():
+            self.failures.append("the plot got no data from the pressure model")
+        w.refresh_readouts()
+        if self.screenshot:
+            w.save_screenshot(self.screenshot)
+            self.results["screenshot"] = self.screenshot
+
+    def _finish(self):
+        if not self._timer.isActive():
+            return
+        self._timer.stop()
+        r = self.results
+        print(f"selftest: renderer {self.window.viewport.renderer()}, solver backend {self.window.backend}, "
+              f"grid {r.get('grid', '?')}", file=self.out)
+        if "fps" in r:
+            print(f"selftest: {r['fps']:.1f} frames/s, {r['steps_per_s']:.0f} solver steps/s "
+                  f"({r['mlups']:.1f} MLUPS, {r['steps_per_frame']:.1f} steps/frame)", file=self.out)
+        if "body_moved_cells" in r:
+            print(f"selftest: body moved {r['body_moved_cells']:.1f} cells when dragged", file=self.out)
+        if "screenshot" in r:
+            print(f"selftest: screenshot saved to {r['screenshot']}", file=self.out)
+        for f in self.failures:
+            print(f"selftest: FAILED: {f}", file=self.out)
+        self.exit_code = 0 if not self.failures else 1
+        print("selftest: ok" if self.exit_code == 0 else "selftest: failed", file=self.out)
+        self.window.close()
+        QApplication.instance().quit()

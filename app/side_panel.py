@@ -1,0 +1,179 @@
+"""The side panel: body (shape, size, angle, hold still, polygon editor), flow (wind speed,
+viscosity with live Re and Ma, grid, walls), forces (model, compare all, readouts), display mode
+and input (mouse or a haptic device). It only edits values; the window applies them.
+"""
+from __future__ import annotations
+
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtWidgets import (QCheckBox, QComboBox, QDoubleSpinBox, QFormLayout, QGroupBox, QHBoxLayout, QLabel,
+                               QPushButton, QScrollArea, QVBoxLayout, QWidget)
+
+from app.bodies import SHAPE_LABELS
+from app.simulation import FORCE_MODELS, GRID_PRESETS, WALLS
+from app.viewport import DISPLAY_MODES
+
+
+def _combo(items: dict) -> QComboBox:
+    box = QComboBox()
+    for key, label in items.items():
+        box.addItem(label, key)
+    return box
+
+
+def select_data(box: QComboBox, data) -> None:
+    """Select the entry whose data is `data` (no-op if absent)."""
+    i = box.findData(data)
+    if i >= 0:
+        box.setCurrentIndex(i)
+
+
+class SidePanel(QScrollArea):
+    """Signals carry the new value; the window applies it and calls `show_*` with the result."""
+
+    shapeChanged = Signal(str)
+    sizeChanged = Signal(float)
+    angleChanged = Signal(float)
+    holdStillToggled = Signal(bool)
+    editToggled = Signal(bool)
+    windChanged = Signal(float)
+    viscosityChanged = Signal(float)
+    gridChanged = Signal(tuple)
+    wallChanged = Signal(str)
+    forceModelChanged = Signal(str)
+    compareAllToggled = Signal(bool)
+    displayModeChanged = Signal(str)
+    arrowsToggled = Signal(bool)
+    inputChanged = Signal(str)
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        inner = QWidget()
+        col = QVBoxLayout(inner)
+        self.setWidget(inner)
+        self.setWidgetResizable(True)
+        self.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
+
+        # body
+        self.shape = _combo(SHAPE_LABELS)
+        self.size = QDoubleSpinBox(decimals=0, minimum=6, maximum=80, singleStep=2, suffix=" cells")
+        self.angle = QDoubleSpinBox(decimals=0, minimum=-180, maximum=180, singleStep=5, suffix="\u00b0")
+        self.angle.setWrapping(True)
+        self.hold_still = QCheckBox("Hold still")
+        self.edit = QPushButton("Edit vertices")
+        self.edit.setCheckable(True)
+        self.edit.setToolTip("Drag the yellow handles; double-click an edge to add a vertex; right-click a handle to delete it")
+        self.save_shape = QPushButton("Save\u2026")
+        self.load_shape = QPushButton("Load\u2026")
+        body = QFormLayout()
+        body.addRow("Shape", self.shape)
+        body.addRow("Size", self.size)
+        body.addRow("Angle", self.angle)
+        body.addRow(self.hold_still)
+        row = QHBoxLayout()
+        for w in (self.edit, self.save_shape, self.load_shape):
+            row.addWidget(w)
+        body.addRow(row)
+        col.addWidget(self._group("Body", body))
+
+        # flow
+        self.wind = QDoubleSpinBox(decimals=3, minimum=0.0, maximum=0.09, singleStep=0.005, suffix=" cells/step")
+        self.viscosity = QDoubleSpinBox(decimals=4, minimum=0.002, maximum=0.3, singleStep=0.002)
+        self.reynolds = QLabel()
+        self.mach = QLabel()
+        for label in (self.reynolds, self.mach):
+            f = label.font()
+            f.setBold(True)
+            label.setFont(f)
+        self.grid = QComboBox()
+        for label, size in GRID_PRESETS.items():
+            self.grid.addItem(label, f"{size[0]}x{size[1]}")
+        self.wall = _combo(WALLS)
+        flow = QFormLayout()
+        flow.addRow("Wind speed", self.wind)
+        flow.addRow("Viscosity", self.viscosity)
+        flow.addRow("Reynolds number", self.reynolds)
+        flow.addRow("Mach number", self.mach)
+        flow.addRow("Grid", self.grid)
+        flow.addRow("Walls", self.wall)
+        col.addWidget(self._group("Flow", flow))
+
+        # forces
+        self.model = _combo(FORCE_MODELS)
+        self.compare_all = QCheckBox("Compute and plot all models")
+        self.drag = QLabel("\u2013")
+        self.lift = QLabel("\u2013")
+        forces = QFormLayout()
+        forces.addRow("Model", self.model)
+        forces.addRow(self.compare_all)
+        forces.addRow("Drag", self.drag)
+        forces.addRow("Lift", self.lift)
+        col.addWidget(self._group("Forces", forces))
+
+        # display and input
+        self.display = _combo({k: m.label for k, m in DISPLAY_MODES.items()})
+        self.arrows = QCheckBox("Force arrows")
+        self.arrows.setChecked(True)
+        self.input = QComboBox()
+        self.input.addItem("Mouse", "mouse")
+        self.input_note = QLabel("")
+        self.input_note.setWordWrap(True)
+        view = QFormLayout()
+        view.addRow("Show", self.display)
+        view.addRow(self.arrows)
+        view.addRow("Input", self.input)
+        view.addRow(self.input_note)
+        col.addWidget(self._group("Display and input", view))
+        col.addStretch(1)
+
+        self.shape.currentIndexChanged.connect(lambda: self.shapeChanged.emit(self.shape.currentData()))
+        self.size.valueChanged.connect(self.sizeChanged)
+        self.angle.valueChanged.connect(self.angleChanged)
+        self.hold_still.toggled.connect(self.holdStillToggled)
+        self.edit.toggled.connect(self.editToggled)
+        self.wind.valueChanged.connect(self.windChanged)
+        self.viscosity.valueChanged.connect(self.viscosityChanged)
+        self.grid.currentIndexChanged.connect(lambda: self.gridChanged.emit(tuple(int(v) for v in self.grid.currentData().split("x"))))
+        self.wall.currentIndexChanged.connect(lambda: self.wallChanged.emit(self.wall.currentData()))
+        self.model.currentIndexChanged.connect(lambda: self.forceModelChanged.emit(self.model.currentData()))
+        self.compare_all.toggled.connect(self.compareAllToggled)
+        self.display.currentIndexChanged.connect(lambda: self.displayModeChanged.emit(self.display.currentData()))
+        self.arrows.toggled.connect(self.arrowsToggled)
+        self.input.currentIndexChanged.connect(lambda: self.inputChanged.emit(self.input.currentData() or "mouse"))
+        self.setMinimumWidth(inner.sizeHint().width() + 24)
+
+    @staticmethod
+    def _group(title, layout):
+        box = QGroupBox(title)
+        box.setLayout(layout)
+        return box
+
+    def show_params(self, params, display_mode):
+        """Set every control from `params` without emitting signals."""
+        widgets = (self.shape, self.size, self.angle, self.wind, self.viscosity, self.grid, self.wall,
+                   self.model, self.compare_all, self.display)
+        for w in widgets:
+            w.blockSignals(True)
+        try:
+            select_data(self.shape, params.shape)
+            self.size.setValue(params.size)
+            self.angle.setValue(params.angle_deg)
+            self.wind.setValue(params.wind)
+            self.viscosity.setValue(params.nu)
+            key = f"{params.grid[0]}x{params.grid[1]}"
+            if self.grid.findData(key) < 0:   # a grid from a scene or settings, not a preset
+                self.grid.addItem(f"{params.grid[0]} x {params.grid[1]}", key)
+            select_data(self.grid, key)
+            select_data(self.wall, params.wall)
+            select_data(self.model, params.force_model)
+            self.compare_all.setChecked(params.compare_all)
+            select_data(self.display, display_mode)
+        finally:
+            for w in widgets:
+                w.blockSignals(False)
+        self.edit.setEnabled(params.shape == "polygon")
+        self.save_shape.setEnabled(True)
+
+    def show_numbers(self, reynolds: float, mach: float, mach_limit: float):
+        self.reynolds.setText(f"Re = {reynolds:.0f}")
+        colour = "#c62828" if mach > mach_limit else "black"
+        self.mach.setText(f"<span style='color:{colour}'>Ma = {mach:.3f}</span> (limit {mach_limit:.2f})")

@@ -1,0 +1,383 @@
+"""The running wind tunnel behind the window (Qt-free, so it is testable on its own):
+the solver, the body and its pose, the mouse coupling, the force models in use, and the
+force history the plot and readouts show. Lattice units (docs/algorithm.md).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from app.coupling import AngleSpring, SpringDamper
+from solver import units
+from solver.backend import create_solver
+from solver.config import FlowConfig
+from solver.motion import MotionRunner
+
+#: grid presets offered in the side panel: label -> (nx, ny)
+GRID_PRESETS = {
+    "192 x 96 (fast)": (192, 96),
+    "256 x 128 (default)": (256, 128),
+    "384 x 192": (384, 192),
+    "512 x 256 (fine)": (512, 256),
+}
+DEFAULT_GRID = (256, 128)
+
+#: force models a student chooses between: registry name -> label
+FORCE_MODELS = {
+    "momentum_exchange": "Momentum exchange",
+    "macroscopic": "Macroscopic (drag equation)",
+    "pressure": "Pressure integration",
+}
+
+#: y-boundaries offered as "wall type": config value -> label
+WALLS = {"no_slip": "Solid walls (no slip)", "free_slip": "Slippery walls (free slip)",
+         "periodic": "No walls (periodic)"}
+
+def default_base_config(grid) -> FlowConfig:
+    """What the panel does not edit: TRT, float32, an outlet sponge, a slow start of the wind
+    (a fast ramp excites a long slosh of the whole tunnel: about +-60 % of U for 1000 steps,
+    +-6 % for 2000, measured at 256 x 128)."""
+    nx, ny = grid
+    return FlowConfig(nx=nx, ny=ny, dtype="float32", inflow_ramp_steps=2000, sponge_cells=32)
+
+
+#: distance (cells) the body's bounding box keeps from the domain edges
+EDGE_MARGIN = 8.0
+
+
+@dataclass
+class Params:
+    """What the side panel edits (lattice units; angle in degrees)."""
+
+    grid: tuple[int, int] = DEFAULT_GRID
+    shape: str = "cylinder"
+    size: float = 20.0
+    angle_deg: float = 0.0
+    wind: float = 0.05
+    nu: float = 0.02
+    wall: str = "no_slip"
+    force_model: str = "momentum_exchange"
+    compare_all: bool = False
+
+
+@dataclass
+class History:
+    """One sample per frame: step, body velocity, relative wind, force of each model in use."""
+
+    time: list = field(default_factory=list)
+    body_velocity: list = field(default_factory=list)
+    wind: list = field(default_factory=list)
+    forces: dict = field(default_factory=dict)  # model -> list of (Fx, Fy)
+
+    MAX = 20000
+
+    def add(self, time, body_velocity, wind, forces):
+        self.time.append(time)
+        self.body_velocity.append(body_velocity)
+        self.wind.append(wind)
+        for name, f in forces.items():
+            series = self.forces.setdefault(name, [])
+            series.extend([(math.nan, math.nan)] * (len(self.time) - 1 - len(series)))
+            series.append(f)
+        if len(self.time) > self.MAX:
+            cut = len(self.time) - self.MAX
+            del self.time[:cut], self.body_velocity[:cut], self.wind[:cut]
+            for series in self.forces.values():
+                del series[:max(0, len(series) - self.MAX)]
+
+    def clear(self):
+        self.time.clear(), self.body_velocity.clear(), self.wind.clear(), self.forces.clear()
+
+    def __len__(self):
+        return len(self.time)
+
+    def drag_lift(self, model: str):
+        """(t, drag, lift) arrays: force along and across the relative wind (NaN where absent)."""
+        n = len(self.time)
+        series = self.forces.get(model, [])
+        f = np.full((n, 2), np.nan)
+        if series:
+            f[n - len(series):] = np.asarray(series[-n:], float)
+        w = np.asarray(self.wind, float).reshape(n, 2)
+        along = drag_direction(w)
+        drag = (f * along).sum(axis=1)
+        lift = f[:, 1] * along[:, 0] - f[:, 0] * along[:, 1]
+        return np.asarray(self.time, float), drag, lift
+
+
+def drag_direction(wind):
+    """Unit vectors along the relative wind (+x where the relative wind is ~0)."""
+    w = np.atleast_2d(np.asarray(wind, float))
+    s = np.hypot(w[:, 0], w[:, 1])
+    out = np.tile([1.0, 0.0], (len(w), 1))
+    ok = s > 1e-9
+    out[ok] = w[ok] / s[ok, None]
+    return out
+
+
+def phase_name(velocity, wind: float) -> str:
+    """Plain words for a scripted phase (SEED-NOTES 'Experiments')."""
+    vx, vy = velocity
+    if vx == 0.0 and vy == 0.0:
+        return "stopped"
+    if wind and vy == 0.0:
+        return "moving with the stream" if vx * wind > 0 else "moving against the stream"
+    return f"moving at ({vx:.3f}, {vy:.3f})"
+
+
+class Simulation:
+    """Owns the solver and the body; `advance(n)` runs n steps and records one force sample."""
+
+    def __init__(self, params: Params | None = None, backend: str = "numpy", ctx=None, shape_factory=None,
+                 base_config: FlowConfig | None = None):
+        from app.bodies import make_shape
+
+        self.params = params or Params()
+        self.backend = backend
+        self.ctx = ctx
+        self.make_shape = shape_factory or make_shape
+        self.polygon = None          # vertices of the custom polygon (body frame), or None
+        self.history = History()
+        self.hold_still = False
+        self.target = None           # where the mouse pulls the body, or None
+        self.angle_target = math.radians(self.params.angle_deg)
+        self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
+        self.base_config = base_config or default_base_config(self.params.grid)
+        self.sweep = None            # (wind speeds, steps each, first step): a wind-speed sweep
+        self.capped = False          # the Mach cap limited the body's speed in the last frame
+        self.solver = None
+        self._build(keep_flow=False)
+
+    # --- construction --------------------------------------------------------------------
+    def flow_config(self, params: Params | None = None) -> FlowConfig:
+        """The base configuration (scene or default) with what the panel edits."""
+        p = params or self.params
+        nx, ny = p.grid
+        base = self.base_config
+        return replace(base, nx=nx, ny=ny, nu=p.nu, inflow_speed=p.wind, y_boundary=p.wall,
+                       sponge_cells=min(base.sponge_cells, nx // 4)).validate()
+
+    def _build(self, keep_flow: bool):
+        config = self.flow_config()
+        old = self.solver
+        solver = create_solver(self.backend, config, **({"ctx": self.ctx} if self.backend == "gl" else {}))
+        if keep_flow and old is not None and old.config.nx == config.nx and old.config.ny == config.ny:
+            solver.set_distributions(old.distributions())
+            solver.time = old.time
+        else:
+            nx, ny = config.nx, config.ny
+            self.pos, self.vel = (nx * 0.3, ny * 0.5), (0.0, 0.0)
+            self.angle, self.rate = math.radians(self.params.angle_deg), 0.0
+            self.angle_target = self.angle
+            self.target = None
+            self.history.clear()
+        if old is not None:
+            old.close()
+        self.solver = solver
+        if self.runner is not None:
+            if keep_flow:
+                self.runner.solver = solver
+            else:
+                self.runner = None
+        self.config = config
+        self.coupling = SpringDamper(max_speed=config.max_speed)
+        if not keep_flow or not hasattr(self, "shape"):
+            self.shape = self.make_shape(self.params, self.polygon, *self.pos, self.angle).validate(config.nx, config.ny)
+        self._clamp_pose()
+        self._enable_models()
+        self.solver.set_body(self.shape, self.vel, 0.0)
+
+    def _enable_models(self):
+        names = list(FORCE_MODELS) if self.params.compare_all else [self.params.force_model]
+        self.solver.enable_force_models(names)
+
+    # --- what the panel changes ------------------------------------------------------------
+    def set_shape(self, kind=None, size=None, angle_deg=None, polygon=None):
+        """Change the body; raises shapes' ShapeError (one line) and keeps the old body if invalid."""
+        params = replace(self.params, **{k: v for k, v in
+                                          (("shape", kind), ("size", size), ("angle_deg", angle_deg)) if v is not None})
+        poly = self.polygon if polygon is None else polygon
+        angle = math.radians(params.angle_deg) if angle_deg is not None else self.angle
+        shape = self.make_shape(params, poly, *self.pos, angle).validate(self.config.nx, self.config.ny)
+        self.params, self.polygon, self.shape = params, poly, shape
+        self.angle = self.angle_target = angle
+        self._clamp_pose()
+        self.solver.set_body(self.shape, self.vel, 0.0)
+
+    def set_flow(self, wind=None, nu=None, wall=None):
+        """Change inflow speed, viscosity or walls, keeping the flow as it is (raises ConfigError)."""
+        params = replace(self.params, **{k: v for k, v in (("wind", wind), ("nu", nu), ("wall", wall)) if v is not None})
+        self.flow_config(params)  # validate first: a bad value leaves everything as it was
+        only_wind = (params.nu, params.wall) == (self.params.nu, self.params.wall)
+        self.params = params
+        if only_wind and hasattr(self.solver, "set_inflow_speed"):
+            self.solver.set_inflow_speed(params.wind)   # live, no rebuild
+        else:
+            self._build(keep_flow=True)
+
+    def set_grid(self, grid):
+        self.params = replace(self.params, grid=tuple(grid))
+        self._build(keep_flow=False)
+
+    def set_force_models(self, selected=None, compare_all=None):
+        self.params = replace(self.params, **{k: v for k, v in
+                                              (("force_model", selected), ("compare_all", compare_all)) if v is not None})
+        self._enable_models()
+
+    def reset_flow(self):
+        """Fluid at rest again, body where it was, history cleared."""
+        pose = (self.pos, self.angle)
+        self._build(keep_flow=False)
+        (self.pos, self.angle) = pose
+        self.angle_target = self.angle
+        self.shape = self.shape.moved(*self.pos, self.angle)
+        self.solver.set_body(self.shape, (0.0, 0.0), 0.0)
+
+    def start_sweep(self, speeds, hold_steps: int):
+        """Hold each wind speed `hold_steps` steps in turn (the 'drag grows with speed' lesson)."""
+        self.sweep = (tuple(speeds), int(hold_steps), self.solver.time)
+        self.set_flow(wind=speeds[0])
+
+    def sweep_stage(self):
+        if self.sweep is None:
+            return None
+        speeds, hold, start = self.sweep
+        k = (self.solver.time - start) // hold
+        return k if k < len(speeds) else None
+
+    def start_script(self, script):
+        """Drive the body through a solver.motion.MotionScript (mouse and hold-still ignored)."""
+        self.shape = self.shape.moved(*self.pos, self.angle)
+        self.runner = MotionRunner(self.solver, self.shape, script)
+
+    def script_phase(self):
+        """(phase index, count, words) of the running script, or None."""
+        r = self.runner
+        if r is None:
+            return None
+        start = 0
+        for k, phase in enumerate(r.script.phases):
+            if r.t < start + phase.steps:
+                return k, len(r.script.phases), phase_name(phase.velocity, self.params.wind)
+            start += phase.steps
+        return None
+
+    def load_scene(self, scene):
+        """Take grid, flow, body, pose and motion from an app.scene.Scene."""
+        from app.bodies import params_for_shape
+
+        kind, size, verts = params_for_shape(scene.body)
+        cfg = scene.config
+        models = [m for m in scene.force_models if m in FORCE_MODELS] or [self.params.force_model]
+        self.base_config = cfg
+        self.params = replace(self.params, grid=(cfg.nx, cfg.ny), shape=kind, size=size or self.params.size,
+                              angle_deg=math.degrees(scene.body.angle), wind=cfg.inflow_speed, nu=cfg.nu,
+                              wall=cfg.y_boundary, force_model=models[0], compare_all=len(models) > 1)
+        self.polygon = verts
+        self.runner = None
+        self.sweep = None
+        self._build(keep_flow=False)
+        self.pos = (scene.body.x, scene.body.y)
+        self.shape = self.shape.moved(*self.pos, self.angle)
+        self._clamp_pose()
+        self.solver.set_body(self.shape, (0.0, 0.0), 0.0)
+        if scene.motion.phases:
+            self.start_script(scene.motion)
+
+    # --- mouse ----------------------------------------------------------------------------
+    def hit(self, x: float, y: float, tolerance: float = 2.0) -> bool:
+        """Is the lattice point (x, y) on the body (or within `tolerance` cells of it)?"""
+        px = x + np.array([0, -1, 1, 0, 0]) * tolerance
+        py = y + np.array([0, 0, 0, -1, 1]) * tolerance
+        return bool(np.any(self.shape.contains(px, py)))
+
+    def rotate_by(self, degrees: float):
+        self.angle_target += math.radians(degrees)
+
+    # --- running --------------------------------------------------------------------------
+    def relative_wind(self):
+        return (self.params.wind - self.vel[0], -self.vel[1])
+
+    def advance(self, n: int):
+        """Run n steps, moving the body in chunks of at most half a cell; record a sample."""
+        n = max(1, int(n))
+        if self.sweep is not None:
+            k = self.sweep_stage()
+            if k is None:
+                self.sweep = None
+            elif self.sweep[0][k] != self.params.wind:
+                self.set_flow(wind=self.sweep[0][k])
+        done = 0
+        acc = {}
+        self.capped = False
+        if self.runner is not None:
+            acc = {k: (fx * n, fy * n) for k, (fx, fy) in self.runner.advance(n).items()}
+            r = self.runner
+            self.pos, self.shape = r.position, r.shape
+            self.vel = r.script.velocity_at(r.t - 1)
+            if r.t >= r.script.total_steps:
+                self.runner = None
+                self.vel = (0.0, 0.0)
+            done = n
+        while done < n:
+            speed = math.hypot(*self.vel)
+            chunk = n - done if speed < 1e-9 else max(1, min(n - done, int(0.5 / speed)))
+            self._move_body(chunk)
+            self.solver.step(chunk)   # raises solver.backend.SolverDiverged when the flow blows up
+            self.capped |= bool(getattr(self.solver, "speed_capped", False))
+            for name, (fx, fy) in self.solver.forces().items():
+                ax, ay = acc.get(name, (0.0, 0.0))
+                acc[name] = (ax + fx * chunk, ay + fy * chunk)
+            done += chunk
+        forces = {k: (v[0] / n, v[1] / n) for k, v in acc.items()}
+        self.history.add(self.solver.time, self.vel, self.relative_wind(), forces)
+        return forces
+
+    def _move_body(self, steps: int):
+        old = (self.pos, self.angle)
+        if self.hold_still:
+            self.vel = (0.0, 0.0)
+        else:
+            self.pos, self.vel, capped = self.coupling.advance(self.pos, self.vel, self.target, steps)
+            self.capped |= capped
+        omega_before = self.rate
+        if not self.hold_still:
+            self.angle, self.rate = AngleSpring().advance(self.angle, self.rate, self.angle_target, steps) \
+                if (self.angle != self.angle_target or self.rate) else (self.angle, 0.0)
+        if self._clamp_pose():
+            self.vel = (0.0 if self._clamped_x else self.vel[0], 0.0 if self._clamped_y else self.vel[1])
+        if (self.pos, self.angle) != old or omega_before:
+            self.shape = self.shape.moved(*self.pos, self.angle)
+            self.solver.set_body(self.shape, self.vel, self.rate)
+
+    def _clamp_pose(self) -> bool:
+        """Keep the body EDGE_MARGIN cells inside the domain; True if it had to be pushed back."""
+        shape = self.shape.moved(*self.pos, self.angle)
+        x0, y0, x1, y1 = shape.bounding_box()
+        nx, ny = self.config.nx, self.config.ny
+        dx = max(0.0, EDGE_MARGIN - x0) - max(0.0, x1 - (nx - 1 - EDGE_MARGIN))
+        dy = max(0.0, EDGE_MARGIN - y0) - max(0.0, y1 - (ny - 1 - EDGE_MARGIN))
+        self._clamped_x, self._clamped_y = dx != 0, dy != 0
+        if dx or dy:
+            self.pos = (self.pos[0] + dx, self.pos[1] + dy)
+            self.shape = shape.moved(*self.pos, self.angle)
+            return True
+        return False
+
+    # --- what the window shows -----------------------------------------------------------
+    def reynolds(self) -> float:
+        """Re of the wind over the body size (solver/units.py)."""
+        return units.reynolds(self.params.wind, self.params.size, self.params.nu)
+
+    def mach(self) -> float:
+        return units.mach(self.params.wind)
+
+    def field_rgba(self) -> np.ndarray:
+        """(ny, nx, 4) float32: rho, ux, uy, vorticity (numpy path; the gl backend has a texture)."""
+        rho, ux, uy = self.solver.macroscopic()
+        out = np.empty(rho.shape + (4,), np.float32)
+        out[..., 0], out[..., 1], out[..., 2] = rho, ux, uy
+        out[..., 3] = np.gradient(uy, axis=1) - np.gradient(ux, axis=0)
+        return out

@@ -1,0 +1,259 @@
+#version 330 core
+// One lattice Boltzmann step t -> t+1, collide and stream fused (pull form), exactly as
+// docs/algorithm.md states it. Populations are stored shifted, g_i = f*_i - w_i RHO0, in three
+// RGBA32F textures: G0 = (g0, g1, g2, g3), G1 = (g4, g5, g6, g7), G2 = (g8, -, -, -).
+// References: Bouzidi, Firdaouss & Lallemand (2001); Lallemand & Luo (2003); Ginzburg (2008);
+// Guo, Zheng & Shi (2002).
+//
+// Compile-time variants (defines injected by solver/gl_programs.py). llvmpipe executes both
+// sides of a divergent branch, so each region of the grid is drawn by the variant it needs:
+//   BODY  1: rule 1a (Bouzidi links with the moving-wall term) and solid nodes (body window);
+//   EDGES 1: rules 1b-1e (walls, inlet, pressure outlet, periodic wrap) (edge strips);
+//   both 0: the fast path, plain streaming (rule 1f) for the interior.
+//   TRT, GUO_FORCE, SPONGE: collision operator, Guo body force, outlet sponge (per-column rates).
+//   X_PERIODIC 0/1; Y_MODE 0 no_slip, 1 free_slip, 2 periodic.
+//   FETCH_NORMALIZED 1: streaming reads with texture() at normalized coordinates through
+//     REPEAT samplers (the wrap comes free); 0: texelFetch() (docs/performance.md compares).
+// @LATTICE
+
+uniform sampler2D G0;
+uniform sampler2D G1;
+uniform sampler2D G2;
+uniform ivec2 N;               // (nx, ny)
+uniform vec2 inv_n;            // (1/nx, 1/ny)
+uniform float omega_plus;      // 1 / tau
+uniform float omega_minus;     // TRT odd rate from the magic number
+uniform vec2 body_force;       // Guo force density F
+#if SPONGE
+uniform sampler2D OMEGA;       // (omega+, omega-) of column ix in texel (ix, 0): the outlet sponge
+#endif
+#if BODY
+uniform usampler2D MASK;       // bit 0 solid; bit i (1..8) q[OPP[i], x] > 0; bit 8+i: that
+                               // link takes the two-node interpolation (q < 1/2, x + c_i fluid)
+uniform sampler2D QA;          // q[1..4, x]
+uniform sampler2D QB;          // q[5..8, x]
+uniform vec2 body_velocity;    // V
+uniform float body_omega;      // Omega, radians per step, counter-clockwise
+uniform vec2 body_centre;      // X
+#endif
+#if EDGES
+uniform sampler2D INFLOW;      // inflow profile(iy) in texel (iy, 0)
+uniform float inflow_ramp;     // ramp(t): u_in(iy, t) = ramp(t) profile(iy)
+#endif
+
+layout(location = 0) out vec4 out0;
+layout(location = 1) out vec4 out1;
+layout(location = 2) out vec4 out2;
+
+float pop(int j, ivec2 p) {  // stored g_j at node p (inside the grid)
+    if (j < 4) return texelFetch(G0, p, 0)[j];
+    if (j < 8) return texelFetch(G1, p, 0)[j - 4];
+    return texelFetch(G2, p, 0).x;
+}
+
+ivec2 wrap(ivec2 p) {
+    return ivec2((p.x + N.x) % N.x, (p.y + N.y) % N.y);
+}
+
+// g_i(x - c_i): plain streaming, periodic wrap at the edges (rules 1e, 1f).
+float streamed(int i, ivec2 x) {
+#if FETCH_NORMALIZED
+    vec2 p = (gl_FragCoord.xy - vec2(C[i])) * inv_n;
+    if (i < 4) return texture(G0, p)[i];
+    if (i < 8) return texture(G1, p)[i - 4];
+    return texture(G2, p).x;
+#elif EDGES
+    return pop(i, wrap(x - C[i]));
+#else
+    return pop(i, x - C[i]);
+#endif
+}
+
+// f^eq_i - w_i RHO0 for density RHO0 + drho and velocity u (seed eq. 9), shifted.
+float feq_shifted(int i, float drho, float rho, vec2 u) {
+    float cu = 3.0 * dot(vec2(C[i]), u);
+    float usq = 1.5 * dot(u, u);
+    return W[i] * (drho + rho * (cu + 0.5 * cu * cu - usq));
+}
+
+void store(float g[9]) {
+    out0 = vec4(g[0], g[1], g[2], g[3]);
+    out1 = vec4(g[4], g[5], g[6], g[7]);
+    out2 = vec4(g[8], 0.0, 0.0, 0.0);
+}
+
+// Collision (algorithm.md steps 2-4) of the incoming shifted populations f at node x, in place,
+// pair by pair (i, OPP[i]), with the operations in the order of the numpy reference
+// (solver/numpy_backend.py, _collide) so that float32 rounding agrees:
+//   feq+ - w RHO0 = w (drho + rho (cu^2/2 - usq)), feq- = w rho cu, cu = 3 c.u, usq = 3/2 u.u.
+void collide_and_store(float f[9], ivec2 x) {
+    float drho = f[0];
+    for (int i = 1; i < Q; ++i) drho += f[i];
+    float rho = drho + RHO0;
+    float jx = 0.0;
+    float jy = 0.0;
+    for (int i = 1; i < Q; ++i) {
+        jx += float(C[i].x) * f[i];
+        jy += float(C[i].y) * f[i];
+    }
+#if GUO_FORCE
+    jx += 0.5 * body_force.x;
+    jy += 0.5 * body_force.y;
+#endif
+    float ux = jx / rho;
+    float uy = jy / rho;
+    float usq = ux * ux;
+    usq += uy * uy;
+    usq *= 1.5;
+#if SPONGE
+    vec2 rates = texelFetch(OMEGA, ivec2(x.x, 0), 0).rg;
+    float op = rates.r;
+    float om = rates.g;
+#else
+    float op = omega_plus;
+    float om = omega_minus;
+#endif
+    f[0] += ((drho - rho * usq) * W[0] - f[0]) * op;
+#if GUO_FORCE
+    float uF = ux * body_force.x + uy * body_force.y;
+    f[0] += (1.0 - 0.5 * op) * (W[0] * -3.0) * uF;
+#endif
+    for (int i = 1; i < Q; ++i) {
+        int ib = OPP[i];
+        if (ib < i) continue;  // each pair once
+        float cx = float(C[i].x);
+        float cy = float(C[i].y);
+        float cu = 3.0 * (cx * ux + cy * uy);
+        float sym = ((cu * cu * 0.5 - usq) * rho) + drho;
+        float anti = cu * rho;
+        float fi = f[i];
+        float fb = f[ib];
+#if TRT
+        float dp = ((fi + fb) * 0.5 - sym * W[i]) * op;
+        float dm = ((fi - fb) * 0.5 - anti * W[i]) * om;
+        fi = fi - dp - dm;
+        fb = fb - dp + dm;
+#else
+        fi += ((sym + anti) * W[i] - fi) * op;
+        fb += ((sym - anti) * W[i] - fb) * op;
+#endif
+#if GUO_FORCE
+        float cF = cx * body_force.x + cy * body_force.y;
+        float cul = cx * ux + cy * uy;
+        float gp = (1.0 - 0.5 * op) * (W[i] * (9.0 * cul * cF - 3.0 * uF));
+        float gm = (1.0 - 0.5 * om) * (3.0 * W[i] * cF);
+        fi += gp;
+        fi += gm;
+        fb += gp;
+        fb -= gm;
+#endif
+        f[i] = fi;
+        f[ib] = fb;
+    }
+    store(f);
+}
+
+#if BODY
+vec2 wall_velocity(vec2 xw) {  // rigid-body velocity at xw (algorithm.md, 'Links cut')
+    vec2 r = xw - body_centre;
+    return body_velocity + body_omega * vec2(-r.y, r.x);
+}
+#endif
+
+#if EDGES
+vec2 stored_velocity(float g[9]) {  // sum c f* / sum f* of shifted populations
+    float rho = RHO0;
+    vec2 j = vec2(0.0);
+    for (int i = 0; i < Q; ++i) {
+        rho += g[i];
+        j += vec2(C[i]) * g[i];
+    }
+    return j / rho;
+}
+
+int reflect_y(int i) {  // j with C[j] = (C[i].x, -C[i].y)
+    int r = 0;
+    for (int j = 0; j < Q; ++j)
+        if (C[j] == ivec2(C[i].x, -C[i].y)) r = j;
+    return r;
+}
+#endif
+
+void main() {
+    ivec2 x = ivec2(gl_FragCoord.xy);
+    float gin[9];
+    for (int i = 0; i < Q; ++i) gin[i] = streamed(i, x);
+#if BODY
+    uint m = texelFetch(MASK, x, 0).r;
+    if ((m & 1u) != 0u) {  // solid node: equilibrium at the body velocity, density RHO0
+        vec2 ub = wall_velocity(vec2(x));
+        float g[9];
+        for (int i = 0; i < Q; ++i) g[i] = feq_shifted(i, 0.0, RHO0, ub);
+        store(g);
+        return;
+    }
+    vec4 qa = texelFetch(QA, x, 0);
+    vec4 qb = texelFetch(QB, x, 0);
+    float qs[9] = float[9](0.0, qa.x, qa.y, qa.z, qa.w, qb.x, qb.y, qb.z, qb.w);
+    float plain[9] = gin;  // plain[ib] = g_ib(x + c_i): the second node of the interpolation
+#endif
+#if BODY || EDGES
+    vec4 a = texelFetch(G0, x, 0);
+    vec4 b = texelFetch(G1, x, 0);
+    vec4 c = texelFetch(G2, x, 0);
+    float own[9] = float[9](a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x);
+#if EDGES
+    float uin = X_PERIODIC == 0 ? inflow_ramp * texelFetch(INFLOW, ivec2(x.y, 0), 0).r : 0.0;
+    // outlet velocity u_b = u(x) + (u(x) - u(x - 1)) / 2 of the stored populations
+    // (solver/inflow.py, outlet_incoming; Krueger et al. 2017, eq. 5.53)
+    vec2 u_out = vec2(0.0);
+    float usq_out = 0.0;
+    if (X_PERIODIC == 0) {
+        ivec2 xw = wrap(x - ivec2(1, 0));
+        vec4 aw = texelFetch(G0, xw, 0);
+        vec4 bw = texelFetch(G1, xw, 0);
+        vec4 cw = texelFetch(G2, xw, 0);
+        float west[9] = float[9](aw.x, aw.y, aw.z, aw.w, bw.x, bw.y, bw.z, bw.w, cw.x);
+        u_out = 1.5 * stored_velocity(own) - 0.5 * stored_velocity(west);
+        usq_out = dot(u_out, u_out);
+    }
+#endif
+    for (int i = 1; i < Q; ++i) {
+        int ib = OPP[i];
+        ivec2 ci = C[i];
+#if BODY
+        if ((m & (1u << uint(i))) != 0u) {  // rule a: Bouzidi with the moving-wall term
+            float q = qs[ib];
+            float cu = dot(vec2(ci), wall_velocity(vec2(x) + q * vec2(C[ib])));
+            if (q >= 0.5)
+                gin[i] = 1.0 / (2.0 * q) * own[ib] + (2.0 * q - 1.0) / (2.0 * q) * own[i]
+                         + 3.0 / q * W[i] * RHO0 * cu;
+            else if ((m & (1u << uint(8 + i))) != 0u)
+                gin[i] = 2.0 * q * own[ib] + (1.0 - 2.0 * q) * plain[ib] + 6.0 * W[i] * RHO0 * cu;
+            else
+                gin[i] = own[ib] + 6.0 * W[i] * RHO0 * cu;
+            continue;
+        }
+#endif
+#if EDGES
+        // conditions test the constant C[i] first, so the unrolled loop drops the rules a
+        // direction cannot meet (llvmpipe runs both sides of a branch that is not constant)
+        ivec2 s = x - ci;
+        bool wall = Y_MODE != 2 && ((ci.y > 0 && s.y < 0) || (ci.y < 0 && s.y >= N.y));
+        ivec2 s2 = ivec2(x.x - ci.x, x.y);
+        // a free-slip tunnel corner keeps the inlet/outlet rule
+        bool corner = Y_MODE == 1 && X_PERIODIC == 0 && ((ci.x > 0 && s2.x < 0) || (ci.x < 0 && s2.x >= N.x));
+        if (wall && !corner) {  // rule b: channel wall
+            if (Y_MODE == 0) gin[i] = own[ib];                      // half-way bounce-back
+            else gin[i] = pop(reflect_y(i), wrap(s2));              // specular reflection
+        } else if (X_PERIODIC == 0 && ci.x > 0 && s.x < 0) {  // rule c: inlet
+            gin[i] = own[ib] + 6.0 * W[i] * RHO0 * (float(ci.x) * uin);
+        } else if (X_PERIODIC == 0 && ci.x < 0 && s.x >= N.x) {  // rule d: pressure outlet
+            float cu = dot(vec2(ci), u_out);
+            gin[i] = -own[ib] + 2.0 * W[i] * RHO0 * (4.5 * cu * cu - 1.5 * usq_out);
+        }  // else rules e, f: gin[i] as streamed (wrapped)
+#endif
+    }
+#endif
+    collide_and_store(gin, x);
+}

@@ -1,0 +1,532 @@
+"""The fragment-shader backend: docs/algorithm.md in GLSL 330 core, run through moderngl.
+
+`GLSolver(config, ctx=moderngl_context)` implements `solver.backend.Solver` with the same extra
+methods as the numpy reference (`set_inflow_speed`, `add_force_model`, `body_window`). It never
+creates a GL context: the CLI and the tests hand it an EGL standalone one, the window Qt's.
+Arithmetic is float32 whatever `config.dtype` says.
+
+State on the GPU: the shifted post-collision populations g_i = f*_i - w_i RHO0 in three RGBA32F
+textures per ping-pong side (G0 = g0..g3, G1 = g4..g7, G2 = g8), written by one fused
+collide+stream pass through three colour attachments (MRT). llvmpipe executes both sides of a
+divergent branch, so the step is drawn as rectangles, each with the variant of
+`shaders/lbm_step.glsl` it needs: the interior (plain streaming, the fast path), the edge rows
+and columns (walls, inlet, outlet, wrap), and the body window (Bouzidi links, solid nodes).
+
+Body: a node mask (R32UI: bit 0 solid, bit i when q[OPP[i], x] > 0, bit 8+i when that link
+takes the two-node interpolation) and the link fractions q (two RGBA32F: q[1..4], q[5..8]) are
+uploaded in `set_body` only, and only over the union of the old and new body windows. Wall
+velocities come from uniforms (V, Omega, centre). Refill, impulses and every force model run on
+the CPU on the read-back body window, with the numpy reference's code (`solver/body.py`,
+`solver/bouzidi.py`, `solver/forces/`): per step with forces, 3 small reads of the window.
+
+API for the app (a QOpenGLWidget sharing this context):
+- `field_texture()` -> moderngl.Texture, nx x ny, RGBA32F = (rho, ux, uy, vorticity), computed
+  by a pass only when called (u as `Solver.macroscopic`; vorticity duy/dx - dux/dy by central
+  differences). NEAREST filtering; bind it with `.use(location=k)` in your own draw.
+- `grid_size` -> (nx, ny); `renderer` -> the GL renderer string; `finish()` waits for the GPU.
+- Every pass sets the state it needs: `ctx.enable_only(moderngl.NOTHING)` (Qt enters paintGL
+  with blending on), no scissor, its own framebuffer and viewport, and binds every texture unit
+  it samples (units 0..7) right before drawing. Nothing is restored: after `step()` or
+  `field_texture()` the bound framebuffer is the solver's, so a paintGL must re-bind its own
+  (`ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`) and its own textures.
+- Divergence: a non-finite value in the body window (read each step that computes forces) or
+  in the tile sums of the finite check (every `check_interval` steps, default every step, read
+  back one step late so the pipeline keeps running, and at the end of each `step(n)`) raises
+  `solver.backend.SolverDiverged` with the step that produced it, as the reference does.
+"""
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from solver.backend import BackendError, Solver, SolverDiverged
+from solver.body import BodyState, expand_box, make_body_state, refill, shifted, union_box, unshifted, window_margin
+from solver.forces import create_model
+from solver.forces.base import BodyWindow
+from solver.gl_programs import create_program
+from solver.inflow import profile, ramp
+from solver.lattice import C, OPP, Q, RHO0, equilibrium
+from solver.numpy_backend import relaxation_rates
+from solver.speed_limit import cap_speed
+
+#: texture units (fixed; every pass binds all it samples)
+UNIT_G = (0, 1, 2)
+UNIT_MASK, UNIT_QA, UNIT_QB, UNIT_INFLOW, UNIT_OMEGA = 3, 4, 5, 6, 7
+#: tile edge of the finite check
+CHECK_BLOCK = 16
+#: region rectangles are aligned to llvmpipe's 4x4 shading blocks
+ALIGN = 4
+_Y_MODE = {"no_slip": 0, "free_slip": 1, "periodic": 2}
+
+
+def _box_minus(outer, inner):
+    """Rectangles (x0, y0, x1, y1) covering `outer` minus `inner` (half-open boxes)."""
+    ox0, oy0, ox1, oy1 = outer
+    ix0, iy0 = max(inner[0], ox0), max(inner[1], oy0)
+    ix1, iy1 = min(inner[2], ox1), min(inner[3], oy1)
+    if ix0 >= ix1 or iy0 >= iy1:
+        return [outer]
+    rects = [(ox0, oy0, ox1, iy0), (ox0, iy1, ox1, oy1), (ox0, iy0, ix0, iy1), (ix1, iy0, ox1, iy1)]
+    return [r for r in rects if r[0] < r[2] and r[1] < r[3]]
+
+
+def _triangles(rects) -> np.ndarray:
+    """Two triangles per rectangle, texel-edge coordinates, float32 (k*6, 2)."""
+    out = []
+    for x0, y0, x1, y1 in rects:
+        out += [(x0, y0), (x1, y0), (x1, y1), (x0, y0), (x1, y1), (x0, y1)]
+    return np.asarray(out, dtype="f4").reshape(-1, 2)
+
+
+def node_mask(solid: np.ndarray, q: np.ndarray, box) -> np.ndarray:
+    """The shader's node mask over box (x0, y0, x1, y1), uint32 (h, w), from full-grid arrays.
+
+    bit 0: solid; bit i (1..8): q[OPP[i], x] > 0 (rule 1a for f_i^in); bit 8+i: additionally
+    q < 1/2, x + c_i is a fluid node in the domain and q[i, x] == 0 (two-node interpolation).
+    """
+    ny, nx = solid.shape
+    x0, y0, x1, y1 = box
+    sl = (slice(y0, y1), slice(x0, x1))
+    fluid_pad = np.pad(~solid, 1, constant_values=False)  # outside the domain: not fluid
+    mask = solid[sl].astype(np.uint32)
+    for i in range(1, Q):
+        ib = OPP[i]
+        cut = (q[ib][sl] > 0) & ~solid[sl]
+        cx, cy = int(C[i, 0]), int(C[i, 1])
+        second_fluid = fluid_pad[y0 + 1 + cy:y1 + 1 + cy, x0 + 1 + cx:x1 + 1 + cx]
+        two_node = cut & (q[ib][sl] < 0.5) & second_fluid & (q[i][sl] == 0)
+        mask |= cut.astype(np.uint32) << np.uint32(i)
+        mask |= two_node.astype(np.uint32) << np.uint32(8 + i)
+    return mask
+
+
+class GLSolver(Solver):
+    """docs/algorithm.md on the GPU (fragment shaders), float32; see the module docstring."""
+
+    name = "gl"
+    #: default tuning (docs/performance.md measures each choice)
+    TUNING = {"split": True, "fetch_normalized": True}
+
+    def __init__(self, config, ctx=None, check_interval: int = 1, tuning: dict | None = None):
+        super().__init__(config)
+        if ctx is None or not isinstance(ctx, moderngl.Context):
+            raise BackendError("the gl backend needs a moderngl.Context (ctx=); it never creates one")
+        self.ctx = ctx
+        self.check_interval = int(check_interval)
+        self.tuning = {**self.TUNING, **(tuning or {})}
+        cfg = self.config
+        nx, ny = cfg.nx, cfg.ny
+        self.nx, self.ny = nx, ny
+        self.renderer = ctx.info.get("GL_RENDERER", "?")
+        sponge = cfg.x_boundary == "tunnel" and cfg.sponge_cells > 0
+        defines = {
+            "TRT": cfg.collision == "trt",
+            "GUO_FORCE": any(c != 0.0 for c in cfg.body_force),
+            "X_PERIODIC": cfg.x_boundary == "periodic",
+            "Y_MODE": _Y_MODE[cfg.y_boundary],
+            "FETCH_NORMALIZED": bool(self.tuning["fetch_normalized"]),
+        }
+        self._defines = defines
+        self._sponge = sponge
+        self._programs = {}
+        op, om = relaxation_rates(cfg)
+        self._uniform_values = dict(
+            G0=UNIT_G[0], G1=UNIT_G[1], G2=UNIT_G[2], MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
+            INFLOW=UNIT_INFLOW, OMEGA=UNIT_OMEGA, N=(nx, ny), grid_size=(float(nx), float(ny)),
+            inv_n=(1.0 / nx, 1.0 / ny), body_force=tuple(float(v) for v in cfg.body_force),
+            omega_plus=float(np.ravel(op)[0]), omega_minus=float(np.ravel(om)[0]))  # column 0: no sponge
+        self._objects = []  # GL objects to release
+
+        def tex(size, components, dtype="f4", repeat=False):
+            t = ctx.texture(size, components, dtype=dtype)
+            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            t.repeat_x = t.repeat_y = repeat
+            self._objects.append(t)
+            return t
+
+        self._g = [[tex((nx, ny), 4, repeat=True) for _ in range(3)] for _ in range(2)]
+        self._fbo = [ctx.framebuffer(color_attachments=side) for side in self._g]
+        self._objects += self._fbo
+        self._cur = 0  # the side holding f*(t)
+        self._mask_tex = tex((nx, ny), 1, "u4")
+        self._qa_tex, self._qb_tex = tex((nx, ny), 4), tex((nx, ny), 4)
+        self._mask_tex.write(np.zeros((ny, nx), "u4"))
+        self._qa_tex.write(np.zeros((ny, nx, 4), "f4"))
+        self._qb_tex.write(np.zeros((ny, nx, 4), "f4"))
+        self._inflow_tex = tex((ny, 1), 1)
+        self._omega_tex = tex((nx, 1), 2)
+        rates = np.stack(np.broadcast_arrays(np.asarray(op, float) * np.ones(nx), np.asarray(om, float)), -1)
+        self._omega_tex.write(rates.astype("f4").tobytes())
+        self._inflow_key = None
+        self._draws = []
+        self._field = self._check = None
+        self._pending_check = None
+
+        self.inflow_speed = float(cfg.inflow_speed)
+        self.inflow_capped = False
+        self.body: BodyState | None = None
+        self._impulse = (0.0, 0.0)
+        self._models = {}
+        self._forces: dict[str, tuple[float, float]] = {}
+        self._set_rects(None)
+        self._upload_body_uniforms()
+        ux0, uy0 = cfg.initial_velocity
+        self.set_distributions(equilibrium(np.full((ny, nx), RHO0), np.full((ny, nx), float(ux0)),
+                                           np.full((ny, nx), float(uy0))))
+
+    # --- helpers ----------------------------------------------------------------
+    @staticmethod
+    def _uniforms(prog, **values):
+        for name, value in values.items():
+            if name in prog:  # the compiler drops unused uniforms
+                prog[name].value = value
+
+    def _program(self, key):
+        """The step variant for region `key` = (body, edges, sponge), compiled on first use."""
+        if key not in self._programs:
+            body, edges, sponge = key
+            defines = {**self._defines, "BODY": body, "EDGES": edges, "SPONGE": sponge}
+            prog = create_program(self.ctx, "rect_vertex.glsl", "lbm_step.glsl", defines)
+            self._uniforms(prog, **self._uniform_values)
+            self._programs[key] = prog
+            if body:
+                self._upload_body_uniforms()
+        return self._programs[key]
+
+    def _regions(self, window):
+        """{(body, edges, sponge): [rectangles]}: which variant draws which part of the grid.
+
+        Rectangles are aligned to llvmpipe's 4x4 pixel blocks (a partly covered block runs the
+        whole shader), so the edge strips are ALIGN wide and the body window is grown to them.
+        """
+        nx, ny, a = self.nx, self.ny, ALIGN
+        sp = int(self._sponge)
+        x1, y1 = (nx - 1) // a * a, (ny - 1) // a * a
+        if not self.tuning["split"] or x1 <= a or y1 <= a:
+            return {(1, 1, sp): [(0, 0, nx, ny)]}
+        interior = (a, a, x1, y1)
+        edges = [(0, 0, nx, a), (0, y1, nx, ny), (0, a, a, y1), (x1, a, nx, y1)]
+        parts = {(0, 0, 0): [interior], (0, 1, sp): edges}
+        if window is not None and window[0] < window[2] and window[1] < window[3]:
+            w = (window[0] // a * a, window[1] // a * a, min(nx, -(-window[2] // a) * a),
+                 min(ny, -(-window[3] // a) * a))
+            parts[(0, 0, 0)] = _box_minus(interior, w)
+            parts[(0, 1, sp)] = [r for e in edges for r in _box_minus(e, w)]
+            inside = w[0] >= a and w[1] >= a and w[2] <= x1 and w[3] <= y1
+            parts[(1, 0, sp) if inside else (1, 1, sp)] = [w]
+        if sp:  # the sponge columns (aligned down) get the variant with per-column rates
+            xs = (nx - self.config.sponge_cells) // a * a
+            plain, sponge = [], []
+            for r in parts[(0, 0, 0)]:
+                if r[0] < xs:
+                    plain.append((r[0], r[1], min(r[2], xs), r[3]))
+                if r[2] > xs:
+                    sponge.append((max(r[0], xs), r[1], r[2], r[3]))
+            parts[(0, 0, 0)], parts[(0, 0, 1)] = plain, sponge
+        return {k: v for k, v in parts.items() if v}
+
+    def _set_rects(self, window):
+        """Vertex data of every region (see _regions), drawn in this order each step."""
+        for vao, vbo in self._draws:
+            vao.release()
+            vbo.release()
+        self._draws = []
+        for key, rects in sorted(self._regions(window).items()):
+            vbo = self.ctx.buffer(_triangles(rects).tobytes())
+            vao = self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")])
+            self._draws.append((vao, vbo))
+
+    def _upload_body_uniforms(self):
+        b = self.body
+        centre = (0.0, 0.0) if b is None else (float(b.shape.x), float(b.shape.y))
+        velocity = (0.0, 0.0) if b is None else tuple(float(v) for v in b.velocity)
+        omega = 0.0 if b is None else float(b.omega)
+        for key, prog in self._programs.items():
+            if key[0]:
+                self._uniforms(prog, body_velocity=velocity, body_omega=omega, body_centre=centre)
+
+    def _update_inflow(self, t):
+        """u_in(iy, t) = ramp(t) profile(iy) (solver/inflow.py): the ramp as a uniform each
+        step, the profile texture rewritten only when the speed changes (a texture write while
+        a queued step reads it would stall the pipeline)."""
+        cfg = self.config
+        if cfg.x_boundary != "tunnel":
+            return
+        if self._inflow_key != self.inflow_speed:
+            self._inflow_key = self.inflow_speed
+            self._inflow_tex.write(profile(cfg.ny, self.inflow_speed, cfg.inflow_profile).astype("f4").tobytes())
+        r = ramp(t, cfg.inflow_ramp_steps)
+        for key, prog in self._programs.items():
+            if key[1]:
+                self._uniforms(prog, inflow_ramp=r)
+
+    def _begin_pass(self, fbo, size):
+        """The state every pass needs, whatever the host (Qt) left: see the module docstring."""
+        ctx = self.ctx
+        ctx.enable_only(moderngl.NOTHING)
+        ctx.scissor = None
+        fbo.use()
+        ctx.viewport = (0, 0, *size)
+
+    def _bind_sources(self, side):
+        for unit, texture in zip(UNIT_G, self._g[side]):
+            texture.use(location=unit)
+        self._mask_tex.use(location=UNIT_MASK)
+        self._qa_tex.use(location=UNIT_QA)
+        self._qb_tex.use(location=UNIT_QB)
+        self._inflow_tex.use(location=UNIT_INFLOW)
+        self._omega_tex.use(location=UNIT_OMEGA)
+
+    # --- inflow -------------------------------------------------------------------
+    def set_inflow_speed(self, speed: float) -> None:
+        """Change the inlet speed U (tunnel), capped at config.max_speed (see inflow_capped)."""
+        u, _, capped = cap_speed(float(speed), 0.0, self.config.max_speed)
+        self.inflow_speed, self.inflow_capped = u, capped
+        self.speed_capped = capped or bool(self.body and self.body.capped)
+
+    # --- stepping ---------------------------------------------------------------
+    def _one_step(self):
+        self._update_inflow(self.time)
+        src, dst = self._cur, 1 - self._cur
+        self._begin_pass(self._fbo[dst], (self.nx, self.ny))
+        self._bind_sources(src)
+        for vao, _ in self._draws:
+            vao.render(moderngl.TRIANGLES)
+        self._cur = dst
+        self.time += 1
+
+    def step(self, n: int = 1) -> None:
+        n = int(n)
+        sums = {name: [0.0, 0.0] for name in self._models}
+        for _ in range(n):
+            src, impulse = self._cur, self._impulse
+            self._impulse = (0.0, 0.0)
+            self._one_step()  # queued; the forces of f*(t) are computed while the GPU runs it
+            if self._models and self.body is not None:
+                win = self._window(src, impulse)
+                if not np.all(np.isfinite(win.f)):
+                    raise SolverDiverged(self.time - 1, "non-finite populations around the body")
+                for name, model in self._models.items():
+                    fx, fy = model.compute(win)
+                    sums[name][0] += fx
+                    sums[name][1] += fy
+            if self.check_interval > 0 and self.time % self.check_interval == 0:
+                self._check_finite()
+        if n > 0:
+            self._check_finite(final=True)
+            self._forces = {name: (s[0] / n, s[1] / n) for name, s in sums.items()}
+
+    def time_variant(self, key, draws: int) -> float:
+        """Seconds to draw step variant `key` = (body, edges, sponge) over the whole grid
+        `draws` times (the state is advanced: for docs/performance.md's cost table only)."""
+        import time
+
+        vbo = self.ctx.buffer(_triangles([(0, 0, self.nx, self.ny)]).tobytes())
+        vao = self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")])
+        self._update_inflow(self.time)
+        self.finish()
+        t0 = time.perf_counter()
+        for _ in range(draws):
+            self._begin_pass(self._fbo[1 - self._cur], (self.nx, self.ny))
+            self._bind_sources(self._cur)
+            vao.render(moderngl.TRIANGLES)
+            self._cur = 1 - self._cur
+        self.finish()
+        elapsed = time.perf_counter() - t0
+        vao.release()
+        vbo.release()
+        return elapsed
+
+    def finish(self) -> None:
+        """Wait until the GPU has done all queued work (for honest timing)."""
+        self.ctx.finish()
+
+    # --- divergence -------------------------------------------------------------
+    def _aux_pass(self, fragment, size, defines=None):
+        """(program, texture, framebuffer, vao) of a one-rectangle pass into an RGBA32F target."""
+        prog = create_program(self.ctx, "rect_vertex.glsl", fragment, defines)
+        tex = self.ctx.texture(size, 4, dtype="f4")
+        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        fbo = self.ctx.framebuffer(color_attachments=[tex])
+        vbo = self.ctx.buffer(_triangles([(0, 0, *size)]).tobytes())
+        vao = self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
+        self._objects += [vao, vbo, fbo, tex, prog]
+        self._uniforms(prog, G0=UNIT_G[0], G1=UNIT_G[1], G2=UNIT_G[2], N=(self.nx, self.ny),
+                       grid_size=(float(size[0]), float(size[1])),
+                       body_force=tuple(float(v) for v in self.config.body_force))
+        return prog, tex, fbo, vao
+
+    def _issue_check(self):
+        """Queue the tile sums of the current state into one of two targets; return it."""
+        if self._check is None:
+            size = (-(-self.nx // CHECK_BLOCK), -(-self.ny // CHECK_BLOCK))
+            first = self._aux_pass("finite_check.glsl", size, {"BLOCK": CHECK_BLOCK})
+            tex = self.ctx.texture(size, 4, dtype="f4")
+            fbo = self.ctx.framebuffer(color_attachments=[tex])
+            self._objects += [fbo, tex]
+            self._check = (first, (first[0], tex, fbo, first[3]))
+            self._check_slot = 0
+        prog, tex, fbo, vao = self._check[self._check_slot]
+        self._check_slot = 1 - self._check_slot
+        self._begin_pass(fbo, tex.size)
+        self._g[self._cur][0].use(location=UNIT_G[0])
+        vao.render(moderngl.TRIANGLES)
+        return fbo
+
+    def _resolve_check(self):
+        """Read the pending check (one step old, so the GPU has usually finished it)."""
+        if self._pending_check is None:
+            return
+        step, fbo = self._pending_check
+        self._pending_check = None
+        sums = np.frombuffer(fbo.read(components=4, dtype="f4"), dtype="f4")
+        if not np.all(np.isfinite(sums)):
+            raise SolverDiverged(step, "density is no longer finite")
+
+    def _check_finite(self, final=False):
+        """Divergence check of the step just done (algorithm.md, 'Divergence'): the tile sums
+        are read one step late (pipelined), and at the end of each step(n) call."""
+        fbo = self._issue_check()
+        self._resolve_check()
+        self._pending_check = (self.time, fbo)
+        if final:
+            self._resolve_check()
+
+    # --- body -------------------------------------------------------------------
+    def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
+        cfg = self.config
+        old = self.body
+        new = None
+        if shape is not None:
+            new = make_body_state(shape, velocity, omega, cfg, window_margin(self._models.values()), raster)
+        box = union_box(old.raster.window if old else None, new.raster.window if new else None)
+        if box is not None:
+            box = expand_box(box, 1, cfg.nx, cfg.ny)
+            x0, y0, x1, y1 = box
+            shape_ = (y1 - y0, x1 - x0)
+            ys, xs = slice(y0, y1), slice(x0, x1)
+            old_solid = old.solid[ys, xs] if old else np.zeros(shape_, bool)
+            new_solid = new.solid[ys, xs] if new else np.zeros(shape_, bool)
+            motion = new if new is not None else old
+            g = self._read_shifted(box)
+            f = unshifted(g)
+            (jx, jy), changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0)
+            g[:, changed] = shifted(f[:, changed]).astype("f4")
+            self._write_shifted(g, box)
+            self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
+            self._upload_raster(new, expand_box(box, 1, cfg.nx, cfg.ny))
+        self.body = new
+        self.speed_capped = (new.capped if new is not None else False) or self.inflow_capped
+        self._set_rects(None if new is None else new.raster.window)
+        self._upload_body_uniforms()
+
+    def _upload_raster(self, body, box):
+        """Node mask and q of `body` (None: no body) over box, into their textures."""
+        x0, y0, x1, y1 = box
+        h, w = y1 - y0, x1 - x0
+        if body is None:
+            mask = np.zeros((h, w), np.uint32)
+            q = np.zeros((Q, h, w), np.float32)
+        else:
+            mask = node_mask(body.raster.solid, body.raster.q, box)
+            q = body.raster.q[:, y0:y1, x0:x1].astype(np.float32)
+        viewport = (x0, y0, w, h)
+        self._mask_tex.write(np.ascontiguousarray(mask).tobytes(), viewport=viewport)
+        self._qa_tex.write(np.ascontiguousarray(np.moveaxis(q[1:5], 0, -1)).tobytes(), viewport=viewport)
+        self._qb_tex.write(np.ascontiguousarray(np.moveaxis(q[5:9], 0, -1)).tobytes(), viewport=viewport)
+
+    # --- forces -----------------------------------------------------------------
+    def _rebuild_body_window(self):
+        b = self.body
+        if b is not None:
+            self.body = make_body_state(b.shape, b.velocity, b.omega, self.config,
+                                        window_margin(self._models.values()), b.raster)
+
+    def enable_force_models(self, names) -> None:
+        self._models = {name: create_model(name) for name in names}
+        self._forces = {}
+        self._rebuild_body_window()
+
+    def add_force_model(self, model) -> None:
+        """Enable an already-built model instance (e.g. with options), keyed by its name."""
+        self._models[model.name] = model
+        self._rebuild_body_window()
+
+    def forces(self) -> dict[str, tuple[float, float]]:
+        return dict(self._forces)
+
+    def body_window(self) -> BodyWindow | None:
+        """The body's force window at the current time (full f*, float64): 3 small reads."""
+        return None if self.body is None else self._window(self._cur, self._impulse)
+
+    def _window(self, side, impulse) -> BodyWindow:
+        b = self.body
+        solid, q = b.window_arrays()
+        f = unshifted(self._read_shifted(b.window, side))
+        return BodyWindow(x0=b.window[0], y0=b.window[1], f=f, solid=solid, q=q, shape=b.shape,
+                          velocity=b.velocity, omega=b.omega, impulse=impulse, config=self.config, links=b.links)
+
+    # --- fields -----------------------------------------------------------------
+    def _read_shifted(self, box=None, side=None) -> np.ndarray:
+        """Stored g (9, h, w) float32 over box (x0, y0, x1, y1), default the whole grid, of the
+        current ping-pong side (or `side`)."""
+        x0, y0, x1, y1 = box or (0, 0, self.nx, self.ny)
+        w, h = x1 - x0, y1 - y0
+        fbo = self._fbo[self._cur if side is None else side]
+        g = np.empty((12, h, w), dtype="f4")
+        for k in range(3):
+            data = fbo.read(viewport=(x0, y0, w, h), components=4, attachment=k, dtype="f4")
+            g[4 * k:4 * k + 4] = np.moveaxis(np.frombuffer(data, dtype="f4").reshape(h, w, 4), -1, 0)
+        return g[:Q]
+
+    def _write_shifted(self, g: np.ndarray, box=None) -> None:
+        x0, y0, x1, y1 = box or (0, 0, self.nx, self.ny)
+        w, h = x1 - x0, y1 - y0
+        padded = np.zeros((12, h, w), dtype="f4")
+        padded[:Q] = g
+        for k in range(3):
+            data = np.ascontiguousarray(np.moveaxis(padded[4 * k:4 * k + 4], 0, -1))
+            self._g[self._cur][k].write(data.tobytes(), viewport=(x0, y0, w, h))
+
+    def distributions(self) -> np.ndarray:
+        return unshifted(self._read_shifted())
+
+    def set_distributions(self, f: np.ndarray) -> None:
+        f = np.asarray(f, dtype=np.float64)
+        if f.shape != (Q, self.ny, self.nx):
+            raise ValueError(f"distributions must have shape {(Q, self.ny, self.nx)}, got {f.shape}")
+        self._write_shifted(shifted(f).astype("f4"))
+
+    def macroscopic(self):
+        """(rho, ux, uy) as Solver.macroscopic, summed on the shifted storage in float64."""
+        g = self._read_shifted()
+        rho = g.sum(axis=0, dtype=np.float64) + RHO0
+        fx, fy = self.config.body_force
+        jx = np.tensordot(C[:, 0].astype(np.float64), g, axes=1) - 0.5 * fx
+        jy = np.tensordot(C[:, 1].astype(np.float64), g, axes=1) - 0.5 * fy
+        return rho, jx / rho, jy / rho
+
+    def total_mass(self) -> float:
+        """sum f over the grid, accumulated in float64 on the shifted storage."""
+        return float(self._read_shifted().sum(dtype=np.float64)) + RHO0 * self.nx * self.ny
+
+    @property
+    def grid_size(self):
+        return self.nx, self.ny
+
+    def field_texture(self):
+        """(rho, ux, uy, vorticity) as an nx x ny RGBA32F texture, computed now by one pass."""
+        if self._field is None:
+            self._field = self._aux_pass("field.glsl", (self.nx, self.ny))
+        prog, tex, fbo, vao = self._field
+        self._begin_pass(fbo, tex.size)
+        for unit, texture in zip(UNIT_G, self._g[self._cur]):
+            texture.use(location=unit)
+        vao.render(moderngl.TRIANGLES)
+        return tex
+
+    def close(self) -> None:
+        for obj in [*(o for d in self._draws for o in d), *self._objects, *self._programs.values()]:
+            obj.release()
+        self._draws, self._objects, self._programs = [], [], {}
+        self._field = self._check = None

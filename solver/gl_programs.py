@@ -1,0 +1,75 @@
+"""Loading the GLSL programs in `shaders/`: lattice constants injected, driver lines kept true.
+
+Every file in `shaders/` is one shader stage whose line 1 is the `#version` directive for GLSL
+330 core (GL 3.3 core, which macOS's 4.1 core also runs). A line `// @LATTICE` is replaced by the D2Q9 constants of
+`solver.lattice.glsl_constants()` (the one lattice definition, DESIGN rule 3) and by any
+compile-time `#define`s a variant asks for; a `#line` directive after the injected block puts
+the driver's line numbers back on the file's own lines, so a compile error reported by the
+driver as "0:57(3)" is line 57 of the file. `ShaderError` names the file and that line.
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from solver.lattice import glsl_constants
+
+SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
+MARKER = "// @LATTICE"
+#: what line 1 of every shader must declare after `#version`
+GLSL_VERSION = "330 core"
+_DRIVER_LINE = re.compile(r"^\s*\d+:(\d+)\((\d+)\):\s*(.*)$")
+
+
+class ShaderError(RuntimeError):
+    """A shader failed to load or compile; the message starts with `file:line:`."""
+
+
+def shader_source(name: str, defines: dict | None = None, directory: Path = SHADER_DIR) -> str:
+    """The text of `shaders/<name>` with constants and defines injected at the marker."""
+    path = Path(directory) / name
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ShaderError(f"{path}: cannot read shader: {exc.strerror}") from None
+    lines = text.splitlines()
+    if not lines or lines[0].split(None, 1) != ["#version", GLSL_VERSION]:
+        raise ShaderError(f"{path}:1: the first line must be the #version directive for GLSL {GLSL_VERSION}")
+    out = []
+    for number, line in enumerate(lines, start=1):
+        if line.strip() == MARKER:
+            out.extend(f"#define {k} {int(v) if isinstance(v, bool) else v}" for k, v in (defines or {}).items())
+            out.append(glsl_constants())
+            out.append(f"#line {number + 1}")
+        else:
+            out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def _explain(path: Path, log: str) -> str:
+    """Turn the driver's log into 'file:line:col: message' lines."""
+    messages = []
+    for raw in log.splitlines():
+        m = _DRIVER_LINE.match(raw)
+        if m:
+            messages.append(f"{path}:{m.group(1)}:{m.group(2)}: {m.group(3)}")
+    return "\n".join(messages) if messages else f"{path}: {log.strip()}"
+
+
+def create_program(ctx, vertex: str, fragment: str, defines: dict | None = None,
+                   directory: Path = SHADER_DIR):
+    """Compile `shaders/<vertex>` + `shaders/<fragment>` into a moderngl Program.
+
+    Raises ShaderError whose first line is `<file>:<line>:<col>: <driver message>`.
+    """
+    vs = shader_source(vertex, defines, directory)
+    fs = shader_source(fragment, defines, directory)
+    try:
+        return ctx.program(vertex_shader=vs, fragment_shader=fs)
+    except Exception as exc:  # moderngl raises a plain Error with the driver's log
+        log = str(exc)
+        stage = fragment
+        if "vertex_shader\n" in log and "fragment_shader\n" not in log:
+            stage = vertex
+        body = log.split("===============", 1)[-1]
+        raise ShaderError(_explain(Path(directory) / stage, body)) from None

@@ -1,0 +1,92 @@
+"""The gl backend's own duties: field texture for the app, robustness to a host's GL state,
+divergence detection, no context creation."""
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+import pytest
+from conftest import make_solver
+
+from shapes import Cylinder
+from solver.backend import BackendError, SolverDiverged, create_solver
+from solver.config import FlowConfig
+from solver.lattice import equilibrium
+
+pytestmark = pytest.mark.gl
+
+
+def _disturbed(nx, ny, seed=2):
+    rng = np.random.default_rng(seed)
+    return equilibrium(1 + 1e-3 * rng.standard_normal((ny, nx)), 0.03 * rng.standard_normal((ny, nx)),
+                       0.03 * rng.standard_normal((ny, nx)))
+
+
+def test_needs_a_context():
+    with pytest.raises(BackendError, match="moderngl.Context"):
+        create_solver("gl", FlowConfig(nx=16, ny=16))
+
+
+def test_field_texture_holds_moments_and_vorticity(request):
+    cfg = FlowConfig(nx=40, ny=24, x_boundary="periodic", y_boundary="periodic", body_force=(1e-5, 0.0))
+    s = make_solver("gl", cfg, request)
+    s.set_distributions(_disturbed(40, 24))
+    s.step(5)
+    tex = s.field_texture()
+    assert tex.size == (40, 24) and tex.components == 4 and tex.dtype == "f4"
+    field = np.frombuffer(tex.read(), dtype="f4").reshape(24, 40, 4)
+    rho, ux, uy = s.macroscopic()
+    assert np.allclose(field[..., 0], rho, rtol=0, atol=1e-6)
+    assert np.allclose(field[..., 1], ux, rtol=0, atol=1e-6)
+    assert np.allclose(field[..., 2], uy, rtol=0, atol=1e-6)
+    # vorticity: central differences inside, one-sided at the domain edges (np.gradient)
+    vort = np.gradient(uy, axis=1, edge_order=1) - np.gradient(ux, axis=0, edge_order=1)
+    assert np.allclose(field[..., 3], vort, rtol=0, atol=1e-5)
+
+
+def test_steps_ignore_the_host_gl_state(gl_context, request):
+    """Qt enters paintGL with blending on and its own textures bound (notes, pitfalls 2-3):
+    the solver's result must not depend on that."""
+    cfg = FlowConfig(nx=48, ny=32, inflow_ramp_steps=10)
+    a, b = make_solver("gl", cfg, request), make_solver("gl", cfg, request)
+    for s in (a, b):
+        s.set_body(Cylinder(8.0, x=16.0, y=16.0), velocity=(0.01, 0.0))
+    a.step(10)
+    ctx = gl_context
+    junk = ctx.texture((4, 4), 4, dtype="f4", data=np.full(64, 7.0, "f4").tobytes())
+    other = ctx.framebuffer(color_attachments=[ctx.texture((4, 4), 4)])
+    for _ in range(10):
+        ctx.enable(moderngl.BLEND | moderngl.CULL_FACE)
+        ctx.blend_func = moderngl.ONE, moderngl.ONE
+        for unit in range(8):
+            junk.use(location=unit)
+        other.use()
+        ctx.viewport = (0, 0, 2, 2)
+        b.step(1)
+        b.field_texture()
+    assert np.array_equal(a.distributions(), b.distributions())
+    ctx.enable_only(moderngl.NOTHING)
+
+
+def test_divergence_raises(request):
+    cfg = FlowConfig(nx=32, ny=32, x_boundary="periodic", y_boundary="periodic")
+    s = make_solver("gl", cfg, request)
+    f = _disturbed(32, 32)
+    f[3, 10, 7] = np.nan
+    s.set_distributions(f)
+    with pytest.raises(SolverDiverged):
+        s.step(1)
+
+
+def test_body_upload_touches_only_the_window(request):
+    """Moving the body rewrites mask and q only near the old and new windows, and removing
+    it clears them."""
+    cfg = FlowConfig(nx=64, ny=32)
+    s = make_solver("gl", cfg, request)
+    s.set_body(Cylinder(6.0, x=20.0, y=16.0))
+    s.set_body(Cylinder(6.0, x=21.5, y=16.0))
+    mask = np.frombuffer(s._mask_tex.read(), dtype="u4").reshape(32, 64)
+    solid = s.body.raster.solid
+    assert np.array_equal((mask & 1).astype(bool), solid)
+    s.set_body(None)
+    mask = np.frombuffer(s._mask_tex.read(), dtype="u4").reshape(32, 64)
+    assert not mask.any()
