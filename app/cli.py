@@ -18,6 +18,7 @@ COMMANDS = {
     "bench": "measure solver speed (both backends) or the haptic loop",
     "devices": "list haptic devices: serial ports, HID devices, simulators",
     "report": "reproduce the seed's experiments and write a Markdown report",
+    "session": "inspect, replay or export a recorded session file",
 }
 
 

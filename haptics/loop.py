@@ -109,6 +109,7 @@ class ForceLoop:
         self._max_cmd = 0.0
         self._disconnect_reason = None
         self._old_switch = None
+        self.callback_error = None  # what on_disconnect raised, if it did
         self.scheduling = "not started"  # how the loop thread is scheduled (see _raise_priority)
         self.recording: dict[str, list] = {"t": [], "body_x": [], "body_y": [], "fx": [], "fy": [],
                                            "pose_x": []}
@@ -209,7 +210,10 @@ class ForceLoop:
         self._zero_device()
         self._stop_evt.set()
         if self.on_disconnect is not None:
-            self.on_disconnect(reason)
+            try:
+                self.on_disconnect(reason)
+            except Exception as exc:  # the app's bug must not keep a motor driven
+                self.callback_error = repr(exc)
 
     def _raise_priority(self) -> str:
         """Make this (the loop) thread wake on time on a busy machine; returns what worked."""
@@ -265,13 +269,13 @@ class ForceLoop:
             (bx, by), (vx, vy) = self.coupling.step(proxy, dt)
             self._target = BodyTarget(bx, by, vx, vy, now, p.buttons, True)
         # 2. solver samples -> smooth force
-        with self._lock:
+        with self._lock:  # (clearing 'nan' under the lock: a NaN submitted meanwhile wins)
             sample, arrival = self._mailbox, self._mailbox_arrival
             self._mailbox = None
+            if sample is not None:
+                self.gate.set_fault("nan", False)
         if sample is not None:
             self.shaper.add(sample.fx, sample.fy, arrival)
-            self.gate.set_fault("nan", False)
-            self.gate.set_fault("stall", False)
         due = self.shaper.next_due
         stalled = due is None or now > due + self.config.safety.stall_timeout
         self.gate.set_fault("stall", stalled)

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 HARD = ("stopped", "nan", "disconnected")
-SOFT = ("stall", "paused")
+SOFT = ("paused", "stall")
 
 
 @dataclass

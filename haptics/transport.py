@@ -6,6 +6,7 @@ Every I/O error becomes `DeviceDisconnected`, so the force loop has one thing to
 """
 from __future__ import annotations
 
+import os
 import time
 
 from haptics.errors import DeviceDisconnected, DeviceError
@@ -21,19 +22,43 @@ class SerialTransport:
 
         self.name = port
         self._serial_exc = serial.SerialException
+        self._pending = bytearray()
         if port_object is not None:
             self._port = port_object
-            return
+        else:
+            try:
+                self._port = serial.serial_for_url(port, baudrate=baudrate, timeout=0, write_timeout=0.5)
+            except (serial.SerialException, OSError, ValueError) as exc:
+                raise DeviceError(f"cannot open serial port {port}: {exc}") from None
+        # On POSIX ports, write to the (non-blocking) descriptor ourselves: pyserial's write
+        # with a timeout raises 'Write timeout' AFTER writing when the calling thread was merely
+        # descheduled for longer than the timeout, and with timeout 0 it spins on EAGAIN.
         try:
-            self._port = serial.serial_for_url(port, baudrate=baudrate, timeout=0, write_timeout=0.05)
-        except (serial.SerialException, OSError, ValueError) as exc:
-            raise DeviceError(f"cannot open serial port {port}: {exc}") from None
+            self._fd = self._port.fileno() if hasattr(self._port, "fileno") else None
+        except Exception:  # loop:// and Windows ports have no usable descriptor
+            self._fd = None
+
+    #: bytes the device may leave unread before it counts as hung (about 0.3 s of commands)
+    MAX_PENDING = 4096
 
     def write(self, data: bytes) -> None:
+        """Queue and send without blocking; what the port cannot take now goes out next time."""
+        if self._fd is None:
+            try:
+                self._port.write(data)
+            except (self._serial_exc, OSError, TypeError, AttributeError) as exc:
+                raise DeviceDisconnected(f"serial port {self.name} lost: {exc}") from None
+            return
+        self._pending += data
         try:
-            self._port.write(data)
-        except (self._serial_exc, OSError, TypeError, AttributeError) as exc:
+            n = os.write(self._fd, self._pending)
+        except BlockingIOError:
+            n = 0
+        except (OSError, TypeError, ValueError) as exc:
             raise DeviceDisconnected(f"serial port {self.name} lost: {exc}") from None
+        del self._pending[:n]
+        if len(self._pending) > self.MAX_PENDING:
+            raise DeviceDisconnected(f"serial port {self.name}: the device stopped reading")
 
     def read_available(self) -> bytes:
         """Whatever bytes have arrived, without waiting (b'' if none)."""

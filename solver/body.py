@@ -103,6 +103,29 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
     return (jx, jy), (new_solid | uncovered)
 
 
+def move_body(old, new, config, read_window, write_nodes):
+    """Cover/uncover bookkeeping between two body states (either may be None), for any backend.
+
+    read_window(x0, y0, x1, y1) -> (9, y1-y0, x1-x0) float64 full f* of that box;
+    write_nodes(x0, y0, f, changed) writes back the nodes where `changed` (the window's (h, w)
+    mask) is True. The box is the union of both raster windows grown by one node (the refill's
+    neighbours). Returns the impulse (Jx, Jy) to add to the next step's force.
+    """
+    box = union_box(old.raster.window if old else None, new.raster.window if new else None)
+    if box is None:
+        return 0.0, 0.0
+    x0, y0, x1, y1 = expand_box(box, 1, config.nx, config.ny)
+    ys, xs = slice(y0, y1), slice(x0, x1)
+    shape = (y1 - y0, x1 - x0)
+    old_solid = old.solid[ys, xs] if old else np.zeros(shape, bool)
+    new_solid = new.solid[ys, xs] if new else np.zeros(shape, bool)
+    motion = new if new is not None else old
+    f = read_window(x0, y0, x1, y1)
+    impulse, changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0)
+    write_nodes(x0, y0, f, changed)
+    return impulse
+
+
 @dataclass
 class BodyState:
     """The body on the grid: shape at its pose, capped motion, raster, windows and links.

@@ -1,12 +1,15 @@
 """Shared helpers for the haptics tests (kept out of conftest.py, which other helpers own)."""
 from __future__ import annotations
 
+import math
+import os
+import threading
 import time
 
 import numpy as np
 
 
-def wait_for(cond, timeout=2.0, step=0.002):
+def wait_for(cond, timeout=3.0, step=0.002):
     """Poll `cond()` until true or timeout; returns its last value."""
     deadline = time.monotonic() + timeout
     while True:
@@ -16,14 +19,49 @@ def wait_for(cond, timeout=2.0, step=0.002):
         time.sleep(step)
 
 
-def feed(loop, value, seconds, hz=100.0, fy=0.0):
-    """Play the solver: submit a constant lattice force at `hz` for `seconds`."""
-    from haptics import ForceSample
+class Feeder:
+    """Plays the solver: submits (fx, fy) lattice force samples at `hz` from its own thread.
 
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        loop.submit_force(ForceSample(value, fy, time.monotonic()))
-        time.sleep(1.0 / hz)
+    It asks for a real-time slot (as the loop does) so that a loaded test machine does not
+    starve it: a starved feeder IS a solver stall, and the loop would rightly zero the force.
+    `sending = False` stops the samples (a stall on purpose).
+    """
+
+    def __init__(self, loop, fx=0.0, fy=0.0, hz=100.0):
+        from haptics import ForceSample
+
+        self.loop, self.fx, self.fy, self.hz = loop, fx, fy, hz
+        self.sending = True
+        self._stop = threading.Event()
+        self._sample = ForceSample
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self):
+        try:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(5))
+        except (OSError, AttributeError):
+            pass
+        next_t = time.monotonic()
+        while not self._stop.is_set():
+            if self.sending:
+                self.loop.submit_force(self._sample(self.fx, self.fy, time.monotonic()))
+            next_t += 1.0 / self.hz
+            time.sleep(max(0.0, next_t - time.monotonic()))
+
+    def close(self):
+        self._stop.set()
+        self._thread.join(1.0)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def force(loop) -> float:
+    return math.hypot(*loop.status().force)
 
 
 def record(loop):

@@ -24,6 +24,41 @@ if os.environ.get("DISPLAY"):
 GRID = (128, 64)
 
 
+@pytest.fixture(scope="module", autouse=True)
+def no_egl_context_current():
+    """libglvnd lets a thread have an EGL or a GLX context current, not both: the gl tier's
+    standalone EGL context (tests/conftest.py) is released while Qt's windows use GLX, and
+    made current again afterwards for the gl tests that follow."""
+    import ctypes
+
+    try:
+        egl = ctypes.CDLL("libEGL.so.1")
+    except OSError:
+        yield
+        return
+    egl.eglGetCurrentContext.restype = egl.eglGetCurrentDisplay.restype = ctypes.c_void_p
+    egl.eglGetCurrentSurface.restype = ctypes.c_void_p
+    egl.eglGetCurrentSurface.argtypes = [ctypes.c_int]
+    egl.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
+    saved = None
+    if egl.eglGetCurrentContext():
+        saved = (egl.eglGetCurrentDisplay(), egl.eglGetCurrentSurface(0x3059), egl.eglGetCurrentSurface(0x305A),
+                 egl.eglGetCurrentContext())
+        egl.eglMakeCurrent(saved[0], None, None, None)
+    yield
+    from PySide6.QtGui import QOpenGLContext
+    from PySide6.QtWidgets import QApplication
+
+    for w in QApplication.topLevelWidgets():
+        w.close()
+    QApplication.processEvents()
+    current = QOpenGLContext.currentContext()
+    if current is not None:
+        current.doneCurrent()
+    if saved is not None:
+        egl.eglMakeCurrent(*saved)
+
+
 @pytest.fixture
 def window(qtbot, tmp_path):
     from PySide6.QtCore import QSettings

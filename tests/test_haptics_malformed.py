@@ -7,20 +7,26 @@ import pytest
 from haptics import ForceLoop, LoopConfig, open_device
 from haptics.protocols import diyhid, hapkit, haply
 from haptics.protocols import spacemouse as sm
-from tests.haptics_helpers import feed, wait_for
+from tests.haptics_helpers import Feeder, wait_for
 
 
 def run_loop(dev):
     loop = ForceLoop(dev, LoopConfig(expected_peak=0.01))
+    loop.feeder = Feeder(loop, 0.01)
     loop.start()
     return loop
+
+
+def stop(loop):
+    loop.feeder.close()
+    loop.stop()
 
 
 def test_haply_garbage_and_truncated_replies():
     dev = open_device("sim://haply2diy")
     loop = run_loop(dev)
     try:
-        feed(loop, 0.01, 0.1)
+        assert wait_for(lambda: dev.counters["good"] > 50)
         before = dict(dev.counters)
         sim = dev.simulator
         sim.inject(b"\xff\xfe\x00garbage")  # noise
@@ -28,13 +34,12 @@ def test_haply_garbage_and_truncated_replies():
         sim.inject(bytes([5]) + struct.pack("<2f", float("nan"), 0.0))  # NaN angle
         sim.inject(bytes([5]) + struct.pack("<2f", 1e9, 0.0))  # impossible angle
         sim.hand.set(0.02, 0.11)
-        feed(loop, 0.01, 0.2)
-        c = dev.counters
-        assert c["dropped_bytes"] > before["dropped_bytes"]
+        assert wait_for(lambda: dev.counters["dropped_bytes"] > before["dropped_bytes"])
+        assert wait_for(lambda: abs(dev.last_pose.x - 0.02) < 1e-3)
         assert loop.status().running and loop.status().state != "disconnected"
         assert dev.last_pose.x == pytest.approx(0.02, abs=1e-3)  # still tracking the hand
     finally:
-        loop.stop()
+        stop(loop)
         dev.close()
 
 
@@ -51,7 +56,7 @@ def test_hapkit_bad_frames_are_counted():
     dev = open_device("sim://hapkit")
     loop = run_loop(dev)
     try:
-        feed(loop, 0.01, 0.1)
+        assert wait_for(lambda: dev.counters["good"] > 50)
         sim = dev.simulator
         frame = hapkit.encode_state(hapkit.State(1, 0.01, 0))
         sim.inject(frame[:-1] + bytes([frame[-1] ^ 0xFF]))  # bad CRC
@@ -61,13 +66,13 @@ def test_hapkit_bad_frames_are_counted():
         sim.inject(b"\xa5\x5a\x01\x82\xff")  # length beyond the maximum
         sim.inject(b"\x00\x11\x22\xa5")  # noise, ends on half a sync word
         sim.inject(frame[:6])  # truncated
-        feed(loop, 0.01, 0.2)
+        assert wait_for(lambda: dev.counters["unexpected"] == 1 and dev.counters["malformed"] >= 2)
         c = dev.counters
         assert c["bad_crc"] >= 1 and c["bad_version"] == 1 and c["unexpected"] == 1
         assert c["malformed"] >= 2 and c["dropped_bytes"] > 0
         assert loop.status().running
     finally:
-        loop.stop()
+        stop(loop)
         dev.close()
 
 
@@ -75,7 +80,7 @@ def test_hid_short_and_foreign_reports_are_counted():
     dev = open_device("sim://diyhid")
     loop = run_loop(dev)
     try:
-        feed(loop, 0.01, 0.1)
+        assert wait_for(lambda: dev.counters["good"] > 50)
         good = diyhid.encode_state(diyhid.State(3, 0.01, 0.0, 0.0, 0, 0))
         dev.simulator.inject(good[:5])  # truncated
         dev.simulator.inject(good[:1] + b"\x07" + good[2:])  # another protocol version
@@ -83,7 +88,7 @@ def test_hid_short_and_foreign_reports_are_counted():
         assert wait_for(lambda: dev.counters["dropped"] >= 3, 1.0)
         assert loop.status().running
     finally:
-        loop.stop()
+        stop(loop)
         dev.close()
 
 
@@ -106,5 +111,5 @@ def test_spacemouse_moves_the_pose_and_ignores_unknown_reports():
         dev.simulator.press(1)
         assert wait_for(lambda: loop.body_target().buttons == 1, 1.0)
     finally:
-        loop.stop()
+        stop(loop)
         dev.close()

@@ -178,3 +178,28 @@ def test_diyhid_rejects_other_versions_and_truncation():
     assert diyhid.decode_input(good) is not None
     assert diyhid.decode_input(good[:1] + b"\x02" + good[2:]) is None  # version 2
     assert diyhid.decode_input(good[:8]) is None  # truncated
+
+
+def test_hapkit_driver_over_pyserial_loopback():
+    # loop:// echoes what is written: the driver's own FORCE frames come back and are rejected
+    # as host-only ('unexpected'); a STATE frame written into the loop is read as the pose.
+    from haptics.drivers.hapkit import Hapkit
+    from haptics.transport import SerialTransport
+
+    dev = Hapkit(SerialTransport("loop://"), "loop://")
+    dev.transport.write(hapkit.encode_state(hapkit.State(3, 0.012, 1)))
+    pose = dev.poll()
+    assert (pose.x, pose.buttons) == (pytest.approx(0.012), 1)
+    dev._send_force(0.5, 0.0)
+    assert dev.poll() is None and dev.counters["unexpected"] == 1
+    dev.transport.close()
+
+
+def test_hid_driver_choice_by_usb_id():
+    from haptics.registry import hid_driver_for
+
+    assert hid_driver_for(0x046D, 0xC626) == "spacemouse"
+    assert hid_driver_for(0x256F, 0xC635) == "spacemouse"
+    assert hid_driver_for(0x16C0, 0x0486) == "diyhid"
+    assert hid_driver_for(0x16C0, 0x0486, usage_page=0x0001) is None  # a Teensy keyboard
+    assert hid_driver_for(0x1234, 0x5678) is None

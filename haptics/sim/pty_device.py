@@ -18,6 +18,7 @@ class PtyDevice:
         self._stop = threading.Event()
         self._lock = threading.Lock()
         self.bytes_in = 0
+        self.errors: list[str] = []  # exceptions raised while answering (should stay empty)
         self.muted = False  # True: the device hangs (reads, never answers) without closing the port
         self._thread = threading.Thread(target=self._run, name=f"sim:{self.port}", daemon=True)
         self._thread.start()
@@ -48,7 +49,11 @@ class PtyDevice:
             self.bytes_in += len(data)
             if self.muted:
                 continue
-            reply = self.on_bytes(data)
+            try:
+                reply = self.on_bytes(data)
+            except Exception as exc:  # a simulator bug must show, not silently hang the port
+                self.errors.append(repr(exc))
+                continue
             if reply:
                 self.inject(reply)
 

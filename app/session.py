@@ -1,0 +1,995 @@
+"""Sessions: record what drove the flow, save it as a versioned zip, replay or export it.
+
+Format (docs/sessions.md): a zip with `manifest.json` (format, version, FeelFlow version,
+backend, renderer, created time, the scene, counts), `parameters.json` (parameter changes) and
+`inputs.npz` / `forces.npz` (arrays, read with `allow_pickle=False`; never pickle).
+Every event carries its *session step* (steps simulated since recording began; it never
+decreases, a reset does not rewind it) and a global sequence number `seq` fixing the order of
+events within one step.
+
+Determinism comes from one code path: `SessionSolver` wraps a backend and is what the GUI, the
+headless runner and the replay all drive. Recording is a side effect of driving it, and replay
+feeds the recorded events back through the same methods, so on the same backend and machine the
+force series is reproduced bit for bit. The recorded series is kept in the file, so
+`Session.frames()` plays a file back without simulating (where the GPU differs).
+
+Qt-free: used by the GUI, the CLI (`feelflow session ...`) and tests.
+"""
+from __future__ import annotations
+
+import dataclasses
+import io
+import json
+import math
+import os
+import zipfile
+import zlib
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+
+from solver.backend import SolverDiverged, create_solver
+from solver.config import ConfigError, FlowConfig
+
+FORMAT = "feelflow-session"
+#: bumped whenever a version-1 reader would misread a file (docs/sessions.md, "Versioning")
+VERSION = 1
+SUFFIX = ".ffsession"
+
+MANIFEST = "manifest.json"
+PARAMETERS = "parameters.json"
+INPUTS = "inputs.npz"
+FORCES = "forces.npz"
+STATE = "state.npz"  # only when the recording started on a running flow (manifest "start")
+MEMBERS = (MANIFEST, PARAMETERS, INPUTS, FORCES)
+#: largest uncompressed member we read (a zip bomb is refused before it is inflated)
+MAX_MEMBER_BYTES = 1 << 30
+
+#: parameter name -> what its value is (docs/sessions.md, "Parameter changes")
+PARAMETER_NAMES = ("body", "inflow_speed", "nu", "force_models", "pause", "resume", "reset", "rebuild")
+#: array name -> (dtype, trailing shape) in each .npz member
+INPUT_ARRAYS = {"seq": ("int64", ()), "step": ("int64", ()), "pose": ("float64", (3,)),
+                "velocity": ("float64", (3,))}
+FORCE_ARRAYS = {"seq": ("int64", ()), "step": ("int64", ()), "n": ("int64", ()),
+                "body": ("float64", (4,)), "values": ("float64", None)}
+STATE_ARRAYS = {"f": ("float64", None)}
+#: a commanded body or inflow speed beyond this (one cell per step) is not a lattice velocity
+MAX_LATTICE_SPEED = 1.0
+
+
+def feelflow_version() -> str:
+    """The installed FeelFlow's version (pyproject.toml), or "unknown" from a bare checkout."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("feelflow")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+class SessionError(ValueError):
+    """A session file or recording is unusable; the message is one line naming what is wrong."""
+
+
+# --- the scene as the session stores it -------------------------------------------------------
+
+def config_to_dict(config: FlowConfig) -> dict:
+    """FlowConfig -> JSON-ready dict (tuples become lists; `extra` is kept if JSON-able)."""
+    d = {}
+    for f in dataclasses.fields(config):
+        v = getattr(config, f.name)
+        d[f.name] = list(v) if isinstance(v, tuple) else v
+    return d
+
+
+def config_from_dict(d) -> FlowConfig:
+    """The inverse of `config_to_dict`, validated; SessionError naming the bad key."""
+    if not isinstance(d, dict):
+        raise SessionError("scene.config must be an object")
+    names = {f.name for f in dataclasses.fields(FlowConfig)}
+    unknown = sorted(set(d) - names)
+    if unknown:
+        raise SessionError(f"scene.config has unknown key {unknown[0]!r}")
+    kwargs = {}
+    for key, v in d.items():
+        if key in ("body_force", "initial_velocity"):
+            if not isinstance(v, list) or len(v) != 2 or not all(_is_number(c) for c in v):
+                raise SessionError(f"scene.config.{key} must be two numbers")
+            v = (float(v[0]), float(v[1]))
+        kwargs[key] = v
+    try:
+        return FlowConfig(**kwargs).validate()
+    except ConfigError as exc:
+        raise SessionError(f"scene.config.{exc}") from None
+    except TypeError as exc:  # a missing nx/ny, or a value of the wrong type
+        raise SessionError(f"scene.config: {str(exc).splitlines()[0]}") from None
+
+
+def _is_number(v) -> bool:
+    return not isinstance(v, bool) and isinstance(v, (int, float)) and math.isfinite(v)
+
+
+def _shape_from_dict(d, where: str, config: FlowConfig):
+    from shapes.base import ShapeError
+    from shapes.io import from_dict
+
+    try:
+        shape = from_dict(d)
+        return shape.validate(config.nx, config.ny) if config is not None else shape.validate()
+    except (ShapeError, TypeError, ValueError) as exc:
+        raise SessionError(f"{where}: {str(exc).splitlines()[0]}") from None
+
+
+def _geometry(shape):
+    """What a shape is, without where it is: its dict minus the pose."""
+    if shape is None:
+        return None
+    d = shape.to_dict()
+    for k in ("x", "y", "angle"):
+        d.pop(k, None)
+    return d
+
+
+# --- recording --------------------------------------------------------------------------------
+
+class SessionRecorder:
+    """Collects a session: the scene, inputs, parameter changes and the force series.
+
+    Events are stamped with the recorder's clock `step` (session steps so far); `record_forces`
+    advances it. The optional `step=` arguments are checks: they must equal the clock (inputs,
+    parameters) or the clock + n (forces). Normally `SessionSolver` feeds a recorder; a caller
+    that drives its own solver may call the record_* methods in the order it drives it.
+    """
+
+    def __init__(self, config: FlowConfig, body=None, force_models=(), *, backend: str = "numpy",
+                 renderer: str | None = None, scene_toml: str | None = None,
+                 scene_source: str | None = None, scene_dict: dict | None = None):
+        self.config = config.validate()
+        self.body = body
+        self.force_models = tuple(force_models)
+        self.backend = backend
+        self.renderer = renderer or ("none (numpy on the CPU)" if backend == "numpy" else "unknown")
+        self.scene_toml = scene_toml
+        self.scene_source = scene_source
+        self.scene_dict = scene_dict
+        self.created = datetime.now(timezone.utc).isoformat(timespec="seconds")
+        self.step = 0
+        self._seq = 0
+        self._inputs: list[tuple] = []   # (seq, step, x, y, angle, vx, vy, omega)
+        self._parameters: list[dict] = []
+        self._forces: list[tuple] = []   # (seq, step, n, (x, y, vx, vy), {model: (fx, fy)})
+        self._models: list[str] = list(self.force_models)
+        #: set by SessionSolver.start_recording: how the running flow was when recording began
+        self.start: dict | None = None
+        self.state: np.ndarray | None = None  # its populations f (9, ny, nx)
+
+    @classmethod
+    def from_scene(cls, scene, *, scene_toml: str | None = None, backend: str | None = None,
+                   renderer: str | None = None) -> "SessionRecorder":
+        """A recorder for an `app.scene.Scene` (anything with config, body, force_models,
+        backend, source)."""
+        return cls(scene.config, scene.body, scene.force_models, backend=backend or scene.backend,
+                   renderer=renderer, scene_toml=scene_toml, scene_source=getattr(scene, "source", None))
+
+    def _stamp(self, step) -> tuple[int, int]:
+        if step is not None and int(step) != self.step:
+            raise ValueError(f"event at step {step}, but the recorder is at step {self.step}")
+        seq = self._seq
+        self._seq += 1
+        return seq, self.step
+
+    def record_input(self, x, y, angle=0.0, vx=0.0, vy=0.0, omega=0.0, *, step=None) -> None:
+        """A body pose (x, y, angle) and commanded motion (vx, vy, omega), lattice units."""
+        values = tuple(float(v) for v in (x, y, angle, vx, vy, omega))
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError(f"input sample {values} is not finite")
+        seq, t = self._stamp(step)
+        self._inputs.append((seq, t) + values)
+
+    def record_parameter(self, name: str, value=None, *, step=None) -> None:
+        """A parameter change (PARAMETER_NAMES; docs/sessions.md says what each value is)."""
+        if name not in PARAMETER_NAMES:
+            raise ValueError(f"unknown parameter {name!r}; one of {', '.join(PARAMETER_NAMES)}")
+        if name == "body" and value is not None and not isinstance(value, dict):
+            value = value.to_dict()
+        if name == "force_models":
+            value = list(value)
+        json.dumps(value, allow_nan=False)  # must be plain JSON
+        seq, t = self._stamp(step)
+        self._parameters.append({"seq": seq, "step": t, "name": name, "value": value})
+
+    def record_forces(self, n: int, forces: dict, body=(math.nan,) * 4, *, step=None) -> None:
+        """`forces` {model: (fx, fy)} averaged over the last n steps; body (x, y, vx, vy) then."""
+        n = int(n)
+        if n < 1:
+            raise ValueError(f"a force row covers at least one step, got n = {n}")
+        if step is not None and int(step) != self.step + n:
+            raise ValueError(f"force row at step {step}, but the recorder is at {self.step} + {n}")
+        seq = self._seq
+        self._seq += 1
+        self.step += n
+        for name in forces:
+            if name not in self._models:
+                self._models.append(name)
+        self._forces.append((seq, self.step, n, tuple(float(v) for v in body),
+                             {k: (float(v[0]), float(v[1])) for k, v in forces.items()}))
+
+    # --- output ---------------------------------------------------------------
+    def session(self) -> "Session":
+        """The recording so far as a `Session` (what `load_session` would return)."""
+        ni, nf = len(self._inputs), len(self._forces)
+        inp = np.array(self._inputs, dtype=np.float64).reshape(ni, 8)
+        values = np.full((nf, 2 * len(self._models)), np.nan)
+        for r, (_, _, _, _, forces) in enumerate(self._forces):
+            for name, (fx, fy) in forces.items():
+                k = self._models.index(name)
+                values[r, 2 * k:2 * k + 2] = fx, fy
+        return Session(
+            manifest=self._manifest(),
+            config=self.config, body=self.body, backend=self.backend,
+            force_models=self.force_models,
+            inputs={"seq": np.array([r[0] for r in self._inputs], dtype=np.int64),
+                    "step": np.array([r[1] for r in self._inputs], dtype=np.int64),
+                    "pose": np.ascontiguousarray(inp[:, 2:5]), "velocity": np.ascontiguousarray(inp[:, 5:8])},
+            parameters=[dict(p) for p in self._parameters],
+            forces={"seq": np.array([r[0] for r in self._forces], dtype=np.int64),
+                    "step": np.array([r[1] for r in self._forces], dtype=np.int64),
+                    "n": np.array([r[2] for r in self._forces], dtype=np.int64),
+                    "body": np.array([r[3] for r in self._forces], dtype=np.float64).reshape(nf, 4),
+                    "values": values},
+            models=tuple(self._models), start=self.start, state=self.state,
+        )
+
+    def _manifest(self) -> dict:
+        scene = {"source": self.scene_source, "toml": self.scene_toml,
+                 "config": config_to_dict(self.config),
+                 "body": self.body.to_dict() if self.body is not None else None,
+                 "force_models": list(self.force_models)}
+        if self.scene_dict is not None:
+            scene["dict"] = json.loads(json.dumps(self.scene_dict, default=str))
+        return {
+            "format": FORMAT, "version": VERSION, "feelflow_version": feelflow_version(),
+            "created": self.created, "backend": self.backend, "renderer": self.renderer,
+            "scene": scene, "start": self.start,
+            "forces": {"models": list(self._models), "columns": force_columns(self._models)},
+            "counts": {"inputs": len(self._inputs), "parameters": len(self._parameters),
+                       "forces": len(self._forces), "steps": self.step},
+        }
+
+    def save(self, path) -> Path:
+        """Write the session file atomically; SessionError (one line) if it cannot."""
+        return save_session(self.session(), path)
+
+
+def force_columns(models) -> list[str]:
+    """The CSV columns of `feelflow run`: step, x, y, vx, vy, fx_<m>, fy_<m> per model."""
+    cols = ["step", "x", "y", "vx", "vy"]
+    for m in models:
+        cols += [f"fx_{m}", f"fy_{m}"]
+    return cols
+
+
+# --- the driver shared by recording and replay ------------------------------------------------
+
+class SessionSolver:
+    """The solver as the app drives it: a backend plus the commands a session records.
+
+    Drive it like a `solver.backend.Solver` (set_body, set_inflow_speed, enable_force_models,
+    step, forces, distributions, time, ...: anything else is passed to the wrapped backend) plus
+    the session-level commands `set_viscosity`, `reset`, `rebuild`, `pause`, `resume`. While it
+    has a `recorder`, every command is recorded; `replay` feeds a recording back through these
+    same methods, which is why a replay reproduces the run. Keep one SessionSolver for the whole
+    life of the flow (it remembers the last placement); `start_recording` can then begin at
+    any moment between two `step` calls.
+
+    `set_viscosity`, `reset` and `rebuild` build a new backend with `factory(config)`
+    (default: the same backend by name, handing on the wrapped solver's `.ctx` if it has one).
+    """
+
+    def __init__(self, solver, recorder: SessionRecorder | None = None, *, factory=None, body=None):
+        self._solver = solver
+        self.recorder = recorder
+        self._factory = factory or _same_backend_factory(solver)
+        self.flow_config = solver.config  # the configuration asked for (reset returns to it)
+        self.geometry_shape = recorder.body if recorder is not None else body  # last known geometry
+        self.shape = None            # the body as last placed (None: no body)
+        self.velocity = (0.0, 0.0)   # commanded
+        self.omega = 0.0
+        self.models: tuple[str, ...] = ()
+        self.inflow_speed = None     # None: the config's
+        self.paused = False
+        self.clock = recorder.step if recorder is not None else 0
+
+    @property
+    def solver(self):
+        """The backend being driven (it changes on reset, rebuild and viscosity changes)."""
+        return self._solver
+
+    def __getattr__(self, name):
+        return getattr(self._solver, name)
+
+    @property
+    def time(self) -> int:
+        return self._solver.time
+
+    # --- recording ------------------------------------------------------------
+    def start_recording(self, **recorder_kwargs) -> SessionRecorder:
+        """Record from now on, starting from the flow as it is (its populations and time are
+        saved in the file); call it between two `step` calls. Keyword arguments go to
+        `SessionRecorder` (renderer, scene_toml, scene_source, scene_dict). Returns the recorder."""
+        rec = SessionRecorder(self._solver.config, self.shape if self.shape is not None else self.geometry_shape,
+                              self.models, backend=self._solver.name, **recorder_kwargs)
+        rec.start = {"time": int(self._solver.time), "body_placed": self.shape is not None,
+                     "velocity": list(self.velocity), "omega": self.omega,
+                     "force_models": list(self.models), "inflow_speed": self.inflow_speed}
+        rec.state = np.ascontiguousarray(self._solver.distributions(), dtype=np.float64)
+        self.recorder = rec
+        self.clock = 0
+        return rec
+
+    def stop_recording(self) -> SessionRecorder | None:
+        """Stop recording; returns the recorder (save it with `.save(path)`)."""
+        rec, self.recorder = self.recorder, None
+        return rec
+
+    # --- solver commands ------------------------------------------------------
+    def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, **kwargs) -> None:
+        rec = self.recorder
+        if shape is None:
+            if rec is not None:
+                rec.record_parameter("body", None)
+            self._solver.set_body(None)
+            self.shape, self.velocity, self.omega = None, (0.0, 0.0), 0.0
+            return
+        velocity = (float(velocity[0]), float(velocity[1]))
+        omega = float(omega)
+        if rec is not None:
+            if _geometry(shape) != _geometry(self.geometry_shape):
+                rec.record_parameter("body", shape.to_dict())
+            rec.record_input(shape.x, shape.y, shape.angle, velocity[0], velocity[1], omega)
+        self._solver.set_body(shape, velocity=velocity, omega=omega, **kwargs)
+        self.geometry_shape = self.shape = shape
+        self.velocity, self.omega = velocity, omega
+
+    def set_inflow_speed(self, speed: float) -> None:
+        if not hasattr(self._solver, "set_inflow_speed"):
+            raise SessionError(f"the {self._solver.name} backend cannot change the inflow speed")
+        if self.recorder is not None:
+            self.recorder.record_parameter("inflow_speed", float(speed))
+        self._solver.set_inflow_speed(float(speed))
+        self.inflow_speed = float(speed)
+
+    def enable_force_models(self, names) -> None:
+        names = tuple(names)
+        if self.recorder is not None:
+            self.recorder.record_parameter("force_models", list(names))
+        self._solver.enable_force_models(names)
+        self.models = names
+
+    def step(self, n: int = 1) -> None:
+        n = int(n)
+        if n < 1:
+            return
+        start = self._solver.time
+        body = self._body_row()
+        try:
+            self._solver.step(n)
+        except SolverDiverged as exc:
+            done = max(1, min(n, exc.step - start))
+            self._record_row(done, {m: (math.nan, math.nan) for m in self.models}, body)
+            raise
+        self._record_row(n, self._solver.forces(), body)
+
+    def _body_row(self):
+        if self.shape is None:
+            return (math.nan,) * 4
+        return (self.shape.x, self.shape.y, self.velocity[0], self.velocity[1])
+
+    def _record_row(self, n, forces, body) -> None:
+        self.clock += n
+        if self.recorder is not None:
+            self.recorder.record_forces(n, forces, body)
+
+    # --- session commands -----------------------------------------------------
+    def set_viscosity(self, nu: float) -> None:
+        """Change the kinematic viscosity, keeping the flow: a new backend with the new config
+        gets the current populations, time, inflow speed, force models and body."""
+        config = dataclasses.replace(self.flow_config, nu=float(nu))
+        try:
+            config.validate()
+        except ConfigError as exc:
+            raise SessionError(f"viscosity: {exc}") from None
+        if self.recorder is not None:
+            self.recorder.record_parameter("nu", float(nu))
+        self.flow_config = config
+        old = self._solver
+        new = _carry_flow(self._factory, config, old.distributions(), old.time, self.shape)
+        self._reapply(new)
+        old.close()
+
+    def reset(self) -> None:
+        """Start the flow again from the configuration's initial state (time 0); the body stays
+        where it is, with its motion, force models and inflow speed."""
+        if self.recorder is not None:
+            self.recorder.record_parameter("reset")
+        old = self._solver
+        self._reapply(self._factory(self.flow_config))
+        old.close()
+
+    def rebuild(self, config: FlowConfig, keep_flow: bool = True) -> None:
+        """Replace the backend with a new one for `config` (any change: grid, walls, viscosity),
+        carrying the populations and time when `keep_flow` and the grid is the same. Nothing
+        else is re-applied: the caller places the body and enables force models again (through
+        this object, so that it is recorded)."""
+        config = config.validate()
+        if self.recorder is not None:
+            self.recorder.record_parameter("rebuild", {"config": config_to_dict(config), "keep_flow": bool(keep_flow)})
+        old = self._solver
+        new = self._factory(config)
+        if keep_flow and (config.nx, config.ny) == (old.config.nx, old.config.ny):
+            new.set_distributions(old.distributions())
+            new.time = old.time
+        self.flow_config = config
+        self.shape, self.velocity, self.omega, self.models, self.inflow_speed = None, (0.0, 0.0), 0.0, (), None
+        self._solver = new
+        old.close()
+
+    def _reapply(self, new) -> None:
+        if self.models:
+            new.enable_force_models(self.models)
+        if self.inflow_speed is not None:
+            new.set_inflow_speed(self.inflow_speed)
+        if self.shape is not None:
+            new.set_body(self.shape, velocity=self.velocity, omega=self.omega)
+        self._solver = new
+
+    def pause(self) -> None:
+        """Mark the simulation paused (no steps follow until `resume`); recorded, no physics."""
+        if self.recorder is not None:
+            self.recorder.record_parameter("pause")
+        self.paused = True
+
+    def resume(self) -> None:
+        if self.recorder is not None:
+            self.recorder.record_parameter("resume")
+        self.paused = False
+
+    def close(self) -> None:
+        self._solver.close()
+
+
+def _same_backend_factory(solver):
+    def factory(config):
+        ctx = getattr(solver, "ctx", None)
+        return create_solver(solver.name, config, **({"ctx": ctx} if ctx is not None else {}))
+    return factory
+
+
+def _carry_flow(factory, config, f, time, shape):
+    """A new backend for `config` holding populations `f` at `time`, with `shape` (if any)
+    placed at rest *before* the populations arrive: a fresh lattice started at rest books no
+    cover impulse, and the caller's own placement afterwards covers no new node."""
+    new = factory(dataclasses.replace(config, initial_velocity=(0.0, 0.0)))
+    if shape is not None:
+        new.set_body(shape, velocity=(0.0, 0.0), omega=0.0)
+    new.set_distributions(f)
+    new.time = int(time)
+    return new
+
+
+def record_headless(solver, scene, *, scene_toml: str | None = None, renderer: str | None = None):
+    """For `feelflow run SCENE --record FILE`: wrap the run's fresh solver so that everything
+    the run does to it is recorded. Returns (session_solver, recorder): hand `session_solver` to
+    the motion runner instead of `solver`, then `recorder.save(FILE)` after the run."""
+    recorder = SessionRecorder.from_scene(scene, scene_toml=scene_toml, backend=solver.name,
+                                          renderer=renderer)
+    return SessionSolver(solver, recorder), recorder
+
+
+# --- a session in memory ----------------------------------------------------------------------
+
+@dataclass
+class Session:
+    """A recorded session (from `load_session` or `SessionRecorder.session()`).
+
+    inputs: seq, step (k,) int64; pose (k, 3) x, y, angle; velocity (k, 3) vx, vy, omega.
+    parameters: [{"seq", "step", "name", "value"}].
+    forces: seq, step, n (m,) int64; body (m, 4) x, y, vx, vy; values (m, 2 * len(models))
+    fx, fy per model (NaN where a model was not computed).
+    """
+
+    manifest: dict
+    config: FlowConfig
+    body: object
+    backend: str
+    force_models: tuple[str, ...]
+    inputs: dict
+    parameters: list
+    forces: dict
+    models: tuple[str, ...]
+    start: dict | None = None        # manifest "start": recording began on a running flow
+    state: np.ndarray | None = None  # then its populations f (9, ny, nx), from state.npz
+    source: str = field(default="session", compare=False)
+
+    @property
+    def steps(self) -> int:
+        return int(self.forces["step"][-1]) if len(self.forces["step"]) else 0
+
+    def events(self):
+        """Every event in recorded order: ("input", step, pose, velocity),
+        ("parameter", step, name, value), ("forces", step, n, body, values)."""
+        out = []
+        for k in range(len(self.inputs["seq"])):
+            out.append((int(self.inputs["seq"][k]), ("input", int(self.inputs["step"][k]),
+                                                     tuple(self.inputs["pose"][k]), tuple(self.inputs["velocity"][k]))))
+        for p in self.parameters:
+            out.append((p["seq"], ("parameter", p["step"], p["name"], p["value"])))
+        f = self.forces
+        for k in range(len(f["seq"])):
+            out.append((int(f["seq"][k]), ("forces", int(f["step"][k]), int(f["n"][k]),
+                                           tuple(f["body"][k]), f["values"][k])))
+        out.sort(key=lambda e: e[0])
+        return [e for _, e in out]
+
+    def frames(self):
+        """Play the recorded series back without simulating: (step, (x, y, vx, vy),
+        {model: (fx, fy)}) per force row, models not computed in that row left out."""
+        f = self.forces
+        for k in range(len(f["step"])):
+            row = f["values"][k]
+            forces = {m: (float(row[2 * j]), float(row[2 * j + 1])) for j, m in enumerate(self.models)
+                      if not (math.isnan(row[2 * j]) and math.isnan(row[2 * j + 1]))}
+            yield int(f["step"][k]), tuple(float(v) for v in f["body"][k]), forces
+
+    def csv_rows(self, values=None):
+        """Rows for `force_columns(self.models)` (shortest round-trip decimals; NaN as 'nan')."""
+        f = self.forces
+        values = f["values"] if values is None else values
+        for k in range(len(f["step"])):
+            yield [str(int(f["step"][k]))] + [_fmt(v) for v in f["body"][k]] + [_fmt(v) for v in values[k]]
+
+
+def _fmt(v) -> str:
+    return "nan" if math.isnan(v) else repr(float(v))
+
+
+# --- files ------------------------------------------------------------------------------------
+
+#: the process umask (read once: os.umask can only be read by setting it)
+_UMASK = os.umask(0o022)
+os.umask(_UMASK)
+
+
+def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
+    """Write `data` through `app.files.atomic_path` (temp file beside, fsync, os.replace): never
+    half a file. SessionError naming the path if it cannot (the old file is left as it was)."""
+    from app.files import atomic_path
+
+    path = Path(path)
+    if path.is_dir():
+        raise SessionError(f"{path}: is a directory")
+    try:
+        mode = path.stat().st_mode & 0o777 if path.exists() else 0o666 & ~_UMASK
+        with atomic_path(path, suffix=".tmp") as tmp:
+            os.chmod(tmp, mode)  # mkstemp makes 0600; a saved file gets the usual permissions
+            with open(tmp, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+    except OSError as exc:
+        raise SessionError(f"{path}: cannot write {what} ({exc.strerror or exc})") from None
+    return path
+
+
+def _npz_bytes(arrays: dict) -> bytes:
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    return buf.getvalue()
+
+
+def session_bytes(session: Session) -> bytes:
+    """The session file's bytes (a zip)."""
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr(MANIFEST, json.dumps(session.manifest, indent=2, allow_nan=False) + "\n")
+        zf.writestr(PARAMETERS, json.dumps(session.parameters, indent=1, allow_nan=False) + "\n")
+        zf.writestr(INPUTS, _npz_bytes(session.inputs))
+        zf.writestr(FORCES, _npz_bytes(session.forces))
+        if session.state is not None:
+            zf.writestr(STATE, _npz_bytes({"f": session.state}))
+    return buf.getvalue()
+
+
+def save_session(session: Session, path) -> Path:
+    """Write a session file atomically (temp file + os.replace)."""
+    return atomic_write_bytes(path, session_bytes(session), "session file")
+
+
+def load_session(path) -> Session:
+    """Read and validate a session file; SessionError with one line naming what is wrong."""
+    path = Path(path)
+    src = str(path)
+
+    def fail(message):
+        raise SessionError(f"{src}: {message}")
+
+    if path.is_dir():
+        fail("is a directory, not a session file")
+    try:
+        zf = zipfile.ZipFile(path)
+    except FileNotFoundError:
+        fail("no such session file")
+    except PermissionError:
+        fail("cannot be read (permission denied)")
+    except (zipfile.BadZipFile, EOFError, OSError):
+        fail("not a FeelFlow session file (not a zip archive; truncated or another kind of file)")
+    with zf:
+        names = set(zf.namelist())
+        missing = [m for m in MEMBERS if m not in names]
+        if missing:
+            fail(f"not a complete session file: member {missing[0]} is missing")
+        data = {}
+        for member in MEMBERS + ((STATE,) if STATE in names else ()):
+            info = zf.getinfo(member)
+            if info.file_size > MAX_MEMBER_BYTES:
+                fail(f"{member} is {info.file_size} bytes uncompressed (limit {MAX_MEMBER_BYTES})")
+            try:
+                data[member] = zf.read(member)
+            except (zipfile.BadZipFile, zlib.error, EOFError, OSError, NotImplementedError,
+                    RuntimeError) as exc:
+                fail(f"{member} is damaged ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})")
+    manifest = _json_member(data[MANIFEST], MANIFEST, fail)
+    parameters = _json_member(data[PARAMETERS], PARAMETERS, fail)
+    starts = isinstance(manifest, dict) and manifest.get("start") is not None
+    if starts and STATE not in data:
+        fail(f"the recording starts on a running flow but member {STATE} is missing")
+    state = _npz_member(data[STATE], STATE, STATE_ARRAYS, fail)["f"] if starts else None
+    try:
+        return _validate(manifest, parameters, _npz_member(data[INPUTS], INPUTS, INPUT_ARRAYS, fail),
+                         _npz_member(data[FORCES], FORCES, FORCE_ARRAYS, fail), src, state)
+    except SessionError as exc:
+        if str(exc).startswith(src + ": "):
+            raise
+        fail(str(exc))
+
+
+def _json_member(raw: bytes, member: str, fail):
+    try:
+        return json.loads(raw.decode("utf-8"), parse_constant=lambda c: fail(f"{member}: {c} is not allowed"))
+    except UnicodeDecodeError:
+        fail(f"{member} is not UTF-8 text")
+    except json.JSONDecodeError as exc:
+        fail(f"{member} is not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg})")
+
+
+def _npz_member(raw: bytes, member: str, spec: dict, fail) -> dict:
+    try:
+        with np.load(io.BytesIO(raw), allow_pickle=False) as npz:
+            names = set(npz.files)
+            missing = [k for k in spec if k not in names]
+            if missing:
+                fail(f"{member} has no array {missing[0]!r}")
+            arrays = {k: npz[k] for k in spec}
+    except SessionError:
+        raise
+    except ValueError as exc:
+        if "allow_pickle" in str(exc) or "pickle" in str(exc).lower():
+            fail(f"{member} contains pickled objects (refused: session files never hold pickle)")
+        fail(f"{member} holds a malformed array ({str(exc).splitlines()[0]})")
+    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, KeyError) as exc:
+        fail(f"{member} is not a readable .npz archive ({type(exc).__name__})")
+    rows = None
+    for name, (dtype, trailing) in spec.items():
+        a = arrays[name]
+        if a.dtype != np.dtype(dtype):
+            fail(f"{member}: array {name!r} must be {dtype}, got {a.dtype}")
+        if trailing is None:
+            ok = a.ndim == (3 if spec is STATE_ARRAYS else 2)
+        else:
+            ok = a.shape[1:] == trailing and a.ndim == 1 + len(trailing)
+        if not ok:
+            want = ("(9, ny, nx)" if spec is STATE_ARRAYS else "(rows, columns)") if trailing is None else str(("rows",) + trailing).replace("'", "")
+            fail(f"{member}: array {name!r} has shape {a.shape}, expected {want}")
+        if spec is STATE_ARRAYS:
+            continue
+        if rows is None:
+            rows = a.shape[0]
+        elif a.shape[0] != rows:
+            fail(f"{member}: array {name!r} has {a.shape[0]} rows, the others {rows}")
+    return arrays
+
+
+def _validate(manifest, parameters, inputs, forces, src, state=None) -> Session:
+    if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
+        raise SessionError(f"{MANIFEST}: not a FeelFlow session (expected \"format\": \"{FORMAT}\")")
+    version = manifest.get("version")
+    if isinstance(version, bool) or not isinstance(version, int):
+        raise SessionError(f"{MANIFEST}: version must be an integer, got {version!r}")
+    if version > VERSION:
+        raise SessionError(f"session format version {version} was written by a newer FeelFlow "
+                           f"(this one reads version {VERSION})")
+    if version != VERSION:
+        raise SessionError(f"unsupported session format version {version} (this FeelFlow reads {VERSION})")
+    for key, kind in (("feelflow_version", str), ("created", str), ("backend", str), ("renderer", str),
+                      ("scene", dict), ("forces", dict), ("counts", dict)):
+        if not isinstance(manifest.get(key), kind):
+            raise SessionError(f"{MANIFEST}: {key!r} is missing or not a {kind.__name__}")
+    scene = manifest["scene"]
+    if "config" not in scene:
+        raise SessionError(f"{MANIFEST}: scene.config is missing")
+    config = config_from_dict(scene["config"])
+    body = None if scene.get("body") is None else _shape_from_dict(scene["body"], "scene.body", config)
+    from solver.forces import MODELS
+
+    initial_models = scene.get("force_models", [])
+    if not isinstance(initial_models, list) or not all(isinstance(m, str) and m in MODELS for m in initial_models):
+        raise SessionError(f"{MANIFEST}: scene.force_models must list force models ({', '.join(MODELS)})")
+    for key in ("toml", "source"):
+        if scene.get(key) is not None and not isinstance(scene[key], str):
+            raise SessionError(f"{MANIFEST}: scene.{key} must be text")
+    models = manifest["forces"].get("models")
+    if not isinstance(models, list) or not all(isinstance(m, str) and m in MODELS for m in models) \
+            or len(set(models)) != len(models):
+        raise SessionError(f"{MANIFEST}: forces.models must list distinct force models ({', '.join(MODELS)})")
+    if forces["values"].shape[1] != 2 * len(models):
+        raise SessionError(f"{FORCES}: 'values' has {forces['values'].shape[1]} columns, expected "
+                           f"{2 * len(models)} (fx, fy for {len(models)} models)")
+    counts = manifest["counts"]
+    actual = {"inputs": len(inputs["seq"]), "parameters": len(parameters) if isinstance(parameters, list) else -1,
+              "forces": len(forces["seq"]), "steps": int(forces["step"][-1]) if len(forces["step"]) else 0}
+    for key, n in actual.items():
+        if counts.get(key) != n:
+            raise SessionError(f"{MANIFEST}: counts.{key} is {counts.get(key)!r} but the file holds {n}")
+    start = _validate_start(manifest.get("start"), state, config)
+    params = _validate_parameters(parameters, config)
+    # the largest grid the session uses (a rebuild may change it)
+    grids = [(config.nx, config.ny)] + [(p["value"]["config"]["nx"], p["value"]["config"]["ny"])
+                                        for p in params if p["name"] == "rebuild"]
+    gx, gy = max(g[0] for g in grids), max(g[1] for g in grids)
+
+    # inputs: finite, in range
+    pose, vel = inputs["pose"], inputs["velocity"]
+    for name, a in (("pose", pose), ("velocity", vel)):
+        bad = ~np.isfinite(a).all(axis=1)
+        if bad.any():
+            raise SessionError(f"{INPUTS}: input {int(np.argmax(bad))} has a non-finite {name} (NaN or inf)")
+    out = (pose[:, 0] < 0) | (pose[:, 0] > gx) | (pose[:, 1] < 0) | (pose[:, 1] > gy)
+    if out.any():
+        k = int(np.argmax(out))
+        raise SessionError(f"{INPUTS}: input {k} puts the body at ({pose[k, 0]:g}, {pose[k, 1]:g}), "
+                           f"outside the {gx} x {gy} grid")
+    fast = np.hypot(vel[:, 0], vel[:, 1]) > MAX_LATTICE_SPEED
+    if fast.any():
+        raise SessionError(f"{INPUTS}: input {int(np.argmax(fast))} has a body speed above "
+                           f"{MAX_LATTICE_SPEED:g} cell per step")
+    # forces: body finite or all NaN (no body); values may be NaN (model not computed)
+    fb = forces["body"]
+    mixed = np.isnan(fb).any(axis=1) & ~np.isnan(fb).all(axis=1)
+    if mixed.any() or np.isinf(fb).any() or np.isinf(forces["values"]).any():
+        raise SessionError(f"{FORCES}: malformed 'body' or 'values' (infinite, or partly missing)")
+    if (forces["n"] < 1).any():
+        raise SessionError(f"{FORCES}: row {int(np.argmax(forces['n'] < 1))} covers fewer than one step")
+    ends = forces["step"]
+    starts = np.concatenate([[0], ends[:-1]])
+    gap = ends - forces["n"] != starts
+    if gap.any():
+        k = int(np.argmax(gap))
+        raise SessionError(f"{FORCES}: row {k} covers steps {ends[k] - forces['n'][k]}..{ends[k]} "
+                           f"but the previous row ended at step {starts[k]}")
+
+    # one order: every seq once, steps never decreasing along it
+    seq_step = [(int(s), int(t)) for s, t in zip(inputs["seq"], inputs["step"])]
+    seq_step += [(p["seq"], p["step"]) for p in params]
+    seq_step += [(int(s), int(t) - int(n)) for s, t, n in zip(forces["seq"], forces["step"], forces["n"])]
+    seq_step.sort()
+    if [s for s, _ in seq_step] != list(range(len(seq_step))):
+        raise SessionError("event sequence numbers must be 0..N-1, each once")
+    last = 0
+    for s, t in seq_step:
+        if t < last:
+            raise SessionError(f"event {s} is at step {t}, before the previous event (step {last})")
+        last = t
+    # inputs and parameters happen between force rows: at the step the last row ended
+    ends_by_seq = {int(s): int(t) for s, t in zip(forces["seq"], forces["step"])}
+    clock = 0
+    order = {int(s): ("i", int(t)) for s, t in zip(inputs["seq"], inputs["step"])}
+    order.update({p["seq"]: ("p", p["step"]) for p in params})
+    for s in range(len(seq_step)):
+        if s in ends_by_seq:
+            clock = ends_by_seq[s]
+        elif order[s][1] != clock:
+            raise SessionError(f"event {s} is stamped step {order[s][1]} but happens at step {clock}")
+    return Session(manifest=manifest, config=config, body=body, backend=manifest["backend"],
+                   force_models=tuple(initial_models), inputs=inputs, parameters=params,
+                   forces=forces, models=tuple(models), start=start, state=state, source=src)
+
+
+def _validate_start(start, state, config: FlowConfig):
+    """manifest "start" (null, or how the running flow was when recording began) and its state."""
+    from solver.forces import MODELS
+
+    if start is None:
+        return None
+    where = f"{MANIFEST}: start"
+    keys = {"time", "body_placed", "velocity", "omega", "force_models", "inflow_speed"}
+    if not isinstance(start, dict) or set(start) != keys:
+        raise SessionError(f"{where} must have exactly {', '.join(sorted(keys))}")
+    if isinstance(start["time"], bool) or not isinstance(start["time"], int) or start["time"] < 0:
+        raise SessionError(f"{where}.time must be a non-negative integer")
+    if not isinstance(start["body_placed"], bool):
+        raise SessionError(f"{where}.body_placed must be true or false")
+    v = start["velocity"]
+    if not (isinstance(v, list) and len(v) == 2 and all(_is_number(c) for c in v)) or not _is_number(start["omega"]) \
+            or math.hypot(*v) > MAX_LATTICE_SPEED:
+        raise SessionError(f"{where}: velocity and omega must be finite numbers (|v| <= 1)")
+    if not isinstance(start["force_models"], list) or not all(isinstance(m, str) and m in MODELS for m in start["force_models"]):
+        raise SessionError(f"{where}.force_models must list force models ({', '.join(MODELS)})")
+    u = start["inflow_speed"]
+    if u is not None and not (_is_number(u) and abs(u) <= MAX_LATTICE_SPEED):
+        raise SessionError(f"{where}.inflow_speed must be null or a number in -1..1")
+    if state.shape != (9, config.ny, config.nx):
+        raise SessionError(f"{STATE}: 'f' has shape {state.shape}, expected (9, {config.ny}, {config.nx})")
+    if not np.isfinite(state).all():
+        raise SessionError(f"{STATE}: the populations hold NaN or inf")
+    return start
+
+
+def _validate_parameters(parameters, config: FlowConfig) -> list:
+    from solver.forces import MODELS
+
+    if not isinstance(parameters, list):
+        raise SessionError(f"{PARAMETERS}: must be a list of parameter changes")
+    out = []
+    for k, p in enumerate(parameters):
+        where = f"{PARAMETERS}: change {k}"
+        if not isinstance(p, dict) or set(p) != {"seq", "step", "name", "value"}:
+            raise SessionError(f"{where} must have exactly seq, step, name, value")
+        for key in ("seq", "step"):
+            if isinstance(p[key], bool) or not isinstance(p[key], int) or p[key] < 0:
+                raise SessionError(f"{where}: {key} must be a non-negative integer, got {p[key]!r}")
+        name, v = p["name"], p["value"]
+        if name not in PARAMETER_NAMES:
+            raise SessionError(f"{where}: unknown parameter {name!r} (one of {', '.join(PARAMETER_NAMES)})")
+        if name == "inflow_speed" and not (_is_number(v) and abs(v) <= MAX_LATTICE_SPEED):
+            raise SessionError(f"{where}: inflow_speed must be a number in -1..1, got {v!r}")
+        if name == "nu":
+            if not _is_number(v):
+                raise SessionError(f"{where}: nu must be a finite number, got {v!r}")
+            try:
+                dataclasses.replace(config, nu=float(v)).validate()
+            except ConfigError as exc:
+                raise SessionError(f"{where}: {exc}") from None
+        if name == "force_models" and (not isinstance(v, list) or not all(isinstance(m, str) and m in MODELS for m in v)):
+            raise SessionError(f"{where}: force_models must list force models ({', '.join(MODELS)})")
+        if name == "body" and v is not None:
+            _shape_from_dict(v, f"{where}: body", None)
+        if name == "rebuild":
+            if not isinstance(v, dict) or set(v) != {"config", "keep_flow"} or not isinstance(v["keep_flow"], bool):
+                raise SessionError(f"{where}: rebuild must be {{\"config\": {{...}}, \"keep_flow\": true|false}}")
+            try:
+                config_from_dict(v["config"])
+            except SessionError as exc:
+                raise SessionError(f"{where}: rebuild {exc}") from None
+        if name in ("pause", "resume", "reset") and v is not None:
+            raise SessionError(f"{where}: {name} takes no value")
+        out.append(dict(p))
+    return out
+
+
+# --- replay -----------------------------------------------------------------------------------
+
+@dataclass
+class ReplayResult:
+    """The re-simulated series next to the recorded one."""
+
+    session: Session          # the replay's own recording
+    values: np.ndarray        # (m, 2 * len(models)) replayed forces in the recorded column order
+    max_deviation: float      # largest |replayed - recorded| (inf where one is missing)
+    max_force: float          # largest |recorded force| (the scale of the deviation)
+    diverged_at: int | None   # session step where the replay diverged, if it did
+
+    @property
+    def relative_deviation(self) -> float:
+        return self.max_deviation / self.max_force if self.max_force > 0 else self.max_deviation
+
+
+def replay(session: Session, backend: str | None = None, *, factory=None, ctx=None, progress=None) -> ReplayResult:
+    """Re-simulate `session` on `backend` (default: the recorded one) by feeding its events
+    through a `SessionSolver` in recorded order; compare the force series."""
+    backend = backend or session.backend
+    if factory is None:
+        kwargs = {"ctx": ctx} if ctx is not None else {}
+        factory = lambda config: create_solver(backend, config, **kwargs)  # noqa: E731
+    start = session.start
+    placed = session.body if start is not None and start["body_placed"] else None
+    if start is None:
+        solver = factory(session.config)
+    else:  # the flow as it was when recording began, then its placement as it was
+        solver = _carry_flow(factory, session.config, session.state, start["time"], placed)
+    rec = SessionRecorder(session.config, session.body, session.force_models, backend=backend,
+                          scene_toml=session.manifest["scene"].get("toml"),
+                          scene_source=session.manifest["scene"].get("source"))
+    driver = SessionSolver(solver, rec, factory=factory)
+    if start is not None:
+        rec.start, rec.state = start, session.state
+        driver.models, driver.inflow_speed = tuple(start["force_models"]), start["inflow_speed"]
+        driver.shape, driver.velocity, driver.omega = placed, tuple(start["velocity"]), start["omega"]
+        driver._reapply(solver)
+    geometry = session.body
+    diverged_at = None
+    events = session.events()
+    try:
+        for k, ev in enumerate(events):
+            kind = ev[0]
+            if kind == "input":
+                (x, y, angle), (vx, vy, omega) = ev[2], ev[3]
+                if geometry is None:
+                    raise SessionError(f"{session.source}: input at step {ev[1]} moves a body the session has not got")
+                driver.set_body(geometry.moved(x=x, y=y, angle=angle), (vx, vy), omega)
+            elif kind == "parameter":
+                name, value = ev[2], ev[3]
+                if name == "body":
+                    if value is None:
+                        driver.set_body(None)
+                        geometry = None
+                    else:
+                        geometry = _shape_from_dict(value, "body", None)
+                elif name == "inflow_speed":
+                    driver.set_inflow_speed(value)
+                elif name == "nu":
+                    driver.set_viscosity(value)
+                elif name == "force_models":
+                    driver.enable_force_models(value)
+                elif name == "reset":
+                    driver.reset()
+                    diverged_at = None
+                elif name == "rebuild":
+                    driver.rebuild(config_from_dict(value["config"]), value["keep_flow"])
+                    diverged_at = None
+                elif name == "pause":
+                    driver.pause()
+                elif name == "resume":
+                    driver.resume()
+            else:
+                try:
+                    driver.step(ev[2])
+                except SolverDiverged:
+                    diverged_at = driver.clock
+            if progress is not None:
+                progress(k + 1, len(events))
+    except SessionError:
+        raise
+    except ValueError as exc:  # ShapeError, ConfigError: the file asks for something impossible
+        raise SessionError(f"{session.source}: event {k} ({ev[0]} at step {ev[1]}) cannot be replayed: "
+                           f"{str(exc).splitlines()[0]}") from None
+    finally:
+        driver.close()
+    replayed = rec.session()
+    values = np.full_like(session.forces["values"], np.nan)
+    for j, m in enumerate(session.models):
+        if m in replayed.models:
+            i = replayed.models.index(m)
+            values[:, 2 * j:2 * j + 2] = replayed.forces["values"][:, 2 * i:2 * i + 2]
+    recorded = session.forces["values"]
+    both_nan = np.isnan(values) & np.isnan(recorded)
+    diff = np.where(both_nan, 0.0, np.abs(values - recorded))
+    diff = np.where(np.isnan(diff), np.inf, diff)
+    max_dev = float(diff.max()) if diff.size else 0.0
+    finite = recorded[np.isfinite(recorded)]
+    max_force = float(np.abs(finite).max()) if finite.size else 0.0
+    return ReplayResult(replayed, values, max_dev, max_force, diverged_at)
+
+
+def export_csv(session: Session, path, values=None) -> Path:
+    """Write the force series as CSV (`force_columns`), atomically; `values` replaces the
+    recorded forces (e.g. a replay's)."""
+    lines = [",".join(force_columns(session.models))]
+    lines += [",".join(row) for row in session.csv_rows(values)]
+    return atomic_write_bytes(path, ("\n".join(lines) + "\n").encode(), "CSV file")
+
+
+def export_manifest(session: Session, path) -> Path:
+    """Write the manifest as JSON, atomically."""
+    return atomic_write_bytes(path, (json.dumps(session.manifest, indent=2) + "\n").encode(), "manifest JSON")
