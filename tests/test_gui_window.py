@@ -24,41 +24,6 @@ if os.environ.get("DISPLAY"):
 GRID = (128, 64)
 
 
-@pytest.fixture(scope="module", autouse=True)
-def no_egl_context_current():
-    """libglvnd lets a thread have an EGL or a GLX context current, not both: the gl tier's
-    standalone EGL context (tests/conftest.py) is released while Qt's windows use GLX, and
-    made current again afterwards for the gl tests that follow."""
-    import ctypes
-
-    try:
-        egl = ctypes.CDLL("libEGL.so.1")
-    except OSError:
-        yield
-        return
-    egl.eglGetCurrentContext.restype = egl.eglGetCurrentDisplay.restype = ctypes.c_void_p
-    egl.eglGetCurrentSurface.restype = ctypes.c_void_p
-    egl.eglGetCurrentSurface.argtypes = [ctypes.c_int]
-    egl.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
-    saved = None
-    if egl.eglGetCurrentContext():
-        saved = (egl.eglGetCurrentDisplay(), egl.eglGetCurrentSurface(0x3059), egl.eglGetCurrentSurface(0x305A),
-                 egl.eglGetCurrentContext())
-        egl.eglMakeCurrent(saved[0], None, None, None)
-    yield
-    from PySide6.QtGui import QOpenGLContext
-    from PySide6.QtWidgets import QApplication
-
-    for w in QApplication.topLevelWidgets():
-        w.close()
-    QApplication.processEvents()
-    current = QOpenGLContext.currentContext()
-    if current is not None:
-        current.doneCurrent()
-    if saved is not None:
-        egl.eglMakeCurrent(*saved)
-
-
 @pytest.fixture
 def window(qtbot, tmp_path):
     from PySide6.QtCore import QSettings
@@ -246,6 +211,7 @@ def test_screenshot_shows_the_body_where_it_is(window, qtbot, tmp_path):
 
     sim = window.sim
     window.panel.hold_still.setChecked(True)
+    window.panel.arrows.setChecked(False)      # the arrows start at the body centre
     sim.pos = (40.0, 30.0)
     window.sim.set_shape()
     window.viewport.update()
@@ -377,3 +343,66 @@ def test_seed_protocol_moves_the_body_with_the_stream(window, qtbot):
     sim.runner.t = 2500 - 5           # skip the first (stopped) phase: the script is a plain object
     qtbot.waitUntil(lambda: sim.pos[0] > x0 + 1, timeout=20000)
     assert sim.script_phase()[2] == "moving with the stream"
+
+
+@pytest.mark.gl
+def test_gl_backend_runs_in_the_widgets_own_context(qtbot, tmp_path):
+    from PySide6.QtCore import QSettings
+
+    from app.main_window import MainWindow
+    from app.selftest import field_is_alive
+    from app.simulation import Params
+
+    w = MainWindow(backend="gl", settings=QSettings(str(tmp_path / "s.ini"), QSettings.IniFormat),
+                   params=Params(grid=GRID, size=12))
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitUntil(lambda: w.sim is not None and w.sim.solver.time > 20, timeout=30000)
+    assert w.sim.solver.name == "gl" and w.sim.solver.ctx is w.viewport.ctx
+    assert w.viewport.field_texture is w.sim.solver.field_texture()
+    ok, why = field_is_alive(w)
+    assert ok, why
+    w.timer.stop()
+
+
+def test_haptic_device_moves_the_body_feels_the_force_and_unplugging_falls_back_to_mouse(window, qtbot):
+    panel = window.panel
+    i = panel.input.findData("sim://diyhid")
+    assert i > 0, [panel.input.itemData(k) for k in range(panel.input.count())]
+    panel.input.setCurrentIndex(i)
+    dev = window.input_device
+    assert dev is not None and dev.url == "sim://diyhid"
+    qtbot.waitUntil(lambda: window.sim.target is not None and dev.loop.status().samples > 5, timeout=20000)
+    assert dev.loop.status().running
+    dev.device.simulator.unplug()          # the real disconnect path of the simulated board
+    qtbot.waitUntil(lambda: window.input_device is None, timeout=10000)
+    assert panel.input.currentData() == "mouse"
+    assert "disconnected" in panel.input_note.text()
+
+
+def test_recording_a_session_saves_inputs_parameters_and_forces(window, qtbot, tmp_path, monkeypatch):
+    from PySide6.QtWidgets import QFileDialog
+
+    from app.selftest import send_mouse
+    from app.session import load_session
+
+    path = tmp_path / "lesson.ffsession"
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(path), ""))
+    window.record_action.trigger()
+    assert window.sim.solver.recorder is not None
+    t0 = window.sim.solver.time
+    vp, sim = window.viewport, window.sim
+    send_mouse(vp, "press", vp.to_widget(*sim.pos))
+    send_mouse(vp, "move", vp.to_widget(sim.pos[0] + 20, sim.pos[1]))
+    qtbot.waitUntil(lambda: sim.solver.time > t0 + 100, timeout=20000)
+    send_mouse(vp, "release", vp.to_widget(sim.pos[0], sim.pos[1]))
+    window.panel.wind.setValue(0.06)
+    t1 = sim.solver.time
+    qtbot.waitUntil(lambda: sim.solver.time > t1 + 50, timeout=20000)
+    window.record_action.trigger()
+    assert window.sim.solver.recorder is None and path.exists()
+    session = load_session(path)
+    names = [p["name"] for p in session.parameters]
+    assert "inflow_speed" in names
+    assert len(session.inputs["step"]) > 0 and len(session.forces["step"]) > 0
+    assert session.steps > 100
