@@ -29,7 +29,7 @@ from solver.config import ConfigError
 TARGET_FRAME_S = 1.0 / 34      # aim a little above 30 fps
 MAX_STEPS_PER_FRAME = 200
 MIN_STEPS_PER_FRAME = 2   # the flow keeps moving even where drawing alone takes 1/30 s
-N_TRACERS = 1500
+N_TRACERS = 900
 
 
 class MainWindow(QMainWindow):
@@ -64,7 +64,7 @@ class MainWindow(QMainWindow):
         pdock.setWidget(self.plot)
         pdock.setFeatures(QDockWidget.DockWidgetMovable)
         self.addDockWidget(Qt.BottomDockWidgetArea, pdock)
-        self.resizeDocks([pdock], [260], Qt.Vertical)
+        self.resizeDocks([pdock], [230], Qt.Vertical)
 
         self.status = {k: QLabel() for k in ("steps", "mlups", "fps", "re", "ma", "renderer")}
         for label in self.status.values():
@@ -146,8 +146,10 @@ class MainWindow(QMainWindow):
         self.plot.sim = self.sim
         self.viewport.mode = self.display_mode
         self.panel.show_params(self.sim.params, self.display_mode)
-        self.status["renderer"].setText(f"{self.viewport.renderer()} ({self.backend} solver)")
+        self.status["renderer"].setText(f"{self.viewport.renderer().split(' (')[0]}, {self.backend} solver")
+        self.status["renderer"].setToolTip(self.viewport.renderer())
         self._upload_field()
+        self.refresh_devices()
         self.timer.start()
         self.slow_timer.start()
         self.refresh_readouts()
@@ -199,6 +201,8 @@ class MainWindow(QMainWindow):
 
     def set_paused(self, paused: bool):
         self.paused = paused
+        if self.input_device is not None:
+            self.input_device.pause(paused)
         self.pause_action.setChecked(paused)
         self.statusBar().showMessage("Paused (space to run)" if paused else "Running", 2000)
 
@@ -302,6 +306,8 @@ class MainWindow(QMainWindow):
         self._after_rebuild()
 
     def _after_rebuild(self):
+        if self.input_device is not None:
+            self.input_device.loop.set_tunnel((0.0, 0.0, self.sim.config.nx - 1.0, self.sim.config.ny - 1.0))
         self._upload_field()
         self.refresh_readouts()
         self.viewport.update()
@@ -460,13 +466,66 @@ class MainWindow(QMainWindow):
         return True
 
     # --- input devices ------------------------------------------------------------------------
+    def refresh_devices(self):
+        """Fill the input selector: the mouse, then every device the haptics layer can drive."""
+        from haptics import list_devices
+
+        box = self.panel.input
+        box.blockSignals(True)
+        current = box.currentData()
+        box.clear()
+        box.addItem("Mouse", "mouse")
+        try:
+            devices = list_devices()
+        except Exception as exc:   # enumeration trouble must not stop the window
+            devices = []
+            self.panel.input_note.setText(f"Could not list devices: {exc}")
+        for info in devices:
+            if info.driver:
+                box.addItem(info.name, info.url)
+        i = box.findData(current)
+        box.setCurrentIndex(max(0, i))
+        box.blockSignals(False)
+
     def set_input(self, url):
-        if url == "mouse":
-            self._close_device()
+        from haptics import BadDeviceURL, DeviceError
+
+        from app.device_input import DeviceInput
+
+        self._close_device()
+        if url == "mouse" or self.sim is None:
             self.panel.input_note.setText("")
+            return
+        try:
+            self.input_device = DeviceInput(url, (self.sim.config.nx, self.sim.config.ny),
+                                            DeviceInput.expected_peak(self.sim), self)
+        except (DeviceError, BadDeviceURL, OSError, ValueError) as exc:
+            QMessageBox.warning(self, "The device cannot be used", f"{exc}\nBack to the mouse.")
+            self._back_to_mouse("")
+            return
+        self.input_device.disconnected.connect(self._device_lost)
+        self.set_hold_still(False)
+        self.panel.input_note.setText("The device moves the body; you feel the selected force model.")
+
+    def _device_lost(self, reason):
+        self._close_device()
+        self._back_to_mouse(f"The device disconnected ({reason}); the mouse moves the body again.")
+
+    def _back_to_mouse(self, message):
+        box = self.panel.input
+        box.blockSignals(True)
+        box.setCurrentIndex(box.findData("mouse"))
+        box.blockSignals(False)
+        self.panel.input_note.setText(message)
+        if message:
+            self.statusBar().showMessage(message, 10000)
+        if self.sim is not None:
+            self.sim.target = None
 
     def _close_device(self):
-        self.input_device = None
+        device, self.input_device = self.input_device, None
+        if device is not None:
+            device.close()
 
     # --- frame loop ---------------------------------------------------------------------------
     def _make_current(self):
@@ -510,6 +569,13 @@ class MainWindow(QMainWindow):
         if not finite:
             self._on_nan()
             return
+        if self.input_device is not None:
+            target = self.input_device.target()
+            if target is not None:
+                self.sim.target = target
+            f = forces.get(self.sim.params.force_model)
+            if f is not None:
+                self.input_device.submit(f, self.sim.solver.time)
         if self.display_mode == "tracers":
             self._advance_tracers(rgba, n)
         self._arrows(forces)
@@ -578,7 +644,7 @@ class MainWindow(QMainWindow):
         k = int(bad.sum())
         if k:
             pts[bad] = np.c_[rng.uniform(0, 3, k), rng.uniform(0, ny - 1, k)]
-        tail = pts - u * 60
+        tail = pts - u * 30   # a short streak: where the particle was 30 steps ago
         self.viewport.tracers = (pts, tail)
 
     def refresh_readouts(self):

@@ -13,7 +13,8 @@
 //   TRT, GUO_FORCE, SPONGE: collision operator, Guo body force, outlet sponge (per-column rates).
 //   X_PERIODIC 0/1; Y_MODE 0 no_slip, 1 free_slip, 2 periodic.
 //   FETCH_NORMALIZED 1: streaming reads with texture() at normalized coordinates through
-//     REPEAT samplers (the wrap comes free); 0: texelFetch() (docs/performance.md compares).
+//     REPEAT samplers (the wrap comes free); 2: the same through textureOffset();
+//     0: texelFetch() (docs/performance.md compares them).
 // @LATTICE
 
 uniform sampler2D G0;
@@ -68,6 +69,22 @@ float streamed(int i, ivec2 x) {
     return pop(i, x - C[i]);
 #endif
 }
+
+#if FETCH_NORMALIZED == 2
+// the nine streaming reads through textureOffset(): one coordinate, constant texel offsets
+void stream_all(out float gin[9]) {
+    vec2 p = gl_FragCoord.xy * inv_n;
+    gin[0] = texture(G0, p).x;
+    gin[1] = textureOffset(G0, p, -C[1]).y;
+    gin[2] = textureOffset(G0, p, -C[2]).z;
+    gin[3] = textureOffset(G0, p, -C[3]).w;
+    gin[4] = textureOffset(G1, p, -C[4]).x;
+    gin[5] = textureOffset(G1, p, -C[5]).y;
+    gin[6] = textureOffset(G1, p, -C[6]).z;
+    gin[7] = textureOffset(G1, p, -C[7]).w;
+    gin[8] = textureOffset(G2, p, -C[8]).x;
+}
+#endif
 
 // f^eq_i - w_i RHO0 for density RHO0 + drho and velocity u (seed eq. 9), shifted.
 float feq_shifted(int i, float drho, float rho, vec2 u) {
@@ -182,7 +199,11 @@ int reflect_y(int i) {  // j with C[j] = (C[i].x, -C[i].y)
 void main() {
     ivec2 x = ivec2(gl_FragCoord.xy);
     float gin[9];
+#if FETCH_NORMALIZED == 2
+    stream_all(gin);
+#else
     for (int i = 0; i < Q; ++i) gin[i] = streamed(i, x);
+#endif
 #if BODY
     uint m = texelFetch(MASK, x, 0).r;
     if ((m & 1u) != 0u) {  // solid node: equilibrium at the body velocity, density RHO0

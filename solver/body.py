@@ -59,6 +59,17 @@ def node_velocity(shape, velocity, omega, x0, y0, h, w):
     return np.broadcast_to(ux, (h, w)).astype(np.float64), np.broadcast_to(uy, (h, w)).astype(np.float64)
 
 
+def _neighbour_sum(field: np.ndarray) -> np.ndarray:
+    """Sum of a (h, w) field over the 8 lattice neighbours (zero outside the window)."""
+    h, w = field.shape
+    pad = np.pad(field, 1)
+    out = np.zeros((h, w), dtype=pad.dtype)
+    for k in range(1, Q):
+        cx, cy = int(C[k, 0]), int(C[k, 1])
+        out += pad[1 + cy:1 + cy + h, 1 + cx:1 + cx + w]
+    return out
+
+
 def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, velocity, omega,
            x0: int, y0: int):
     """Cover, uncover and re-equilibrate the solid nodes of a window of full f* (in place).
@@ -67,17 +78,28 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
     reach one node beyond every old and new solid node (or the domain edge).
     Covered nodes (new & ~old) give their momentum to the body; uncovered ones (old & ~new)
     get f^eq(rho_new, u_body) and take momentum -rho_new u_body from it; every solid node gets
-    f^eq(RHO0, u_body). `shape` gives u_body: the new body, or the old one when it is removed
-    (None: at rest). Returns (impulse (Jx, Jy), changed (h, w) bool mask of written nodes).
+    f^eq(RHO0, u_body). The mass this creates or destroys (solid nodes hold RHO0) goes back to
+    the fluid ring around the body (fluid nodes next to an old or new solid node), each node
+    scaled by the same added density (velocity kept); the momentum that adds is booked too.
+    `shape` gives u_body: the new body, or the old one when it is removed (None: at rest).
+    Returns (impulse (Jx, Jy), changed (h, w) bool mask of written nodes).
     """
     h, w = new_solid.shape
     covered = new_solid & ~old_solid
     uncovered = old_solid & ~new_solid
+    if not (covered.any() or uncovered.any()):
+        if new_solid.any():
+            ux, uy = node_velocity(shape, velocity, omega, x0, y0, h, w)
+            f[:, new_solid] = equilibrium(np.full(int(new_solid.sum()), RHO0), ux[new_solid], uy[new_solid])
+        return (0.0, 0.0), new_solid.copy()
+    cx_, cy_ = C[:, 0].astype(np.float64), C[:, 1].astype(np.float64)
     jx = jy = 0.0
+    lost = 0.0   # mass the cover/uncover removes from the grid
     if covered.any():
         fc = f[:, covered]
-        jx += float(C[:, 0].astype(np.float64) @ fc.sum(axis=1))
-        jy += float(C[:, 1].astype(np.float64) @ fc.sum(axis=1))
+        jx += float(cx_ @ fc.sum(axis=1))
+        jy += float(cy_ @ fc.sum(axis=1))
+        lost += float(fc.sum()) - RHO0 * int(covered.sum())
     if shape is not None:
         ux, uy = node_velocity(shape, velocity, omega, x0, y0, h, w)
     else:
@@ -85,22 +107,49 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
     if uncovered.any():
         rho = f.sum(axis=0)
         donor = ~new_solid & ~uncovered
-        rsum = np.zeros((h, w))
-        cnt = np.zeros((h, w))
-        pad_r = np.pad(np.where(donor, rho, 0.0), 1)
-        pad_c = np.pad(donor.astype(np.float64), 1)
-        for k in range(1, Q):
-            cx, cy = int(C[k, 0]), int(C[k, 1])
-            rsum += pad_r[1 + cy:1 + cy + h, 1 + cx:1 + cx + w]
-            cnt += pad_c[1 + cy:1 + cy + h, 1 + cx:1 + cx + w]
+        rsum = _neighbour_sum(np.where(donor, rho, 0.0))
+        cnt = _neighbour_sum(donor.astype(np.float64))
         rho_new = np.where(cnt > 0, rsum / np.maximum(cnt, 1), RHO0)[uncovered]
         uxu, uyu = ux[uncovered], uy[uncovered]
         f[:, uncovered] = equilibrium(rho_new, uxu, uyu)
         jx -= float((rho_new * uxu).sum())
         jy -= float((rho_new * uyu).sum())
+        lost += RHO0 * int(uncovered.sum()) - float(rho_new.sum())
     if new_solid.any():
         f[:, new_solid] = equilibrium(np.full(int(new_solid.sum()), RHO0), ux[new_solid], uy[new_solid])
-    return (jx, jy), (new_solid | uncovered)
+    ring = ~new_solid & (_neighbour_sum((new_solid | old_solid).astype(np.float64)) > 0)
+    if lost != 0.0 and ring.any():
+        fr = f[:, ring]
+        rho_r = fr.sum(axis=0)
+        scale = 1.0 + (lost / int(ring.sum())) / rho_r
+        added = fr * (scale - 1.0)
+        f[:, ring] = fr + added
+        jx -= float(cx_ @ added.sum(axis=1))
+        jy -= float(cy_ @ added.sum(axis=1))
+    return (jx, jy), (new_solid | uncovered | ring)
+
+
+def move_body(old, new, config, read_window, write_nodes):
+    """Cover/uncover bookkeeping between two body states (either may be None), for any backend.
+
+    read_window(x0, y0, x1, y1) -> (9, y1-y0, x1-x0) float64 full f* of that box;
+    write_nodes(x0, y0, f, changed) writes back the nodes where `changed` (the window's (h, w)
+    mask) is True. The box is the union of both raster windows grown by one node (the refill's
+    neighbours). Returns the impulse (Jx, Jy) to add to the next step's force.
+    """
+    box = union_box(old.raster.window if old else None, new.raster.window if new else None)
+    if box is None:
+        return 0.0, 0.0
+    x0, y0, x1, y1 = expand_box(box, 1, config.nx, config.ny)
+    ys, xs = slice(y0, y1), slice(x0, x1)
+    shape = (y1 - y0, x1 - x0)
+    old_solid = old.solid[ys, xs] if old else np.zeros(shape, bool)
+    new_solid = new.solid[ys, xs] if new else np.zeros(shape, bool)
+    motion = new if new is not None else old
+    f = read_window(x0, y0, x1, y1)
+    impulse, changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0)
+    write_nodes(x0, y0, f, changed)
+    return impulse
 
 
 @dataclass

@@ -105,7 +105,7 @@ class GLSolver(Solver):
 
     name = "gl"
     #: default tuning (docs/performance.md measures each choice)
-    TUNING = {"split": True, "fetch_normalized": True}
+    TUNING = {"split": True, "fetch_normalized": 2}
 
     def __init__(self, config, ctx=None, check_interval: int = 1, tuning: dict | None = None):
         super().__init__(config)
@@ -124,7 +124,7 @@ class GLSolver(Solver):
             "GUO_FORCE": any(c != 0.0 for c in cfg.body_force),
             "X_PERIODIC": cfg.x_boundary == "periodic",
             "Y_MODE": _Y_MODE[cfg.y_boundary],
-            "FETCH_NORMALIZED": bool(self.tuning["fetch_normalized"]),
+            "FETCH_NORMALIZED": int(self.tuning["fetch_normalized"]),
         }
         self._defines = defines
         self._sponge = sponge

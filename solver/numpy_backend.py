@@ -11,8 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from solver.backend import Solver, SolverDiverged
-from solver.body import (BodyState, expand_box, make_body_state, refill, shifted, union_box,
-                         unshifted, window_margin)
+from solver.body import BodyState, make_body_state, move_body, shifted, unshifted, window_margin
 from solver.bouzidi import incoming
 from solver.collision import Collider
 from solver.config import FlowConfig
@@ -103,19 +102,8 @@ class NumpySolver(Solver):
         new = None
         if shape is not None:
             new = make_body_state(shape, velocity, omega, cfg, window_margin(self._models.values()), raster)
-        box = union_box(old.raster.window if old else None, new.raster.window if new else None)
-        if box is not None:
-            x0, y0, x1, y1 = expand_box(box, 1, cfg.nx, cfg.ny)
-            ys, xs = slice(y0, y1), slice(x0, x1)
-            shape_ = (y1 - y0, x1 - x0)
-            old_solid = old.solid[ys, xs] if old else np.zeros(shape_, bool)
-            new_solid = new.solid[ys, xs] if new else np.zeros(shape_, bool)
-            motion = new if new is not None else old
-            f = unshifted(self.g[:, ys, xs])
-            (jx, jy), changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0)
-            sub = self.g[:, ys, xs]
-            sub[:, changed] = shifted(f[:, changed]).astype(self.dtype)
-            self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
+        jx, jy = move_body(old, new, cfg, self._read_window, self._write_nodes)
+        self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         self.body = new
         if new is not None:
             wx0, wy0, wx1, wy1 = new.raster.window  # holds every solid node
@@ -127,6 +115,14 @@ class NumpySolver(Solver):
         else:
             self._solid_idx = self._solid_g = None
             self.speed_capped = self.inflow_capped
+
+    def _read_window(self, x0, y0, x1, y1) -> np.ndarray:
+        return unshifted(self.g[:, y0:y1, x0:x1])
+
+    def _write_nodes(self, x0, y0, f, changed) -> None:
+        h, w = changed.shape
+        sub = self.g[:, y0:y0 + h, x0:x0 + w]
+        sub[:, changed] = shifted(f[:, changed]).astype(self.dtype)
 
     # --- forces ---------------------------------------------------------------
     def enable_force_models(self, names) -> None:

@@ -40,6 +40,7 @@ def make_solver(backend: str, config, request=None):
 # current"), even after the EGL context is released; glcontext cannot attach moderngl to a
 # Qt EGL context either. So a run that selects both GUI and other tests keeps the GUI ones for
 # a second process: installer/run-tests.sh runs `pytest -m gui` after the rest.
+@pytest.hookimpl(trylast=True)  # after -m/-k have deselected what they will
 def pytest_collection_modifyitems(config, items):
     gui = [item for item in items if item.get_closest_marker("gui")]
     if gui and len(gui) < len(items):

@@ -211,6 +211,7 @@ def test_screenshot_shows_the_body_where_it_is(window, qtbot, tmp_path):
 
     sim = window.sim
     window.panel.hold_still.setChecked(True)
+    window.panel.arrows.setChecked(False)      # the arrows start at the body centre
     sim.pos = (40.0, 30.0)
     window.sim.set_shape()
     window.viewport.update()
@@ -342,3 +343,38 @@ def test_seed_protocol_moves_the_body_with_the_stream(window, qtbot):
     sim.runner.t = 2500 - 5           # skip the first (stopped) phase: the script is a plain object
     qtbot.waitUntil(lambda: sim.pos[0] > x0 + 1, timeout=20000)
     assert sim.script_phase()[2] == "moving with the stream"
+
+
+@pytest.mark.gl
+def test_gl_backend_runs_in_the_widgets_own_context(qtbot, tmp_path):
+    from PySide6.QtCore import QSettings
+
+    from app.main_window import MainWindow
+    from app.selftest import field_is_alive
+    from app.simulation import Params
+
+    w = MainWindow(backend="gl", settings=QSettings(str(tmp_path / "s.ini"), QSettings.IniFormat),
+                   params=Params(grid=GRID, size=12))
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitUntil(lambda: w.sim is not None and w.sim.solver.time > 20, timeout=30000)
+    assert w.sim.solver.name == "gl" and w.sim.solver.ctx is w.viewport.ctx
+    assert w.viewport.field_texture is w.sim.solver.field_texture()
+    ok, why = field_is_alive(w)
+    assert ok, why
+    w.timer.stop()
+
+
+def test_haptic_device_moves_the_body_feels_the_force_and_unplugging_falls_back_to_mouse(window, qtbot):
+    panel = window.panel
+    i = panel.input.findData("sim://diyhid")
+    assert i > 0, [panel.input.itemData(k) for k in range(panel.input.count())]
+    panel.input.setCurrentIndex(i)
+    dev = window.input_device
+    assert dev is not None and dev.url == "sim://diyhid"
+    qtbot.waitUntil(lambda: window.sim.target is not None and dev.loop.status().samples > 5, timeout=20000)
+    assert dev.loop.status().running
+    dev.device.simulator.unplug()          # the real disconnect path of the simulated board
+    qtbot.waitUntil(lambda: window.input_device is None, timeout=10000)
+    assert panel.input.currentData() == "mouse"
+    assert "disconnected" in panel.input_note.text()

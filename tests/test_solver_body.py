@@ -37,6 +37,24 @@ def test_fixed_cylinder_feels_drag_and_no_lift(backend, model, request):
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
+def test_spinning_cylinder_feels_magnus_lift(backend, request):
+    """Rotation in the moving-wall term: a cylinder spinning counter-clockwise (Omega > 0) in a
+    stream along +x speeds the flow below it and slows it above, so the lift points down
+    (Magnus; Kutta-Joukowski L = -rho U Gamma); reversing the spin mirrors the flow exactly."""
+    lift = {}
+    for omega in (0.005, -0.005):
+        s = _tunnel(backend, request)
+        s.enable_force_models(["momentum_exchange"])
+        s.set_body(Cylinder(8.0, x=30.3, y=20.0), omega=omega)
+        s.step(400)
+        fx, lift[omega] = s.forces()["momentum_exchange"]
+        assert fx > 0
+    assert lift[0.005] < -0.05 * fx
+    tol = 1e-9 if backend == "numpy" else 1e-4
+    assert lift[-0.005] == pytest.approx(-lift[0.005], rel=tol)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("collision", ["bgk", "trt"])
 def test_body_moving_with_the_stream_leaves_it_uniform(backend, collision, request):
     """Moving-wall term, cover and refill together: a cylinder carried by a uniform stream at
@@ -67,43 +85,34 @@ def test_body_moving_with_the_stream_leaves_it_uniform(backend, collision, reque
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
-def test_moving_body_mass_bookkeeping(backend, request):
-    """A body moved back and forth in a closed (periodic) box: the mass the refill creates or
-    destroys is exactly (1 - rho) per covered node (solid nodes hold rho0) plus (rho_new - 1)
-    per uncovered node, so its sum is bounded by events x the largest density deviation.
-    (The interpolated moving-wall links leak a little too; `feelflow validate` reports the drift
-    over 20 000 steps.)"""
+def test_cover_and_uncover_conserve_mass(backend, request):
+    """A body moved back and forth in a closed (periodic) box. Covering a node (it becomes
+    solid at rho0) and refilling one (rho_new from its neighbours) create or destroy mass; the
+    refill hands that mass back to the fluid ring around the body, so each set_body conserves
+    the total mass to rounding. What is left is the streaming's own leak through the
+    interpolated moving-wall links (Bouzidi et al. 2001 is not mass-conserving), which must
+    stay well below what the uncorrected refill lost here (3.6e-4 over these 400 steps)."""
     cfg = FlowConfig(nx=64, ny=48, nu=0.05, collision="trt", x_boundary="periodic", y_boundary="periodic")
     s = make_solver(backend, cfg, request)
     c = Cylinder(10.3, x=30.2, y=24.1)
     s.set_body(c)
     s.step(1)
     m0 = s.total_mass()
-    x, v, events, dev, refill_change = c.x, 0.02, 0, 0.0, 0.0
+    tol = 1e-11 if backend == "numpy" else 1e-4
+    x, v, events = c.x, 0.02, 0
     for k in range(400):
         vv = v if (k // 100) % 2 == 0 else -v
         x += vv
-        rho, _, _ = s.macroscopic()
-        old = s.body.solid.copy() if hasattr(s, "body") else None
+        old = s.body.solid.copy()
         before = s.total_mass()
         s.set_body(c.moved(x=x), velocity=(vv, 0.0))
-        if old is not None:
-            new = s.body.solid
-            covered, uncovered = new & ~old, old & ~new
-            rho_after, _, _ = s.macroscopic()
-            expected = np.sum(1.0 - rho[covered]) + np.sum(rho_after[uncovered] - 1.0)
-            # gl stores float32: each rewritten node rounds its 9 populations (<= 2e-7 in all)
-            changed = int(covered.sum() + uncovered.sum())
-            tol = 1e-12 if backend == "numpy" else 2e-7 * max(changed, 1)
-            assert s.total_mass() - before == pytest.approx(expected, abs=tol)
-            refill_change += s.total_mass() - before
-            events += int(covered.sum() + uncovered.sum())
-        dev = max(dev, float(np.abs(rho - 1).max()))
+        events += int((s.body.solid != old).sum())
+        assert s.total_mass() == pytest.approx(before, abs=tol)
         s.step(1)
     assert events > 20
-    assert abs(refill_change) <= events * dev
-    stream_change = s.total_mass() - m0 - refill_change
-    print(f"relative drift {(s.total_mass() - m0) / m0:.2e}: refill {refill_change:.3e}, steps {stream_change:.3e}")
+    drift = (s.total_mass() - m0) / m0
+    print(f"relative mass drift over 400 steps: {drift:.2e}")
+    assert abs(drift) < 1e-4
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

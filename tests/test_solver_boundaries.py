@@ -5,7 +5,6 @@ Inlet: moving-wall half-way bounce-back (Ladd 1994); outlet: anti-bounce-back pr
 """
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest

@@ -181,9 +181,10 @@ def _format_row(r) -> str:
 
 # --- tuning variants (docs/performance.md) ---------------------------------------------------
 VARIANTS = {
-    "one program, texelFetch (no regions)": {"split": False, "fetch_normalized": False},
-    "regions, texelFetch": {"split": True, "fetch_normalized": False},
-    "regions, texture() + REPEAT (default)": {},
+    "one program, texelFetch (no regions)": {"split": False, "fetch_normalized": 0},
+    "regions, texelFetch": {"split": True, "fetch_normalized": 0},
+    "regions, texture() + REPEAT": {"split": True, "fetch_normalized": 1},
+    "regions, textureOffset() + REPEAT (default)": {},
 }
 #: step variants (body, edges, sponge) whose cost per node the variants run measures
 REGION_VARIANTS = {"interior (fast path)": (0, 0, 0), "interior + sponge rates": (0, 0, 1),

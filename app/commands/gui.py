@@ -11,7 +11,7 @@ import sys
 
 from app.cli import UserError
 
-DEFAULT_BACKEND = "numpy"  # "gl" once solver/gl_backend.py lands
+DEFAULT_BACKEND = "gl"
 
 
 def add_arguments(parser):

@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from solver.forces.base import BodyWindow, ForceModel
-from solver.forces.sampling import bilinear, moments
+from solver.forces.sampling import bilinear_stencil, moments_at
 
 #: kind -> (C_D, source). Wedges depend on which way they face (see `drag_coefficient`).
 DRAG_COEFFICIENTS: dict[str, tuple[float, str]] = {
@@ -96,16 +96,19 @@ class MacroscopicDrag(ForceModel):
 
     def sample(self, window: BodyWindow):
         """(rho, ux, uy): length-weighted means on the contour at `distance` from the surface."""
-        pts, normals, lengths = window.shape.surface_elements(self.spacing)
-        pts = np.asarray(pts, dtype=np.float64)
-        normals = np.asarray(normals, dtype=np.float64)
-        lengths = np.asarray(lengths, dtype=np.float64)
-        sx = pts[:, 0] + self.distance * normals[:, 0]
-        sy = pts[:, 1] + self.distance * normals[:, 1]
-        rho, ux, uy = moments(window)
-        r, u, v = bilinear(window, (rho, ux, uy), sx, sy)
-        wsum = lengths.sum()
-        return float((r * lengths).sum() / wsum), float((u * lengths).sum() / wsum), float((v * lengths).sum() / wsum)
+        key = (window.shape, window.x0, window.y0, window.solid.shape)
+        if getattr(self, "_key", None) != key:  # rebuilt only when the pose changes
+            pts, normals, lengths = window.shape.surface_elements(self.spacing)
+            pts = np.asarray(pts, dtype=np.float64)
+            normals = np.asarray(normals, dtype=np.float64)
+            lengths = np.asarray(lengths, dtype=np.float64)
+            stencil = bilinear_stencil(window, pts[:, 0] + self.distance * normals[:, 0],
+                                       pts[:, 1] + self.distance * normals[:, 1])
+            self._geom = (stencil, stencil.nodes(), lengths / lengths.sum())
+            self._key = key
+        stencil, nodes, weight = self._geom
+        rho, ux, uy = moments_at(window, nodes)
+        return tuple(float(np.dot(stencil.apply(a), weight)) for a in (rho, ux, uy))
 
     def compute(self, window: BodyWindow) -> tuple[float, float]:
         rho, ux, uy = self.sample(window)

@@ -28,7 +28,7 @@ import math
 import numpy as np
 
 from solver.forces.base import BodyWindow, ForceModel
-from solver.forces.sampling import fluid_extrapolate
+from solver.forces.sampling import fluid_fit_stencil, moments_at
 from solver.lattice import CS2, RHO0
 
 #: beta that makes eq. 23 equal to the lattice pressure c_s^2 (rho - rho_0) to first order
@@ -57,13 +57,23 @@ class PressureIntegration(ForceModel):
         #: cells the body window must extend beyond the body (the fit's stencil)
         self.margin = int(math.ceil(radius)) + 2
 
+    def _geometry(self, window: BodyWindow):
+        """Surface elements and the wall-density stencil, rebuilt only when the pose changes."""
+        key = (window.shape, window.x0, window.y0, window.solid.shape)
+        if getattr(self, "_key", None) != key:
+            pts, normals, lengths = window.shape.surface_elements(self.spacing)
+            pts = np.asarray(pts, dtype=np.float64)
+            stencil = fluid_fit_stencil(window, pts[:, 0], pts[:, 1], self.radius)
+            self._geom = (pts, np.asarray(normals, dtype=np.float64), np.asarray(lengths, dtype=np.float64),
+                          stencil, stencil.nodes())
+            self._key = key
+        return self._geom
+
     def wall_density(self, window: BodyWindow):
         """(points, normals, lengths, rho on the wall) for the shape's surface elements."""
-        pts, normals, lengths = window.shape.surface_elements(self.spacing)
-        pts = np.asarray(pts, dtype=np.float64)
-        rho = np.asarray(window.f, dtype=np.float64).sum(axis=0)
-        rho_wall = fluid_extrapolate(window, rho, pts[:, 0], pts[:, 1], self.radius)
-        return pts, np.asarray(normals, dtype=np.float64), np.asarray(lengths, dtype=np.float64), rho_wall
+        pts, normals, lengths, stencil, nodes = self._geometry(window)
+        rho = moments_at(window, nodes)[0]
+        return pts, normals, lengths, stencil.apply(rho)
 
     def compute(self, window: BodyWindow) -> tuple[float, float]:
         _, normals, lengths, rho = self.wall_density(window)

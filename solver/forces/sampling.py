@@ -40,11 +40,25 @@ def _check_inside(window, ix, iy, what):
             "the backend must widen the window by the model's `margin`")
 
 
-def bilinear(window, fields, px, py):
-    """Bilinear interpolation of node fields at points (px, py) (world lattice coordinates).
+class Stencil:
+    """Values at k points as fixed linear combinations of node values: v_k = sum_m coef[k, m] *
+    field[idx[k, m]] (idx: flat indices into the window's (h, w) arrays). Built once per body
+    pose, applied every step."""
 
-    fields: sequence of (h, w) arrays on the window. Returns a list of (k,) arrays.
-    """
+    def __init__(self, idx: np.ndarray, coef: np.ndarray):
+        self.idx = idx
+        self.coef = coef
+
+    def apply(self, field_flat: np.ndarray) -> np.ndarray:
+        return (field_flat[self.idx] * self.coef).sum(axis=1)
+
+    def nodes(self) -> np.ndarray:
+        """The distinct flat node indices the stencil reads (for gathering only those)."""
+        return np.unique(self.idx)
+
+
+def bilinear_stencil(window, px, py) -> Stencil:
+    """Bilinear interpolation at points (px, py) (world lattice coordinates)."""
     gx = np.asarray(px, dtype=np.float64) - window.x0
     gy = np.asarray(py, dtype=np.float64) - window.y0
     i0 = np.floor(gx).astype(np.int64)
@@ -52,27 +66,30 @@ def bilinear(window, fields, px, py):
     _check_inside(window, np.concatenate([i0, i0 + 1]), np.concatenate([j0, j0 + 1]), "bilinear")
     tx = gx - i0
     ty = gy - j0
-    w00 = (1 - tx) * (1 - ty)
-    w10 = tx * (1 - ty)
-    w01 = (1 - tx) * ty
-    w11 = tx * ty
-    out = []
-    for a in fields:
-        out.append(w00 * a[j0, i0] + w10 * a[j0, i0 + 1] + w01 * a[j0 + 1, i0] + w11 * a[j0 + 1, i0 + 1])
-    return out
+    w = window.solid.shape[1]
+    idx = np.stack([j0 * w + i0, j0 * w + i0 + 1, (j0 + 1) * w + i0, (j0 + 1) * w + i0 + 1], axis=1)
+    coef = np.stack([(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty], axis=1)
+    return Stencil(idx, coef)
 
 
-def fluid_extrapolate(window, field, px, py, radius: float = 2.5):
-    """Value of `field` at points (px, py) from a linear least-squares fit to the fluid nodes
-    within `radius` of each point (weights (1 - r/radius)^2); solid nodes are never used.
+def bilinear(window, fields, px, py):
+    """Bilinear interpolation of node fields (each (h, w)) at points (px, py); list of (k,) arrays."""
+    st = bilinear_stencil(window, px, py)
+    return [st.apply(np.asarray(a).ravel()) for a in fields]
+
+
+def fluid_fit_stencil(window, px, py, radius: float = 2.5) -> Stencil:
+    """Value at points (px, py) from a linear least-squares fit to the fluid nodes within
+    `radius` of each point (weights (1 - r/radius)^2); solid nodes are never used.
 
     Points on the body surface thus get the fluid's value extrapolated to the wall. Where fewer
     than three non-collinear fluid nodes lie within the radius, the nearest fluid node's value is
-    used instead.
+    used instead. The fit is linear in the node values, so it is a fixed stencil per pose.
     """
     px = np.asarray(px, dtype=np.float64)
     py = np.asarray(py, dtype=np.float64)
     fluid = ~np.asarray(window.solid, dtype=bool)
+    h, w = fluid.shape
     r = int(np.ceil(radius))
     off = np.arange(-r, r + 2)
     ox, oy = np.meshgrid(off, off)
@@ -86,19 +103,40 @@ def fluid_extrapolate(window, field, px, py, radius: float = 2.5):
     dx = nx_ + window.x0 - px[:, None]
     dy = ny_ + window.y0 - py[:, None]
     dist = np.hypot(dx, dy)
-    wgt = np.where(fluid[ny_, nx_] & (dist < radius), (1.0 - dist / radius) ** 2, 0.0)
-    vals = field[ny_, nx_]
-    # normal equations of the weighted fit  v ~ a + b dx + c dy
+    is_fluid = fluid[ny_, nx_]
+    wgt = np.where(is_fluid & (dist < radius), (1.0 - dist / radius) ** 2, 0.0)
+    # weighted fit v ~ a + b dx + c dy: a = e0 . (A^T W A)^-1 A^T W v
     basis = np.stack([np.ones_like(dx), dx, dy], axis=-1)  # (k, m, 3)
     ata = np.einsum("km,kmi,kmj->kij", wgt, basis, basis)
-    atb = np.einsum("km,kmi,km->ki", wgt, basis, vals)
     det = np.linalg.det(ata)
     ok = np.abs(det) > 1e-9
-    result = np.empty(px.shape, dtype=np.float64)
+    coef = np.zeros(dx.shape)
     if ok.any():
-        result[ok] = np.linalg.solve(ata[ok], atb[ok][..., None])[:, 0, 0]
+        row = np.linalg.solve(ata[ok], np.broadcast_to(np.array([1.0, 0.0, 0.0]), (int(ok.sum()), 3))[..., None])[..., 0]
+        coef[ok] = np.einsum("ki,kmi->km", row, basis[ok]) * wgt[ok]
     if (~ok).any():  # too few fluid nodes: nearest fluid node
-        dmask = np.where(fluid[ny_, nx_], dist, np.inf)[~ok]
-        pick = np.argmin(dmask, axis=1)
-        result[~ok] = vals[~ok][np.arange(pick.size), pick]
-    return result
+        pick = np.argmin(np.where(is_fluid, dist, np.inf)[~ok], axis=1)
+        sub = np.zeros((int((~ok).sum()), dx.shape[1]))
+        sub[np.arange(pick.size), pick] = 1.0
+        coef[~ok] = sub
+    return Stencil(ny_ * w + nx_, coef)
+
+
+def fluid_extrapolate(window, field, px, py, radius: float = 2.5):
+    """`fluid_fit_stencil` applied to one (h, w) field."""
+    return fluid_fit_stencil(window, px, py, radius).apply(np.asarray(field).ravel())
+
+
+def moments_at(window, nodes: np.ndarray):
+    """(rho, ux, uy) as flat (h*w) arrays, computed only at the flat node indices `nodes`
+    (elsewhere zero / one); far cheaper than the whole window's moments."""
+    h, w = window.solid.shape
+    f = np.asarray(window.f, dtype=np.float64).reshape(9, h * w)[:, nodes]
+    rho = np.ones(h * w)
+    ux = np.zeros(h * w)
+    uy = np.zeros(h * w)
+    r = f.sum(axis=0)
+    rho[nodes] = r
+    ux[nodes] = C[:, 0].astype(np.float64) @ f / r
+    uy[nodes] = C[:, 1].astype(np.float64) @ f / r
+    return rho, ux, uy

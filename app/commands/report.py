@@ -1,0 +1,65 @@
+"""`feelflow report seed`: reproduce the seed's experiments with all four force models and write
+docs/report-seed.md with PNG plots (the work is in app/seed_report.py).
+
+Parts (`--only`): protocol, shapes, sweep, lift; each stores its series in
+OUT/report-seed/data-<part>.json, and the report is written from every part stored there, so
+parts can be run separately (or again) and `--replot` rebuilds text and plots without running.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from app.cli import UserError
+
+TARGETS = ("seed",)
+
+
+def add_arguments(parser):
+    parser.add_argument("target", choices=TARGETS, help="which report (seed: the thesis's experiments)")
+    parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
+    parser.add_argument("--quick", action="store_true",
+                        help="a few dozen steps per run: a smoke test of the whole chain, not physics")
+    parser.add_argument("--phase-steps", default=None, metavar="N",
+                        help="steps per protocol phase instead of the scenes' 15000 (stated in the report)")
+    parser.add_argument("--only", default=None, metavar="PART[,PART]",
+                        help="run only these parts: protocol, shapes, sweep, lift (default: all)")
+    parser.add_argument("--scenes", default="scenes", metavar="DIR", help="folder holding the scenes (default: scenes)")
+    parser.add_argument("--out", default="docs", metavar="DIR",
+                        help="folder for report-seed.md and report-seed/ (default: docs)")
+    parser.add_argument("--replot", action="store_true",
+                        help="rebuild text and plots from the stored series without running the flow")
+
+
+def main(args) -> int:
+    from app.seed_report import PARTS, run_part, save_part, write_report
+
+    out = Path(args.out)
+    if not out.is_dir():
+        raise UserError(f"--out: {args.out!r} is not a folder")
+    phase_steps = None
+    if args.phase_steps is not None:
+        try:
+            phase_steps = int(args.phase_steps)
+        except ValueError:
+            phase_steps = 0
+        if phase_steps < 1:
+            raise UserError(f"--phase-steps: must be a positive integer, got {args.phase_steps!r}")
+    parts = PARTS
+    if args.only is not None:
+        parts = tuple(p.strip() for p in args.only.split(",") if p.strip())
+        bad = [p for p in parts if p not in PARTS]
+        if bad or not parts:
+            raise UserError(f"--only: unknown part {bad[0] if bad else args.only!r}; choose from {', '.join(PARTS)}")
+    if not args.replot:
+        scenes = Path(args.scenes)
+        if not scenes.is_dir():
+            raise UserError(f"--scenes: {args.scenes!r} is not a folder")
+        for part in parts:
+            print(f"feelflow report seed: {part} on {args.backend}", file=sys.stderr, flush=True)
+            data = run_part(part, scenes, args.backend, args.quick, phase_steps,
+                            log=lambda line: print(line, file=sys.stderr, flush=True))
+            save_part(out / "report-seed", data)
+    path = write_report(out)
+    print(f"{path}: written")
+    return 0
