@@ -83,11 +83,12 @@ def _publish(mm, loop, seq: list, st=None) -> None:
     fields = [("x", bt.x), ("y", bt.y), ("vx", bt.vx), ("vy", bt.vy), ("t", bt.t),
               ("buttons", bt.buttons), ("valid", bt.valid), ("fx", loop._force[0]), ("fy", loop._force[1]),
               ("ticks", loop._ticks), ("gain", loop.gate.gain)]
+    state, running = loop.state_now()
+    fields += [("running", running), ("state", _STATES.index(state) if state in _STATES else 0)]
     if st is not None:
-        fields += [("running", st.running), ("rate_hz", st.rate_hz), ("jitter_p99_ms", st.jitter_p99_ms),
+        fields += [("rate_hz", st.rate_hz), ("jitter_p99_ms", st.jitter_p99_ms),
                    ("overruns", st.overruns), ("samples", st.samples), ("nan_samples", st.nan_samples),
-                   ("stalls", st.stalls), ("max_force_commanded", st.max_force_commanded),
-                   ("state", _STATES.index(st.state) if st.state in _STATES else 0)]
+                   ("stalls", st.stalls), ("max_force_commanded", st.max_force_commanded)]
     for k, v in fields:
         vals[_IDX[k]] = float(v)
     seq[0] += 1
