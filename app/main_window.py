@@ -176,6 +176,8 @@ class MainWindow(QMainWindow):
         self._action(f, "Export plot as PNG\u2026", self.export_png_dialog)
         self._action(f, "Save screenshot\u2026", self.screenshot_dialog)
         f.addSeparator()
+        self.record_action = self._action(f, "Record session", self.toggle_recording, checkable=True)
+        f.addSeparator()
         self._action(f, "Quit", self.close, "Ctrl+Q")
         e = bar.addMenu("&Edit")
         undo = self.undo.createUndoAction(self, "Undo")
@@ -199,7 +201,24 @@ class MainWindow(QMainWindow):
     def toggle_pause(self, _=None):
         self.set_paused(not self.paused)
 
+    def toggle_recording(self, _=None):
+        if self.sim is None:
+            return
+        solver = self.sim.solver
+        if solver.recorder is None:
+            solver.start_recording(renderer=self.viewport.renderer())
+            self.record_action.setChecked(True)
+            self.statusBar().showMessage("Recording a session: inputs, parameter changes and forces.", 5000)
+            return
+        self.record_action.setChecked(False)
+        recorder = solver.stop_recording()
+        path, _ = QFileDialog.getSaveFileName(self, "Save session", "lesson.ffsession", "Sessions (*.ffsession)")
+        if path:
+            self._try(lambda: recorder.save(path), "Could not save the session")
+
     def set_paused(self, paused: bool):
+        if self.sim is not None and paused != self.paused:
+            self.sim.solver.pause() if paused else self.sim.solver.resume()
         self.paused = paused
         if self.input_device is not None:
             self.input_device.pause(paused)
@@ -432,7 +451,7 @@ class MainWindow(QMainWindow):
     def _try(self, fn, title):
         try:
             fn()
-        except OSError as exc:
+        except (OSError, ValueError) as exc:   # ValueError: ShapeError, SessionError (one line each)
             QMessageBox.warning(self, title, str(exc))
 
     # --- presets ------------------------------------------------------------------------------
