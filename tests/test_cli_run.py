@@ -160,3 +160,11 @@ def test_run_on_gl_matches_numpy(tmp_path):
         assert b[:5] == pytest.approx(a[:5])
         scale = max(abs(v) for v in a[5:])
         assert max(abs(x - y) for x, y in zip(a[5:], b[5:])) <= 1e-4 * scale
+
+
+def test_validate_reports_a_blow_up_as_a_failed_case():
+    # 2D-2 (Re 100) at 10 cells per diameter needs tau = 0.515: the flow blows up
+    result = feelflow("validate", "--case", "schaefer-turek-2d2", "--resolution", "10")
+    assert result.returncode == 1
+    assert "Traceback" not in result.stderr and result.stderr == ""
+    assert "| stable | 0 | 1 .. 1 | **no** |" in result.stdout
