@@ -161,7 +161,7 @@ class GLSolver(Solver):
         rates = np.stack(np.broadcast_arrays(np.asarray(op, float) * np.ones(nx), np.asarray(om, float)), -1)
         self._omega_tex.write(rates.astype("f4").tobytes())
         self._inflow_key = None
-        self._draws = []
+        self._draws, self._draw_regions = [], None
         self._field = None
         self._discard = self.tuning["divergence"] == "discard"
         self._tiles = None
@@ -231,12 +231,17 @@ class GLSolver(Solver):
         return {k: v for k, v in parts.items() if v}
 
     def _set_rects(self, window):
-        """Vertex data of every region (see _regions), drawn in this order each step."""
+        """Vertex data of every region (see _regions), drawn in this order each step; kept
+        when the (block-aligned) regions did not change."""
+        regions = sorted(self._regions(window).items())
+        if regions == self._draw_regions:
+            return
+        self._draw_regions = regions
         for vao, vbo in self._draws:
             vao.release()
             vbo.release()
         self._draws = []
-        for key, rects in sorted(self._regions(window).items()):
+        for key, rects in regions:
             vbo = self.ctx.buffer(_triangles(rects).tobytes())
             vao = self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")])
             self._draws.append((vao, vbo))
