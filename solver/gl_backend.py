@@ -90,13 +90,16 @@ def node_mask(solid: np.ndarray, q: np.ndarray, box) -> np.ndarray:
     ny, nx = solid.shape
     x0, y0, x1, y1 = box
     sl = (slice(y0, y1), slice(x0, x1))
-    fluid_pad = np.pad(~solid, 1, constant_values=False)  # outside the domain: not fluid
+    # fluid flags of box + 1, with the outside of the domain counted as not fluid
+    fluid_pad = np.zeros((y1 - y0 + 2, x1 - x0 + 2), bool)
+    ya, yb, xa, xb = max(y0 - 1, 0), min(y1 + 1, ny), max(x0 - 1, 0), min(x1 + 1, nx)
+    fluid_pad[ya - y0 + 1:yb - y0 + 1, xa - x0 + 1:xb - x0 + 1] = ~solid[ya:yb, xa:xb]
     mask = solid[sl].astype(np.uint32)
     for i in range(1, Q):
         ib = OPP[i]
         cut = (q[ib][sl] > 0) & ~solid[sl]
         cx, cy = int(C[i, 0]), int(C[i, 1])
-        second_fluid = fluid_pad[y0 + 1 + cy:y1 + 1 + cy, x0 + 1 + cx:x1 + 1 + cx]
+        second_fluid = fluid_pad[1 + cy:y1 - y0 + 1 + cy, 1 + cx:x1 - x0 + 1 + cx]
         two_node = cut & (q[ib][sl] < 0.5) & second_fluid & (q[i][sl] == 0)
         mask |= cut.astype(np.uint32) << np.uint32(i)
         mask |= two_node.astype(np.uint32) << np.uint32(8 + i)
