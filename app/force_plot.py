@@ -30,6 +30,8 @@ def fit_power_law(speed, drag, bins: int = 12):
     speed, drag = speed[ok], drag[ok]
     if len(speed) < 3:
         return np.array([]), np.array([]), None
+    if speed.max() < speed.min() * 1.01:     # one speed so far: one point
+        return np.array([speed.mean()]), np.array([drag.mean()]), None
     edges = np.geomspace(speed.min(), speed.max() * 1.0001, bins + 1)
     idx = np.digitize(speed, edges) - 1
     us, fs = [], []
@@ -69,7 +71,11 @@ class ForcePlot(QWidget):
         bar = QHBoxLayout()
         for w in (self.view, self.pause_box, self.clear_button, self.csv_button, self.png_button):
             bar.addWidget(w)
+        self.fit_label = QLabel("")
+        self.fit_label.setFont(self.readout.font())
         bar.addStretch(1)
+        bar.addWidget(self.fit_label)
+        bar.addSpacing(16)
         bar.addWidget(self.readout)
 
         pg.setConfigOptions(antialias=True, background="w", foreground="k")
@@ -84,9 +90,8 @@ class ForcePlot(QWidget):
             f.setPointSize(11)
             self.plot.getAxis(ax).label.setFont(f)
         self.curves = {}
-        self.scatter = pg.ScatterPlotItem(size=9, brush=pg.mkBrush(220, 40, 40), pen=pg.mkPen("k"))
-        self.fit_line = pg.PlotCurveItem(pen=pg.mkPen((40, 40, 40), width=2, style=Qt.DashLine))
-        self.fit_text = pg.TextItem(anchor=(0, 0), color="k")
+        self.scatter = self.fit_line = None
+        self.fitted_exponent = None
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 4, 4, 4)
         layout.addLayout(bar)
@@ -112,13 +117,16 @@ class ForcePlot(QWidget):
         self.legend = self.plot.addLegend(offset=(10, 5))
         speed_view = self.view.currentData() == "speed"
         self.plot.setLogMode(speed_view, speed_view)
-        if speed_view:
-            self.plot.addItem(self.scatter)
-            self.plot.addItem(self.fit_line)
-            self.plot.addItem(self.fit_text)
+        if speed_view:   # PlotDataItems: the log mode transforms them (bare scatter items it does not)
+            self.scatter = self.plot.plot([], [], pen=None, symbol="o", symbolSize=10,
+                                          symbolBrush=pg.mkBrush(220, 40, 40), symbolPen=pg.mkPen("k"),
+                                          name="mean drag at one speed")
+            self.fit_line = self.plot.plot([], [], pen=pg.mkPen((40, 40, 40), width=2, style=Qt.DashLine),
+                                           name="fit")
             self.plot.getAxis("bottom").setLabel("relative speed |U - V| (lattice units)")
             self.plot.getAxis("left").setLabel("drag (lattice units)")
         else:
+            self.fit_label.setText("")
             self.plot.getAxis("bottom").setLabel("time (solver steps)")
             self.plot.getAxis("left").setLabel("force (lattice units)")
         self.refresh(force=True)
@@ -159,7 +167,7 @@ class ForcePlot(QWidget):
         cd, cl = self.coefficients()
 
         def fmt(v):
-            return "\u2013" if not math.isfinite(v) else f"{v:.2f}"
+            return "\u2013" if not math.isfinite(v) else f"{v + 0.0:.2f}".replace("-0.00", "0.00")
         self.readout.setText(f"C<sub>D</sub> = {fmt(cd)} &nbsp; C<sub>L</sub> = {fmt(cl)}")
 
     def _curve(self, key, pen, name):
@@ -198,13 +206,10 @@ class ForcePlot(QWidget):
             c = np.mean(np.log(fs) - n * np.log(us))
             xs = np.geomspace(us.min(), us.max(), 20)
             self.fit_line.setData(xs, np.exp(c) * xs ** n)
-            self.fit_text.setText(f"drag \u221d U^{n:.2f}")
-            self.fit_text.setPos(math.log10(us.min()), math.log10(fs.max()))
+            self.fit_label.setText(f"fit: drag \u221d U<sup>{n:.2f}</sup>")
         else:
             self.fit_line.setData([], [])
-            self.fit_text.setText("move the body at several speeds\n(or run the preset 'drag grows with speed')")
-            if len(us):
-                self.fit_text.setPos(math.log10(us.min()), math.log10(fs.max()))
+            self.fit_label.setText("fit: needs speeds a factor 1.5 apart")
         self.fitted_exponent = n
 
     # --- export ---------------------------------------------------------------------------

@@ -29,7 +29,7 @@ from solver.config import ConfigError
 TARGET_FRAME_S = 1.0 / 34      # aim a little above 30 fps
 MAX_STEPS_PER_FRAME = 200
 MIN_STEPS_PER_FRAME = 2   # the flow keeps moving even where drawing alone takes 1/30 s
-N_TRACERS = 1500
+N_TRACERS = 900
 
 
 class MainWindow(QMainWindow):
@@ -64,7 +64,7 @@ class MainWindow(QMainWindow):
         pdock.setWidget(self.plot)
         pdock.setFeatures(QDockWidget.DockWidgetMovable)
         self.addDockWidget(Qt.BottomDockWidgetArea, pdock)
-        self.resizeDocks([pdock], [260], Qt.Vertical)
+        self.resizeDocks([pdock], [230], Qt.Vertical)
 
         self.status = {k: QLabel() for k in ("steps", "mlups", "fps", "re", "ma", "renderer")}
         for label in self.status.values():
@@ -146,7 +146,8 @@ class MainWindow(QMainWindow):
         self.plot.sim = self.sim
         self.viewport.mode = self.display_mode
         self.panel.show_params(self.sim.params, self.display_mode)
-        self.status["renderer"].setText(f"{self.viewport.renderer()} ({self.backend} solver)")
+        self.status["renderer"].setText(f"{self.viewport.renderer().split(' (')[0]}, {self.backend} solver")
+        self.status["renderer"].setToolTip(self.viewport.renderer())
         self._upload_field()
         self.refresh_devices()
         self.timer.start()
@@ -175,6 +176,8 @@ class MainWindow(QMainWindow):
         self._action(f, "Export plot as PNG\u2026", self.export_png_dialog)
         self._action(f, "Save screenshot\u2026", self.screenshot_dialog)
         f.addSeparator()
+        self.record_action = self._action(f, "Record session", self.toggle_recording, checkable=True)
+        f.addSeparator()
         self._action(f, "Quit", self.close, "Ctrl+Q")
         e = bar.addMenu("&Edit")
         undo = self.undo.createUndoAction(self, "Undo")
@@ -198,7 +201,24 @@ class MainWindow(QMainWindow):
     def toggle_pause(self, _=None):
         self.set_paused(not self.paused)
 
+    def toggle_recording(self, _=None):
+        if self.sim is None:
+            return
+        solver = self.sim.solver
+        if solver.recorder is None:
+            solver.start_recording(renderer=self.viewport.renderer())
+            self.record_action.setChecked(True)
+            self.statusBar().showMessage("Recording a session: inputs, parameter changes and forces.", 5000)
+            return
+        self.record_action.setChecked(False)
+        recorder = solver.stop_recording()
+        path, _ = QFileDialog.getSaveFileName(self, "Save session", "lesson.ffsession", "Sessions (*.ffsession)")
+        if path:
+            self._try(lambda: recorder.save(path), "Could not save the session")
+
     def set_paused(self, paused: bool):
+        if self.sim is not None and paused != self.paused:
+            self.sim.solver.pause() if paused else self.sim.solver.resume()
         self.paused = paused
         if self.input_device is not None:
             self.input_device.pause(paused)
@@ -431,7 +451,7 @@ class MainWindow(QMainWindow):
     def _try(self, fn, title):
         try:
             fn()
-        except OSError as exc:
+        except (OSError, ValueError) as exc:   # ValueError: ShapeError, SessionError (one line each)
             QMessageBox.warning(self, title, str(exc))
 
     # --- presets ------------------------------------------------------------------------------
@@ -643,7 +663,7 @@ class MainWindow(QMainWindow):
         k = int(bad.sum())
         if k:
             pts[bad] = np.c_[rng.uniform(0, 3, k), rng.uniform(0, ny - 1, k)]
-        tail = pts - u * 60
+        tail = pts - u * 30   # a short streak: where the particle was 30 steps ago
         self.viewport.tracers = (pts, tail)
 
     def refresh_readouts(self):

@@ -11,6 +11,7 @@ import numpy as np
 
 from app.coupling import AngleSpring, SpringDamper
 from solver import units
+from app.session import SessionSolver
 from solver.backend import create_solver
 from solver.config import FlowConfig
 from solver.motion import MotionRunner
@@ -165,26 +166,21 @@ class Simulation:
 
     def _build(self, keep_flow: bool):
         config = self.flow_config()
-        old = self.solver
-        solver = create_solver(self.backend, config, **({"ctx": self.ctx} if self.backend == "gl" else {}))
-        if keep_flow and old is not None and old.config.nx == config.nx and old.config.ny == config.ny:
-            solver.set_distributions(old.distributions())
-            solver.time = old.time
-        else:
+        same_grid = self.solver is not None and (self.solver.config.nx, self.solver.config.ny) == (config.nx, config.ny)
+        if self.solver is None:   # one SessionSolver for the life of the window (app/session.py)
+            backend = create_solver(self.backend, config, **({"ctx": self.ctx} if self.backend == "gl" else {}))
+            self.solver = SessionSolver(backend)
+        else:                     # recorded as a rebuild when a session is being recorded
+            self.solver.rebuild(config, keep_flow=keep_flow and same_grid)
+        if not (keep_flow and same_grid):
             nx, ny = config.nx, config.ny
             self.pos, self.vel = (nx * 0.3, ny * 0.5), (0.0, 0.0)
             self.angle, self.rate = math.radians(self.params.angle_deg), 0.0
             self.angle_target = self.angle
             self.target = None
             self.history.clear()
-        if old is not None:
-            old.close()
-        self.solver = solver
-        if self.runner is not None:
-            if keep_flow:
-                self.runner.solver = solver
-            else:
-                self.runner = None
+        if self.runner is not None and not keep_flow:
+            self.runner = None
         self.config = config
         self.coupling = SpringDamper(max_speed=config.max_speed)
         if not keep_flow or not hasattr(self, "shape"):
@@ -231,13 +227,14 @@ class Simulation:
         self._enable_models()
 
     def reset_flow(self):
-        """Fluid at rest again, body where it was, history cleared."""
-        pose = (self.pos, self.angle)
-        self._build(keep_flow=False)
-        (self.pos, self.angle) = pose
+        """The flow from its initial state again (time 0), body where it was, at rest; history cleared."""
+        self.solver.reset()
+        self.runner = self.sweep = None
+        self.vel, self.rate, self.target = (0.0, 0.0), 0.0, None
         self.angle_target = self.angle
         self.shape = self.shape.moved(*self.pos, self.angle)
         self.solver.set_body(self.shape, (0.0, 0.0), 0.0)
+        self.history.clear()
 
     def start_sweep(self, speeds, hold_steps: int):
         """Hold each wind speed `hold_steps` steps in turn (the 'drag grows with speed' lesson)."""

@@ -34,10 +34,10 @@ class DisplayMode:
 
 
 DISPLAY_MODES = {
-    "speed": DisplayMode("Speed", "viridis", 0, (0.0, 1.6), "speed / wind speed"),
-    "vorticity": DisplayMode("Vorticity", "CET-D1", 1, (-4.0, 4.0), "vorticity \u00d7 D / U"),
-    "pressure": DisplayMode("Pressure", "CET-D1", 2, (-1.5, 1.5), "pressure coeff. Cp"),
-    "tracers": DisplayMode("Tracers", "viridis", 3, (0.0, 1.6), "speed / wind speed"),
+    "speed": DisplayMode("Speed", "viridis", 0, (0.0, 1.6), "speed\n\u00f7 wind speed"),
+    "vorticity": DisplayMode("Vorticity", "CET-D1", 1, (-4.0, 4.0), "vorticity\n\u00d7 D \u00f7 U"),
+    "pressure": DisplayMode("Pressure", "CET-D1", 2, (-1.5, 1.5), "pressure\ncoefficient Cp"),
+    "tracers": DisplayMode("Tracers", "viridis", 3, (0.0, 1.6), "speed\n\u00f7 wind speed"),
 }
 
 BODY_FILL = QColor(225, 225, 225)
@@ -245,6 +245,8 @@ class Viewport(QOpenGLWidget):
         p.setPen(QPen(Qt.black, 1.5))
         p.setBrush(QBrush(colour))
         p.drawPolygon(tip)
+        if length < 30:   # too short to carry a label without covering the body
+            return
         self._label(p, QPointF(end.x() + 10 * ux - 4, end.y() + 10 * uy + (16 if uy > 0.5 else -8 if uy < -0.5 else 5)),
                     label, QColor(255, 255, 255), box=colour.darker(130))
 
@@ -346,7 +348,7 @@ class Viewport(QOpenGLWidget):
 
     def _paint_tracers(self, p: QPainter):
         pts, prev = self.tracers
-        p.setPen(QPen(QColor(20, 40, 120), 2.0, Qt.SolidLine, Qt.RoundCap))
+        p.setPen(QPen(QColor(20, 40, 120), 1.6, Qt.SolidLine, Qt.FlatCap))
         r = self.lattice_rect()
         nx, ny = self.sim.config.nx, self.sim.config.ny
         sx, sy = r.width() / nx, r.height() / ny

@@ -378,3 +378,31 @@ def test_haptic_device_moves_the_body_feels_the_force_and_unplugging_falls_back_
     qtbot.waitUntil(lambda: window.input_device is None, timeout=10000)
     assert panel.input.currentData() == "mouse"
     assert "disconnected" in panel.input_note.text()
+
+
+def test_recording_a_session_saves_inputs_parameters_and_forces(window, qtbot, tmp_path, monkeypatch):
+    from PySide6.QtWidgets import QFileDialog
+
+    from app.selftest import send_mouse
+    from app.session import load_session
+
+    path = tmp_path / "lesson.ffsession"
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(path), ""))
+    window.record_action.trigger()
+    assert window.sim.solver.recorder is not None
+    t0 = window.sim.solver.time
+    vp, sim = window.viewport, window.sim
+    send_mouse(vp, "press", vp.to_widget(*sim.pos))
+    send_mouse(vp, "move", vp.to_widget(sim.pos[0] + 20, sim.pos[1]))
+    qtbot.waitUntil(lambda: sim.solver.time > t0 + 100, timeout=20000)
+    send_mouse(vp, "release", vp.to_widget(sim.pos[0], sim.pos[1]))
+    window.panel.wind.setValue(0.06)
+    t1 = sim.solver.time
+    qtbot.waitUntil(lambda: sim.solver.time > t1 + 50, timeout=20000)
+    window.record_action.trigger()
+    assert window.sim.solver.recorder is None and path.exists()
+    session = load_session(path)
+    names = [p["name"] for p in session.parameters]
+    assert "inflow_speed" in names
+    assert len(session.inputs["step"]) > 0 and len(session.forces["step"]) > 0
+    assert session.steps > 100

@@ -1,7 +1,7 @@
 """The seed's macroscopic drag model (seed eq. 19, fig. 14): the textbook drag equation fed with
 the flow sampled on a contour around the body.
 
-    F = 1/2 rho A |U| (C_D U + C_L |U| e_L),    U = u - V
+    F = 1/2 rho |U| (C_D A U + C_L c |U| e_L),    U = u - V
 
 - u: mean fluid velocity on the contour at distance `distance` (d, default 4 cells, the seed's
   working value; fig. 14) from the body surface, sampled by bilinear interpolation of the
@@ -10,6 +10,7 @@ the flow sampled on a contour around the body.
 - V: the body's translational velocity (rotation is ignored).
 - A: `shape.frontal_area` for the direction of U.
 - C_D, C_L: a table per shape kind (below), textbook values at Re 1e4-1e5, collected in
+  (C_L is referred to the chord c of the half airfoil, C_D to the frontal width A)
   ../shared/reference/benchmarks.md from White, *Fluid Mechanics* (table 7.2) and Hoerner,
   *Fluid-Dynamic Drag* (1965). e_L is the unit vector normal to U on the side of the body's own
   "up" (its +y axis rotated by its angle).
@@ -18,7 +19,8 @@ This model knows nothing of the flow around the body except one mean velocity: i
 like |U|^2 by construction, and it separates shapes only through the coefficients it is given.
 Sampling at d -> 0 reads the wall velocity V (no-slip), so U -> 0: the seed's first failure.
 The sampling contour must lie inside the body window: `margin` (ceil(d) + 2 cells) tells the
-backends how far the window must extend beyond the body.
+backends how far the window must extend beyond the body. Where the window is clipped by the
+domain's edge (a body near a wall), the contour points beyond it are left out.
 """
 from __future__ import annotations
 
@@ -28,6 +30,7 @@ import numpy as np
 
 from solver.forces.base import BodyWindow, ForceModel
 from solver.forces.sampling import bilinear_stencil, moments_at
+from solver.lattice import RHO0
 
 #: kind -> (C_D, source). Wedges depend on which way they face (see `drag_coefficient`).
 DRAG_COEFFICIENTS: dict[str, tuple[float, str]] = {
@@ -66,17 +69,18 @@ def drag_coefficient(shape, flow_dir) -> tuple[float, str]:
     return DRAG_COEFFICIENTS.get(kind, DRAG_COEFFICIENTS["polygon"])
 
 
-def lift_coefficient(shape) -> float:
-    """C_L of the shape's kind (0 where LIFT_SOURCES has no entry)."""
+def lift_coefficient(shape) -> tuple[float, float]:
+    """(C_L, reference length) of the shape's kind: (0, 0) where LIFT_SOURCES has no entry.
+    The half airfoil's thin-airfoil C_L is referred to its chord, not to its frontal width."""
     if getattr(shape, "kind", None) == "half_airfoil":
         chord = float(getattr(shape, "chord"))
         thickness = float(getattr(shape, "thickness"))
-        return 2.0 * math.pi * thickness / chord
-    return 0.0
+        return 2.0 * math.pi * thickness / chord, chord
+    return 0.0, 0.0
 
 
 class MacroscopicDrag(ForceModel):
-    """F = 1/2 rho A |U| (C_D U + C_L |U| e_L) with U sampled on a contour (seed eq. 19, fig. 14)."""
+    """F = 1/2 rho |U| (C_D A U + C_L c |U| e_L) with U sampled on a contour (seed eq. 19, fig. 14)."""
 
     name = "macroscopic"
     description = "drag equation with C_D from a table, fluid velocity sampled d cells off the wall (seed)"
@@ -104,9 +108,12 @@ class MacroscopicDrag(ForceModel):
             lengths = np.asarray(lengths, dtype=np.float64)
             stencil = bilinear_stencil(window, pts[:, 0] + self.distance * normals[:, 0],
                                        pts[:, 1] + self.distance * normals[:, 1])
-            self._geom = (stencil, stencil.nodes(), lengths / lengths.sum())
+            weight = lengths * stencil.valid  # points beyond a clipped window are left out
+            self._geom = (stencil, stencil.nodes(), weight / weight.sum() if weight.sum() > 0 else None)
             self._key = key
         stencil, nodes, weight = self._geom
+        if weight is None:  # the whole contour lies beyond the domain: nothing to sample
+            return RHO0, window.velocity[0], window.velocity[1]
         rho, ux, uy = moments_at(window, nodes)
         return tuple(float(np.dot(stencil.apply(a), weight)) for a in (rho, ux, uy))
 
@@ -122,7 +129,9 @@ class MacroscopicDrag(ForceModel):
         direction = np.array([ux / speed, uy / speed])
         area = float(shape.frontal_area(direction))
         cd = self.cd_override if self.cd_override is not None else drag_coefficient(shape, direction)[0]
-        cl = self.cl_override if self.cl_override is not None else lift_coefficient(shape)
+        cl, lift_length = lift_coefficient(shape)
+        if self.cl_override is not None:
+            cl, lift_length = self.cl_override, (lift_length or area)
         fx = 0.5 * rho * area * speed * cd * ux
         fy = 0.5 * rho * area * speed * cd * uy
         if cl:
@@ -130,6 +139,6 @@ class MacroscopicDrag(ForceModel):
             e_lift = np.array([-direction[1], direction[0]])
             if float(np.dot(e_lift, up)) < 0:
                 e_lift = -e_lift
-            fx += 0.5 * rho * area * speed * speed * cl * e_lift[0]
-            fy += 0.5 * rho * area * speed * speed * cl * e_lift[1]
+            fx += 0.5 * rho * lift_length * speed * speed * cl * e_lift[0]
+            fy += 0.5 * rho * lift_length * speed * speed * cl * e_lift[1]
         return float(fx), float(fy)

@@ -77,7 +77,8 @@ class PressureIntegration(ForceModel):
 
     def compute(self, window: BodyWindow) -> tuple[float, float]:
         _, normals, lengths, rho = self.wall_density(window)
-        p = self.beta_prime * (rho * rho - RHO0 * RHO0)
+        valid = self._geom[3].valid  # a surface point with no fluid node in reach: gauge pressure 0
+        p = np.where(valid, self.beta_prime * (rho * rho - RHO0 * RHO0), 0.0)
         fx = -float(np.sum(p * normals[:, 0] * lengths))
         fy = -float(np.sum(p * normals[:, 1] * lengths))
         return fx, fy

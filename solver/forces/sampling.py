@@ -32,22 +32,23 @@ def moments(window):
     return rho, ux, uy
 
 
-def _check_inside(window, ix, iy, what):
+def _inside(window, ix, iy):
+    """Which window indices lie inside the window (it is clipped at the domain's edges, so a
+    body near a wall can have sample points beyond it: those are left out, never wrapped)."""
     h, w = window.solid.shape
-    if ix.size and (ix.min() < 0 or iy.min() < 0 or ix.max() >= w or iy.max() >= h):
-        raise ValueError(
-            f"{what}: sample points reach outside the body window ({w}x{h} at {window.x0},{window.y0}); "
-            "the backend must widen the window by the model's `margin`")
+    return (ix >= 0) & (iy >= 0) & (ix < w) & (iy < h)
 
 
 class Stencil:
     """Values at k points as fixed linear combinations of node values: v_k = sum_m coef[k, m] *
     field[idx[k, m]] (idx: flat indices into the window's (h, w) arrays). Built once per body
-    pose, applied every step."""
+    pose, applied every step. `valid[k]` is False for a point the window could not serve (its
+    value is then 0; callers leave it out)."""
 
-    def __init__(self, idx: np.ndarray, coef: np.ndarray):
+    def __init__(self, idx: np.ndarray, coef: np.ndarray, valid: np.ndarray):
         self.idx = idx
         self.coef = coef
+        self.valid = valid
 
     def apply(self, field_flat: np.ndarray) -> np.ndarray:
         return (field_flat[self.idx] * self.coef).sum(axis=1)
@@ -63,13 +64,15 @@ def bilinear_stencil(window, px, py) -> Stencil:
     gy = np.asarray(py, dtype=np.float64) - window.y0
     i0 = np.floor(gx).astype(np.int64)
     j0 = np.floor(gy).astype(np.int64)
-    _check_inside(window, np.concatenate([i0, i0 + 1]), np.concatenate([j0, j0 + 1]), "bilinear")
+    valid = _inside(window, i0, j0) & _inside(window, i0 + 1, j0 + 1)
+    i0 = np.where(valid, i0, 0)
+    j0 = np.where(valid, j0, 0)
     tx = gx - i0
     ty = gy - j0
     w = window.solid.shape[1]
     idx = np.stack([j0 * w + i0, j0 * w + i0 + 1, (j0 + 1) * w + i0, (j0 + 1) * w + i0 + 1], axis=1)
-    coef = np.stack([(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty], axis=1)
-    return Stencil(idx, coef)
+    coef = np.stack([(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty], axis=1) * valid[:, None]
+    return Stencil(idx, coef, valid)
 
 
 def bilinear(window, fields, px, py):
@@ -99,11 +102,13 @@ def fluid_fit_stencil(window, px, py, radius: float = 2.5) -> Stencil:
     by = np.floor(py - window.y0).astype(np.int64)
     nx_ = bx[:, None] + ox[None, :]  # (k, m) window indices
     ny_ = by[:, None] + oy[None, :]
-    _check_inside(window, nx_.ravel(), ny_.ravel(), "fluid_extrapolate")
+    inside = _inside(window, nx_, ny_)
     dx = nx_ + window.x0 - px[:, None]
     dy = ny_ + window.y0 - py[:, None]
     dist = np.hypot(dx, dy)
-    is_fluid = fluid[ny_, nx_]
+    nx_ = np.where(inside, nx_, 0)
+    ny_ = np.where(inside, ny_, 0)
+    is_fluid = fluid[ny_, nx_] & inside
     wgt = np.where(is_fluid & (dist < radius), (1.0 - dist / radius) ** 2, 0.0)
     # weighted fit v ~ a + b dx + c dy: a = e0 . (A^T W A)^-1 A^T W v
     basis = np.stack([np.ones_like(dx), dx, dy], axis=-1)  # (k, m, 3)
@@ -114,12 +119,13 @@ def fluid_fit_stencil(window, px, py, radius: float = 2.5) -> Stencil:
     if ok.any():
         row = np.linalg.solve(ata[ok], np.broadcast_to(np.array([1.0, 0.0, 0.0]), (int(ok.sum()), 3))[..., None])[..., 0]
         coef[ok] = np.einsum("ki,kmi->km", row, basis[ok]) * wgt[ok]
-    if (~ok).any():  # too few fluid nodes: nearest fluid node
+    valid = ok | is_fluid.any(axis=1)
+    if (~ok).any():  # too few fluid nodes: nearest fluid node (none at all: not valid)
         pick = np.argmin(np.where(is_fluid, dist, np.inf)[~ok], axis=1)
         sub = np.zeros((int((~ok).sum()), dx.shape[1]))
-        sub[np.arange(pick.size), pick] = 1.0
+        sub[np.arange(pick.size), pick] = valid[~ok]
         coef[~ok] = sub
-    return Stencil(ny_ * w + nx_, coef)
+    return Stencil(ny_ * w + nx_, coef, valid)
 
 
 def fluid_extrapolate(window, field, px, py, radius: float = 2.5):

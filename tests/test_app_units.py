@@ -1,0 +1,54 @@
+"""Qt-free parts of the app: the mouse coupling, the power-law fit of the drag plot, history."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from app.coupling import SpringDamper
+
+
+def test_spring_damper_settles_on_the_target_without_overshoot():
+    """Critical damping: x(t) = T (1 - (1 + w t) e^{-w t}) from rest, never past the target."""
+    c = SpringDamper(w0=0.05, max_speed=10.0)
+    pos, vel = (0.0, 0.0), (0.0, 0.0)
+    xs = []
+    for _ in range(200):
+        pos, vel, capped = c.advance(pos, vel, (10.0, 0.0), 1)
+        xs.append(pos[0])
+        assert not capped
+    assert max(xs) <= 10.0 + 1e-9
+    t = 100
+    exact = 10.0 * (1 - (1 + 0.05 * t) * math.exp(-0.05 * t))
+    assert xs[t - 1] == pytest.approx(exact, rel=0.05)   # semi-implicit Euler, dt = 1 step
+    assert xs[-1] == pytest.approx(10.0, abs=0.05)
+
+
+def test_spring_damper_caps_the_speed_and_says_so():
+    c = SpringDamper(w0=0.05, max_speed=0.05)
+    pos, vel, capped = c.advance((0.0, 0.0), (0.0, 0.0), (100.0, 100.0), 50)
+    assert capped and math.hypot(*vel) == pytest.approx(0.05)
+    assert math.hypot(*pos) <= 0.05 * 50 + 1e-9
+
+
+def test_power_law_fit_recovers_the_exponent():
+    from app.force_plot import fit_power_law
+
+    rng = np.random.default_rng(0)
+    u = np.repeat([0.02, 0.03, 0.045, 0.065, 0.09], 40)
+    f = 3.0 * u ** 1.7 * (1 + 0.02 * rng.standard_normal(u.size))
+    us, fs, n = fit_power_law(u, f)
+    assert len(us) == 5 and n == pytest.approx(1.7, abs=0.03)
+    _, _, n = fit_power_law(np.full(50, 0.05), np.full(50, 0.01))
+    assert n is None
+
+
+def test_history_drag_and_lift_are_along_and_across_the_relative_wind():
+    from app.simulation import History
+
+    h = History()
+    h.add(1, (0.0, 0.0), (0.05, 0.0), {"m": (2.0, 1.0)})
+    h.add(2, (0.0, -0.05), (0.0, 0.05), {"m": (2.0, 1.0)})    # wind from below: drag along +y
+    _, drag, lift = h.drag_lift("m")
+    assert drag.tolist() == [2.0, 1.0] and lift.tolist() == [1.0, -2.0]
