@@ -43,7 +43,8 @@ import moderngl
 import numpy as np
 
 from solver.backend import BackendError, Solver, SolverDiverged
-from solver.body import BodyState, expand_box, make_body_state, refill, shifted, union_box, unshifted, window_margin
+from solver.body import (BodyState, expand_box, make_body_state, move_body, shifted, union_box, unshifted,
+                         window_margin)
 from solver.forces import create_model
 from solver.forces.base import BodyWindow
 from solver.gl_programs import create_program
@@ -416,22 +417,23 @@ class GLSolver(Solver):
         new = None
         if shape is not None:
             new = make_body_state(shape, velocity, omega, cfg, window_margin(self._models.values()), raster)
+        read = {}
+
+        def read_window(x0, y0, x1, y1):  # the refill box, read back once
+            read["g"] = self._read_shifted((x0, y0, x1, y1))
+            return unshifted(read["g"])
+
+        def write_nodes(x0, y0, f, changed):  # rewrite the box, changed nodes from the refill
+            g = read["g"]
+            g[:, changed] = shifted(f[:, changed]).astype("f4")
+            h, w = changed.shape
+            self._write_shifted(g, (x0, y0, x0 + w, y0 + h))
+
+        jx, jy = move_body(old, new, cfg, read_window, write_nodes)
+        self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         box = union_box(old.raster.window if old else None, new.raster.window if new else None)
         if box is not None:
-            box = expand_box(box, 1, cfg.nx, cfg.ny)
-            x0, y0, x1, y1 = box
-            shape_ = (y1 - y0, x1 - x0)
-            ys, xs = slice(y0, y1), slice(x0, x1)
-            old_solid = old.solid[ys, xs] if old else np.zeros(shape_, bool)
-            new_solid = new.solid[ys, xs] if new else np.zeros(shape_, bool)
-            motion = new if new is not None else old
-            g = self._read_shifted(box)
-            f = unshifted(g)
-            (jx, jy), changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0)
-            g[:, changed] = shifted(f[:, changed]).astype("f4")
-            self._write_shifted(g, box)
-            self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
-            self._upload_raster(new, expand_box(box, 1, cfg.nx, cfg.ny))
+            self._upload_raster(new, expand_box(box, 2, cfg.nx, cfg.ny))
         self.body = new
         self.speed_capped = (new.capped if new is not None else False) or self.inflow_capped
         self._set_rects(None if new is None else new.raster.window)
