@@ -70,6 +70,7 @@ class Viewport(QOpenGLWidget):
         self.tracers = None
         self.frames = 0
         self.field_texture = None
+        self.rho_ref = 1.0             # free-stream density for the pressure view (set by the window)
         self._grab = None              # offset from body centre to the pressed point
         self._edit_vertex = None       # index of the vertex being dragged
         self._edit_preview = None
@@ -175,6 +176,7 @@ class Viewport(QOpenGLWidget):
         self.program["mode"] = mode.shader_mode
         self.program["scale"] = self.display_scale()
         self.program["range"] = mode.range
+        self.program["rho_ref"] = self.rho_ref
         self.vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
         ctx.viewport = full
 
