@@ -21,6 +21,15 @@ of `haptics.types`. The API for the app:
     loop.status()                                  # LoopStatus: state, rate, jitter, counters
     loop.stop(); dev.close()
 
+In the app, prefer the same loop in a child process, which no GUI or solver thread of the app
+can stall through the interpreter lock (docs/haptics.md, 'Timing'):
+
+    loop = ProcessForceLoop("sim://haply2diy", LoopConfig(...), on_disconnect=callback)
+    loop.capabilities; loop.start(); ...same calls as above...; loop.close()
+
+`body_target()` is meant as the target of the app's own coupling (the mouse's), which applies
+the Mach cap; divide its velocity (nodes per second) by the steps per second.
+
 Units: ForceSample is in LATTICE units (tunnel axes); the loop alone converts to newtons
 (`ForceScale`: the scene's expected peak -> comfort_fraction x device maximum) and clamps to the
 device maximum every tick; drivers clamp again. Poses are metres in the device frame.
@@ -35,6 +44,15 @@ from haptics.types import BodyTarget, Capabilities, DeviceInfo, ForceSample, Pos
 
 __all__ = [
     "BadDeviceURL", "BodyTarget", "Capabilities", "DeviceDisconnected", "DeviceError", "DeviceInfo",
-    "ForceLoop", "ForceSample", "LoopConfig", "LoopStatus", "Pose", "SafetyConfig", "list_devices",
+    "ForceLoop", "ForceSample", "LoopConfig", "LoopStatus", "Pose", "ProcessForceLoop", "SafetyConfig",
+    "list_devices",
     "open_device",
 ]
+
+
+def __getattr__(name):  # ProcessForceLoop lazily: `python -m haptics.process_loop` imports this package
+    if name == "ProcessForceLoop":
+        from haptics.process_loop import ProcessForceLoop
+
+        return ProcessForceLoop
+    raise AttributeError(f"module 'haptics' has no attribute {name!r}")

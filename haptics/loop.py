@@ -181,6 +181,11 @@ class ForceLoop:
         """Where the coupled body is now (tunnel coordinates) and how fast it moves."""
         return self._target
 
+    def state_now(self) -> tuple[str, bool]:
+        """(state, running), cheaply (status() also computes rate and jitter statistics)."""
+        running = self._thread is not None and self._thread.is_alive()
+        return (self.gate.state if (running or self._disconnect_reason) else "idle"), running
+
     def status(self) -> LoopStatus:
         periods = np.array(self._periods, dtype=float)
         if periods.size > 1:
@@ -188,8 +193,7 @@ class ForceLoop:
             jitter = float(np.percentile(np.abs(periods - self.ticker.period), 99) * 1e3)
         else:
             rate, jitter = 0.0, 0.0
-        running = self._thread is not None and self._thread.is_alive()
-        state = self.gate.state if (running or self._disconnect_reason) else "idle"
+        state, running = self.state_now()
         return LoopStatus(state, running, self._ticks, rate, jitter, self.ticker.overruns,
                           self._samples, self._nan, self.gate.counts["stall"], self.gate.gain,
                           self._force, self._max_cmd, dict(self.device.counters), self._disconnect_reason,

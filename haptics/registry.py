@@ -151,14 +151,17 @@ def _guess_serial_driver(port: str) -> str:
 def _open_sim(kind: str, url: str, drivers):
     from haptics.transport import HidTransport, SerialTransport
 
-    if kind == "haply2diy":
-        from haptics.sim.haply_sim import HaplySim
-        sim = HaplySim()
-        dev = drivers[kind](SerialTransport(sim.port), url)
-    elif kind == "hapkit":
-        from haptics.sim.hapkit_sim import HapkitSim
-        sim = HapkitSim()
-        dev = drivers[kind](SerialTransport(sim.port), url)
+    if kind in ("haply2diy", "hapkit"):  # serial boards: a simulator process behind a pty
+        from haptics.drivers.haply2diy import WORKSPACE
+        from haptics.sim.hapkit_sim import INFO
+        from haptics.sim.serve import RemoteSim
+        ws = WORKSPACE if kind == "haply2diy" else ((INFO.x_min, INFO.x_max), (0.0, 0.0))
+        sim = RemoteSim(kind, ws)
+        try:
+            dev = drivers[kind](SerialTransport(sim.port), url)
+        except DeviceError:
+            sim.stop()
+            raise
     else:
         from haptics.sim.hid_sim import DiyHidSim, SpaceMouseSim
         sim = SpaceMouseSim() if kind == "spacemouse" else DiyHidSim()

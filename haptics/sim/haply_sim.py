@@ -8,6 +8,7 @@ firmware does.
 """
 from __future__ import annotations
 
+import collections
 import math
 import struct
 
@@ -27,7 +28,7 @@ class HaplySim(PtyDevice):
         self.encoders = {}  # port -> (offset, resolution)
         self.motors = []  # ports, in order
         self.torques = {}  # port -> last torque
-        self.commands = []  # (cmd, device id) seen, for tests
+        self.commands = collections.deque(maxlen=64)  # the last commands seen, for tests
         self._buf = bytearray()
         self._reported = None  # (th1, th2) radians last sent to the host
         super().__init__()
