@@ -80,6 +80,8 @@ class MainWindow(QMainWindow):
         self.panel.show_params(self.params, self.display_mode)
         self._connect_panel()
         self.viewport.contextReady.connect(self._on_context)
+        self.viewport.contextFailed.connect(self._cannot_start)
+        self.startup_error = None
         self.viewport.polygonEdited.connect(self.edit_polygon)
         geometry = self.settings.value("geometry")
         if geometry is not None:
@@ -145,7 +147,24 @@ class MainWindow(QMainWindow):
         super().closeEvent(ev)
 
     # --- start ------------------------------------------------------------------------------
+    def _cannot_start(self, message):
+        """No GL or no backend: one plain dialog, then the window closes (exit code 2)."""
+        self.startup_error = message
+        hint = "" if self.backend == "numpy" else "\nThe numpy solver may work: feelflow gui --backend numpy"
+        QTimer.singleShot(0, lambda: (QMessageBox.critical(self, "FeelFlow cannot start", message + hint),
+                                      self.close()))
+
     def _on_context(self, ctx):
+        from solver.backend import BackendError
+
+        try:
+            self._create_simulation(ctx)
+        except (BackendError, RuntimeError) as exc:
+            self._cannot_start(f"The {self.backend} solver cannot run here: {str(exc).splitlines()[0]}")
+            return
+        self._simulation_started()
+
+    def _create_simulation(self, ctx):
         try:
             self.sim = Simulation(self.params, backend=self.backend, ctx=ctx)
             polygon = self._polygon_from_settings()
@@ -156,6 +175,8 @@ class MainWindow(QMainWindow):
             self.sim = Simulation(Params(), backend=self.backend, ctx=ctx)
         if self.sim.params.shape == "polygon" and self.sim.polygon is None:
             self._install_default_polygon()
+
+    def _simulation_started(self):
         self.viewport.sim = self.sim
         self.plot.sim = self.sim
         self.viewport.mode = self.display_mode

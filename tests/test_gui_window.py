@@ -420,3 +420,20 @@ def test_recording_a_session_saves_inputs_parameters_and_forces(window, qtbot, t
     assert "inflow_speed" in names
     assert len(session.inputs["step"]) > 0 and len(session.forces["step"]) > 0
     assert session.steps > 100
+
+
+def test_a_backend_that_cannot_run_is_a_dialog_and_a_clean_close(qtbot, tmp_path, monkeypatch):
+    from PySide6.QtCore import QSettings
+    from PySide6.QtWidgets import QMessageBox
+
+    from app.main_window import MainWindow
+
+    shown = []
+    monkeypatch.setattr(QMessageBox, "critical", lambda *a, **k: shown.append(a[2]))
+    w = MainWindow(backend="no-such-backend", settings=QSettings(str(tmp_path / "s.ini"), QSettings.IniFormat))
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitUntil(lambda: bool(shown), timeout=20000)
+    assert "cannot run here" in shown[0] and "unknown backend" in shown[0]
+    assert w.sim is None and w.startup_error
+    qtbot.waitUntil(lambda: not w.isVisible(), timeout=5000)
