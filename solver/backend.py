@@ -38,9 +38,24 @@ class Solver(ABC):
     #: True when the last set_body motion (or the inflow) was reduced to config.max_speed
     speed_capped: bool = False
 
+    #: True when the last set_inflow_speed asked for more than config.max_speed
+    inflow_capped: bool = False
+
     def __init__(self, config: FlowConfig):
         self.config = config.validate()
         self.time = 0  # steps done
+        self.inflow_speed = float(self.config.inflow_speed)  # U of the tunnel inlet, in use
+
+    # --- inflow ---------------------------------------------------------------
+    def set_inflow_speed(self, speed: float) -> None:
+        """Change the inlet speed U (tunnel) from the next step on, capped at config.max_speed
+        (solver/speed_limit.py); `inflow_capped` and `speed_capped` say when the cap bit."""
+        from solver.speed_limit import cap_speed
+
+        u, _, capped = cap_speed(float(speed), 0.0, self.config.max_speed)
+        self.inflow_speed, self.inflow_capped = u, capped
+        body = getattr(self, "body", None)
+        self.speed_capped = capped or bool(body is not None and body.capped)
 
     # --- body -----------------------------------------------------------------
     @abstractmethod

@@ -19,7 +19,6 @@ from solver.forces import create_model
 from solver.forces.base import BodyWindow
 from solver.inflow import inflow_velocity, outlet_incoming
 from solver.lattice import C, OPP, Q, RHO0, W, equilibrium
-from solver.speed_limit import cap_speed
 
 #: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall
 MIRROR_Y = np.array([0, 1, 4, 3, 2, 8, 7, 6, 5])
@@ -79,21 +78,12 @@ class NumpySolver(Solver):
             cx, cy = int(C[i, 0]), int(C[i, 1])
             self._roll.append([((yd, xd), (ys, xs))
                                for yd, ys in _roll_segments(cy, ny) for xd, xs in _roll_segments(cx, nx)])
-        self.inflow_speed = float(cfg.inflow_speed)
-        self.inflow_capped = False
         self.body: BodyState | None = None
         self._solid_idx = None
         self._solid_g = None
         self._impulse = (0.0, 0.0)
         self._models = {}
         self._forces: dict[str, tuple[float, float]] = {}
-
-    # --- inflow ---------------------------------------------------------------
-    def set_inflow_speed(self, speed: float) -> None:
-        """Change the inlet speed U (tunnel), capped at config.max_speed (see inflow_capped)."""
-        u, _, capped = cap_speed(float(speed), 0.0, self.config.max_speed)
-        self.inflow_speed, self.inflow_capped = u, capped
-        self.speed_capped = capped or bool(self.body and self.body.capped)
 
     # --- body -----------------------------------------------------------------
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:

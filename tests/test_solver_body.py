@@ -149,6 +149,16 @@ def test_body_speed_is_capped_at_the_mach_limit(backend, request):
     assert not s.speed_capped
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_inflow_speed_is_capped_at_the_mach_limit(backend, request):
+    s = _tunnel(backend, request)
+    s.set_inflow_speed(1.0)
+    assert s.inflow_capped and s.speed_capped
+    assert s.inflow_speed == pytest.approx(s.config.max_speed)
+    s.set_inflow_speed(0.02)
+    assert not s.inflow_capped and not s.speed_capped and s.inflow_speed == 0.02
+
+
 def test_capped_body_velocity_keeps_direction_and_bounds_surface_speed():
     s = make_solver("numpy", FlowConfig(nx=120, ny=41))
     s.set_body(Cylinder(8.0, x=30.3, y=20.0), velocity=(0.3, 0.4), omega=0.01)
