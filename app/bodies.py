@@ -20,6 +20,9 @@ SHAPE_LABELS = {
     "polygon": "Custom polygon",
 }
 
+#: the polygon a student starts from, in units of the body size: an arrow-like pentagon
+DEFAULT_POLYGON = ((-0.5, -0.3), (0.2, -0.3), (0.5, 0.0), (0.2, 0.3), (-0.5, 0.3))
+
 PLATE_THICKNESS = 0.1      # x size (at least 2 cells)
 WEDGE_APEX_DEG = 60.0
 AIRFOIL_THICKNESS = 0.2    # x chord
@@ -38,9 +41,13 @@ def make_shape(params, polygon, x, y, angle):
         return HalfAirfoil(size, AIRFOIL_THICKNESS * size, x, y, angle)
     if kind == "polygon":
         if polygon is None:
-            raise ValueError("the custom polygon has no vertices yet")
+            polygon = default_polygon(size)
         return Polygon(polygon, x, y, angle)
     raise ValueError(f"unknown shape {kind!r}")
+
+
+def default_polygon(size: float):
+    return [(px * size, py * size) for px, py in DEFAULT_POLYGON]
 
 
 def params_for_shape(shape):

@@ -80,7 +80,7 @@ class ForcePlot(QWidget):
 
         pg.setConfigOptions(antialias=True, background="w", foreground="k")
         self.plot = pg.PlotWidget()
-        self.plot.showGrid(x=True, y=True, alpha=0.3)
+        self.plot.showGrid(x=False, y=True, alpha=0.3)   # the grid is redrawn with the axes: keep it light
         self.legend = self.plot.addLegend(offset=(10, 5))
         self.plot.getAxis("bottom").setLabel("time (solver steps)")
         self.plot.getAxis("left").setLabel("force (lattice units)")
@@ -112,9 +112,10 @@ class ForcePlot(QWidget):
         self.refresh(force=True)
 
     def _switch_view(self):
+        self._shown = None
         self.plot.clear()
         self.curves.clear()
-        self.legend = self.plot.addLegend(offset=(10, 5))
+        self._reset_legend(1)
         speed_view = self.view.currentData() == "speed"
         self.plot.setLogMode(speed_view, speed_view)
         if speed_view:   # PlotDataItems: the log mode transforms them (bare scatter items it does not)
@@ -130,6 +131,12 @@ class ForcePlot(QWidget):
             self.plot.getAxis("bottom").setLabel("time (solver steps)")
             self.plot.getAxis("left").setLabel("force (lattice units)")
         self.refresh(force=True)
+
+    def _reset_legend(self, columns: int):
+        """The plot keeps one legend across clear(): empty it and set its layout."""
+        self.legend = self.plot.addLegend(offset=(10, 5))
+        self.legend.clear()
+        self.legend.setColumnCount(columns)
 
     def models_shown(self):
         sim = self.sim
@@ -178,10 +185,11 @@ class ForcePlot(QWidget):
     def _draw_time_view(self):
         sim = self.sim
         shown = self.models_shown()
-        for key in list(self.curves):
-            if key[0] not in shown:
-                self.plot.removeItem(self.curves.pop(key))
-                self.legend.removeItem(self._name(key))
+        if getattr(self, "_shown", None) != (tuple(shown), sim.params.compare_all):
+            self._shown = (tuple(shown), sim.params.compare_all)
+            self.plot.clear()                  # curves and legend rebuilt for the new set of models
+            self.curves.clear()
+            self._reset_legend(3 if len(shown) > 1 else 1)
         for model in shown:
             t, drag, lift = sim.history.drag_lift(model)
             cd, cl = MODEL_COLOURS.get(model, ((0, 0, 0), (90, 90, 90)))

@@ -4,6 +4,7 @@ with adaptive stepping (as many solver steps per frame as keep the window at >= 
 """
 from __future__ import annotations
 
+import json
 import math
 import time
 
@@ -18,7 +19,8 @@ make_none_immortal()  # before any Qt object: see app/qt_runtime.py
 
 from app.force_plot import ForcePlot  # noqa: E402
 from app.presets import PRESETS
-from app.shape_editor import DEFAULT_POLYGON, SetPolygon
+from app.bodies import default_polygon
+from app.shape_editor import SetPolygon
 from app.side_panel import SidePanel
 from app.simulation import FORCE_MODELS, Params, Simulation
 from app.viewport import DISPLAY_MODES, Viewport
@@ -78,6 +80,8 @@ class MainWindow(QMainWindow):
         self.panel.show_params(self.params, self.display_mode)
         self._connect_panel()
         self.viewport.contextReady.connect(self._on_context)
+        self.viewport.contextFailed.connect(self._cannot_start)
+        self.startup_error = None
         self.viewport.polygonEdited.connect(self.edit_polygon)
         geometry = self.settings.value("geometry")
         if geometry is not None:
@@ -112,12 +116,21 @@ class MainWindow(QMainWindow):
                       force_model=get("force_model", d.force_model, str),
                       compare_all=str(s.value("compare_all", "false")).lower() == "true")
 
+    def _polygon_from_settings(self):
+        try:
+            verts = json.loads(str(self.settings.value("polygon", "null")))
+            return [(float(x), float(y)) for x, y in verts] if verts else None
+        except (TypeError, ValueError):
+            return None
+
     def save_settings(self):
         s, p = self.settings, self.params_now()
         s.setValue("grid", f"{p.grid[0]}x{p.grid[1]}")
         for key in ("shape", "size", "angle_deg", "wind", "nu", "wall", "force_model"):
             s.setValue(key, getattr(p, key))
         s.setValue("compare_all", "true" if p.compare_all else "false")
+        if self.sim is not None and self.sim.polygon is not None:
+            s.setValue("polygon", json.dumps([list(v) for v in self.sim.polygon]))
         s.setValue("display_mode", self.display_mode)
         s.setValue("geometry", self.saveGeometry())
         s.sync()
@@ -134,14 +147,36 @@ class MainWindow(QMainWindow):
         super().closeEvent(ev)
 
     # --- start ------------------------------------------------------------------------------
+    def _cannot_start(self, message):
+        """No GL or no backend: one plain dialog, then the window closes (exit code 2)."""
+        self.startup_error = message
+        hint = "" if self.backend == "numpy" else "\nThe numpy solver may work: feelflow gui --backend numpy"
+        QTimer.singleShot(0, lambda: (QMessageBox.critical(self, "FeelFlow cannot start", message + hint),
+                                      self.close()))
+
     def _on_context(self, ctx):
+        from solver.backend import BackendError
+
+        try:
+            self._create_simulation(ctx)
+        except (BackendError, RuntimeError) as exc:
+            self._cannot_start(f"The {self.backend} solver cannot run here: {str(exc).splitlines()[0]}")
+            return
+        self._simulation_started()
+
+    def _create_simulation(self, ctx):
         try:
             self.sim = Simulation(self.params, backend=self.backend, ctx=ctx)
-        except (ConfigError, ShapeError) as exc:   # remembered settings that no longer work
+            polygon = self._polygon_from_settings()
+            if polygon is not None and self.sim.params.shape == "polygon":
+                self.sim.set_shape(polygon=polygon)
+        except (ConfigError, ShapeError, ValueError) as exc:   # remembered settings that no longer work
             self.statusBar().showMessage(f"Remembered settings ignored ({exc}); using the defaults.", 8000)
             self.sim = Simulation(Params(), backend=self.backend, ctx=ctx)
         if self.sim.params.shape == "polygon" and self.sim.polygon is None:
             self._install_default_polygon()
+
+    def _simulation_started(self):
         self.viewport.sim = self.sim
         self.plot.sim = self.sim
         self.viewport.mode = self.display_mode
@@ -292,8 +327,7 @@ class MainWindow(QMainWindow):
             self.set_editing(False)
 
     def _install_default_polygon(self):
-        size = self.sim.params.size
-        verts = [(x * size, y * size) for x, y in DEFAULT_POLYGON]
+        verts = default_polygon(self.sim.params.size)
         self._make_current()
         try:
             self.sim.set_shape(kind="polygon", polygon=verts)
@@ -597,6 +631,8 @@ class MainWindow(QMainWindow):
                 self.input_device.submit(f, self.sim.solver.time)
         if self.display_mode == "tracers":
             self._advance_tracers(rgba, n)
+        if self.display_mode == "pressure" and self.viewport.frames % 5 == 0:
+            self.viewport.rho_ref = self._free_stream_density(rgba)
         self._arrows(forces)
         self.viewport.update()
         # adaptive stepping: cost per step and the rest of the frame, smoothed
@@ -615,6 +651,17 @@ class MainWindow(QMainWindow):
             nodes = self.sim.config.nx * self.sim.config.ny
             self.rates = {"steps_per_s": w[1] / dt, "fps": w[2] / dt, "mlups": w[1] * nodes / dt / 1e6}
             self._rate_window = [now, 0, 0]
+
+    def _free_stream_density(self, rgba) -> float:
+        """Median density of the fluid: the reference of the pressure coefficient (the lattice's
+        mean density drifts by a fraction of a percent, which alone is Cp ~ 1 at U = 0.05)."""
+        sim = self.sim
+        if rgba is None:
+            nx, ny = sim.config.nx, sim.config.ny
+            rgba = np.frombuffer(sim.solver.field_texture().read(), np.float32).reshape(ny, nx, 4)
+        rho = rgba[::2, ::2, 0]
+        rho = rho[np.isfinite(rho)]
+        return float(np.median(rho)) if rho.size else 1.0
 
     def _gl_field_finite(self) -> bool:
         data = np.frombuffer(self.sim.solver.field_texture().read(), np.float32)

@@ -4,10 +4,6 @@ from __future__ import annotations
 
 from PySide6.QtGui import QUndoCommand
 
-#: the polygon a student starts from (body frame, in units of the body size): an arrow-like pentagon
-DEFAULT_POLYGON = [(-0.5, -0.3), (0.2, -0.3), (0.5, 0.0), (0.2, 0.3), (-0.5, 0.3)]
-
-
 class SetPolygon(QUndoCommand):
     """Replace the polygon's vertices; `apply` is the window's function that installs a list."""
 

@@ -70,6 +70,7 @@ class Viewport(QOpenGLWidget):
         self.tracers = None
         self.frames = 0
         self.field_texture = None
+        self.rho_ref = 1.0             # free-stream density for the pressure view (set by the window)
         self._grab = None              # offset from body centre to the pressed point
         self._edit_vertex = None       # index of the vertex being dragged
         self._edit_preview = None
@@ -78,8 +79,18 @@ class Viewport(QOpenGLWidget):
         self.setFocusPolicy(Qt.StrongFocus)
 
     # --- GL ---------------------------------------------------------------------------------
+    contextFailed = Signal(str)     # no usable OpenGL 3.3: one line for the user
+
     def initializeGL(self):
-        self.ctx = moderngl.create_context()
+        try:
+            self.ctx = moderngl.create_context(require=330)
+        except Exception as exc:   # moderngl.Error and friends: say so, never a traceback
+            self.ctx = None
+            self.contextFailed.emit(f"OpenGL 3.3 is not available here ({str(exc).splitlines()[0]})")
+            return
+        self._init_programs()
+
+    def _init_programs(self):
         self.program = self.ctx.program(vertex_shader=load_shader("display_vertex.glsl"),
                                         fragment_shader=load_shader("display.glsl"))
         self.vao = self.ctx.vertex_array(self.program, [])
@@ -137,6 +148,8 @@ class Viewport(QOpenGLWidget):
         return QPointF(r.left() + (x + 0.5) / nx * r.width(), r.bottom() - (y + 0.5) / ny * r.height())
 
     def paintGL(self):
+        if self.ctx is None:
+            return
         painter = QPainter(self)
         painter.beginNativePainting()   # Qt's GL state is saved; moderngl draws the field
         try:
@@ -175,6 +188,7 @@ class Viewport(QOpenGLWidget):
         self.program["mode"] = mode.shader_mode
         self.program["scale"] = self.display_scale()
         self.program["range"] = mode.range
+        self.program["rho_ref"] = self.rho_ref
         self.vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
         ctx.viewport = full
 

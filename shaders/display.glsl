@@ -8,6 +8,7 @@ uniform sampler2D lut;      // 256 x 1 RGBA colormap (built by pyqtgraph's Color
 uniform int mode;           // 0 speed, 1 vorticity, 2 pressure, 3 tracers (speed, faded)
 uniform float scale;        // lattice value -> shown value (e.g. 1/U for speed / wind speed)
 uniform vec2 range;         // shown values at the bottom and the top of the colour bar
+uniform float rho_ref;      // free-stream density: pressure is shown relative to it
 
 in vec2 uv;
 out vec4 colour;
@@ -22,7 +23,7 @@ void main() {
     if (mode == 1) {
         v = f.w;
     } else if (mode == 2) {
-        v = CS2 * (f.x - RHO0);             // p - p0 = c_s^2 (rho - rho0)
+        v = CS2 * (f.x - rho_ref);          // p - p_inf = c_s^2 (rho - rho_inf)
     } else {
         v = length(f.yz);
     }

@@ -15,6 +15,8 @@
 //   FETCH_NORMALIZED 1: streaming reads with texture() at normalized coordinates through
 //     REPEAT samplers (the wrap comes free); 2: the same through textureOffset();
 //     0: texelFetch() (docs/performance.md compares them).
+//   DIVERGENCE_DISCARD 1: a node with a non-finite density discards its fragment (an
+//     occlusion-query divergence check; measured slower than the tile check, not the default).
 // @LATTICE
 
 uniform sampler2D G0;
@@ -106,6 +108,11 @@ void store(float g[9]) {
 void collide_and_store(float f[9], ivec2 x) {
     float drho = f[0];
     for (int i = 1; i < Q; ++i) drho += f[i];
+#if DIVERGENCE_DISCARD
+    // a non-finite density writes nothing; the backend counts the fragments that passed with an
+    // occlusion query (measured alternative to shaders/finite_check.glsl; the state is lost anyway)
+    if (!(abs(drho) < 3.0e38)) discard;
+#endif
     float rho = drho + RHO0;
     float jx = 0.0;
     float jy = 0.0;

@@ -29,10 +29,13 @@ API for the app (a QOpenGLWidget sharing this context):
   it samples (units 0..7) right before drawing. Nothing is restored: after `step()` or
   `field_texture()` the bound framebuffer is the solver's, so a paintGL must re-bind its own
   (`ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`) and its own textures.
-- Divergence: a non-finite value in the body window (read each step that computes forces) or
-  in the tile sums of the finite check (every `check_interval` steps, default every step, read
-  back one step late so the pipeline keeps running, and at the end of each `step(n)`) raises
-  `solver.backend.SolverDiverged` with the step that produced it, as the reference does.
+- Divergence: after every step a small pass sums g_0..g_3 over 16 x 16 tiles
+  (`shaders/finite_check.glsl`; NaN reaches every population of the neighbours within a step);
+  the sums are read one step late so the pipeline keeps running, and at the end of each
+  `step(n)`. A non-finite sum, or a non-finite body window (read each step that computes
+  forces), raises `solver.backend.SolverDiverged` with the step that produced it, as the
+  reference does. (An occlusion query counting fragments that a non-finite node discards,
+  tuning divergence="discard", halved the step's speed on llvmpipe: docs/performance.md.)
 """
 from __future__ import annotations
 
@@ -40,7 +43,8 @@ import moderngl
 import numpy as np
 
 from solver.backend import BackendError, Solver, SolverDiverged
-from solver.body import BodyState, expand_box, make_body_state, refill, shifted, union_box, unshifted, window_margin
+from solver.body import (BodyState, expand_box, make_body_state, move_body, shifted, union_box, unshifted,
+                         window_margin)
 from solver.forces import create_model
 from solver.forces.base import BodyWindow
 from solver.gl_programs import create_program
@@ -52,10 +56,10 @@ from solver.speed_limit import cap_speed
 #: texture units (fixed; every pass binds all it samples)
 UNIT_G = (0, 1, 2)
 UNIT_MASK, UNIT_QA, UNIT_QB, UNIT_INFLOW, UNIT_OMEGA = 3, 4, 5, 6, 7
-#: tile edge of the finite check
-CHECK_BLOCK = 16
 #: region rectangles are aligned to llvmpipe's 4x4 shading blocks
 ALIGN = 4
+#: tile edge of the finite check
+CHECK_BLOCK = 16
 _Y_MODE = {"no_slip": 0, "free_slip": 1, "periodic": 2}
 
 
@@ -87,13 +91,16 @@ def node_mask(solid: np.ndarray, q: np.ndarray, box) -> np.ndarray:
     ny, nx = solid.shape
     x0, y0, x1, y1 = box
     sl = (slice(y0, y1), slice(x0, x1))
-    fluid_pad = np.pad(~solid, 1, constant_values=False)  # outside the domain: not fluid
+    # fluid flags of box + 1, with the outside of the domain counted as not fluid
+    fluid_pad = np.zeros((y1 - y0 + 2, x1 - x0 + 2), bool)
+    ya, yb, xa, xb = max(y0 - 1, 0), min(y1 + 1, ny), max(x0 - 1, 0), min(x1 + 1, nx)
+    fluid_pad[ya - y0 + 1:yb - y0 + 1, xa - x0 + 1:xb - x0 + 1] = ~solid[ya:yb, xa:xb]
     mask = solid[sl].astype(np.uint32)
     for i in range(1, Q):
         ib = OPP[i]
         cut = (q[ib][sl] > 0) & ~solid[sl]
         cx, cy = int(C[i, 0]), int(C[i, 1])
-        second_fluid = fluid_pad[y0 + 1 + cy:y1 + 1 + cy, x0 + 1 + cx:x1 + 1 + cx]
+        second_fluid = fluid_pad[1 + cy:y1 - y0 + 1 + cy, 1 + cx:x1 - x0 + 1 + cx]
         two_node = cut & (q[ib][sl] < 0.5) & second_fluid & (q[i][sl] == 0)
         mask |= cut.astype(np.uint32) << np.uint32(i)
         mask |= two_node.astype(np.uint32) << np.uint32(8 + i)
@@ -105,14 +112,13 @@ class GLSolver(Solver):
 
     name = "gl"
     #: default tuning (docs/performance.md measures each choice)
-    TUNING = {"split": True, "fetch_normalized": 2}
+    TUNING = {"split": True, "fetch_normalized": 2, "divergence": "tiles"}
 
-    def __init__(self, config, ctx=None, check_interval: int = 1, tuning: dict | None = None):
+    def __init__(self, config, ctx=None, tuning: dict | None = None):
         super().__init__(config)
         if ctx is None or not isinstance(ctx, moderngl.Context):
             raise BackendError("the gl backend needs a moderngl.Context (ctx=); it never creates one")
         self.ctx = ctx
-        self.check_interval = int(check_interval)
         self.tuning = {**self.TUNING, **(tuning or {})}
         cfg = self.config
         nx, ny = cfg.nx, cfg.ny
@@ -125,6 +131,7 @@ class GLSolver(Solver):
             "X_PERIODIC": cfg.x_boundary == "periodic",
             "Y_MODE": _Y_MODE[cfg.y_boundary],
             "FETCH_NORMALIZED": int(self.tuning["fetch_normalized"]),
+            "DIVERGENCE_DISCARD": self.tuning["divergence"] == "discard",
         }
         self._defines = defines
         self._sponge = sponge
@@ -158,9 +165,11 @@ class GLSolver(Solver):
         rates = np.stack(np.broadcast_arrays(np.asarray(op, float) * np.ones(nx), np.asarray(om, float)), -1)
         self._omega_tex.write(rates.astype("f4").tobytes())
         self._inflow_key = None
-        self._draws = []
-        self._field = self._check = None
-        self._pending_check = None
+        self._draws, self._draw_regions = [], None
+        self._field = None
+        self._discard = self.tuning["divergence"] == "discard"
+        self._tiles = None
+        self._pending, self._idle_queries = [], []  # divergence checks: (step, kind, object)
 
         self.inflow_speed = float(cfg.inflow_speed)
         self.inflow_capped = False
@@ -226,12 +235,17 @@ class GLSolver(Solver):
         return {k: v for k, v in parts.items() if v}
 
     def _set_rects(self, window):
-        """Vertex data of every region (see _regions), drawn in this order each step."""
+        """Vertex data of every region (see _regions), drawn in this order each step; kept
+        when the (block-aligned) regions did not change."""
+        regions = sorted(self._regions(window).items())
+        if regions == self._draw_regions:
+            return
+        self._draw_regions = regions
         for vao, vbo in self._draws:
             vao.release()
             vbo.release()
         self._draws = []
-        for key, rects in sorted(self._regions(window).items()):
+        for key, rects in regions:
             vbo = self.ctx.buffer(_triangles(rects).tobytes())
             vao = self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")])
             self._draws.append((vao, vbo))
@@ -290,10 +304,21 @@ class GLSolver(Solver):
         src, dst = self._cur, 1 - self._cur
         self._begin_pass(self._fbo[dst], (self.nx, self.ny))
         self._bind_sources(src)
-        for vao, _ in self._draws:
-            vao.render(moderngl.TRIANGLES)
+        if self._discard:
+            query = self._idle_queries.pop() if self._idle_queries else self.ctx.query(samples=True)
+            with query:
+                for vao, _ in self._draws:
+                    vao.render(moderngl.TRIANGLES)
+        else:
+            for vao, _ in self._draws:
+                vao.render(moderngl.TRIANGLES)
         self._cur = dst
         self.time += 1
+        if self._discard:
+            self._pending.append((self.time, "query", query))
+        else:
+            self._pending.append((self.time, "tiles", self._issue_tile_check()))
+        self._resolve_check()
 
     def step(self, n: int = 1) -> None:
         n = int(n)
@@ -310,10 +335,8 @@ class GLSolver(Solver):
                     fx, fy = model.compute(win)
                     sums[name][0] += fx
                     sums[name][1] += fy
-            if self.check_interval > 0 and self.time % self.check_interval == 0:
-                self._check_finite()
         if n > 0:
-            self._check_finite(final=True)
+            self._resolve_check(wait_all=True)
             self._forces = {name: (s[0] / n, s[1] / n) for name, s in sums.items()}
 
     def time_variant(self, key, draws: int) -> float:
@@ -356,41 +379,36 @@ class GLSolver(Solver):
                        body_force=tuple(float(v) for v in self.config.body_force))
         return prog, tex, fbo, vao
 
-    def _issue_check(self):
-        """Queue the tile sums of the current state into one of two targets; return it."""
-        if self._check is None:
+    def _issue_tile_check(self):
+        """Queue the tile sums of g_0..g_3 of the current state into one of two targets."""
+        if self._tiles is None:
             size = (-(-self.nx // CHECK_BLOCK), -(-self.ny // CHECK_BLOCK))
             first = self._aux_pass("finite_check.glsl", size, {"BLOCK": CHECK_BLOCK})
             tex = self.ctx.texture(size, 4, dtype="f4")
             fbo = self.ctx.framebuffer(color_attachments=[tex])
             self._objects += [fbo, tex]
-            self._check = (first, (first[0], tex, fbo, first[3]))
-            self._check_slot = 0
-        prog, tex, fbo, vao = self._check[self._check_slot]
-        self._check_slot = 1 - self._check_slot
+            self._tiles = [first, (first[0], tex, fbo, first[3])]
+        self._tiles.reverse()
+        prog, tex, fbo, vao = self._tiles[0]
         self._begin_pass(fbo, tex.size)
         self._g[self._cur][0].use(location=UNIT_G[0])
         vao.render(moderngl.TRIANGLES)
         return fbo
 
-    def _resolve_check(self):
-        """Read the pending check (one step old, so the GPU has usually finished it)."""
-        if self._pending_check is None:
-            return
-        step, fbo = self._pending_check
-        self._pending_check = None
-        sums = np.frombuffer(fbo.read(components=4, dtype="f4"), dtype="f4")
-        if not np.all(np.isfinite(sums)):
-            raise SolverDiverged(step, "density is no longer finite")
-
-    def _check_finite(self, final=False):
-        """Divergence check of the step just done (algorithm.md, 'Divergence'): the tile sums
-        are read one step late (pipelined), and at the end of each step(n) call."""
-        fbo = self._issue_check()
-        self._resolve_check()
-        self._pending_check = (self.time, fbo)
-        if final:
-            self._resolve_check()
+    def _resolve_check(self, wait_all=False):
+        """Divergence check of earlier steps (algorithm.md, 'Divergence'), read one step late so
+        the pipeline keeps running (all pending when `wait_all`): the tile sums must be finite,
+        or (tuning divergence="discard") every node must have written its fragment."""
+        while self._pending and (wait_all or len(self._pending) > 1):
+            step, kind, obj = self._pending.pop(0)
+            if kind == "query":
+                self._idle_queries.append(obj)
+                bad = obj.samples != self.nx * self.ny
+            else:
+                bad = not np.all(np.isfinite(np.frombuffer(obj.read(components=4, dtype="f4"), dtype="f4")))
+            if bad:
+                self._pending = []
+                raise SolverDiverged(step, "density is no longer finite")
 
     # --- body -------------------------------------------------------------------
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
@@ -399,22 +417,23 @@ class GLSolver(Solver):
         new = None
         if shape is not None:
             new = make_body_state(shape, velocity, omega, cfg, window_margin(self._models.values()), raster)
+        read = {}
+
+        def read_window(x0, y0, x1, y1):  # the refill box, read back once
+            read["g"] = self._read_shifted((x0, y0, x1, y1))
+            return unshifted(read["g"])
+
+        def write_nodes(x0, y0, f, changed):  # rewrite the box, changed nodes from the refill
+            g = read["g"]
+            g[:, changed] = shifted(f[:, changed]).astype("f4")
+            h, w = changed.shape
+            self._write_shifted(g, (x0, y0, x0 + w, y0 + h))
+
+        jx, jy = move_body(old, new, cfg, read_window, write_nodes)
+        self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         box = union_box(old.raster.window if old else None, new.raster.window if new else None)
         if box is not None:
-            box = expand_box(box, 1, cfg.nx, cfg.ny)
-            x0, y0, x1, y1 = box
-            shape_ = (y1 - y0, x1 - x0)
-            ys, xs = slice(y0, y1), slice(x0, x1)
-            old_solid = old.solid[ys, xs] if old else np.zeros(shape_, bool)
-            new_solid = new.solid[ys, xs] if new else np.zeros(shape_, bool)
-            motion = new if new is not None else old
-            g = self._read_shifted(box)
-            f = unshifted(g)
-            (jx, jy), changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0)
-            g[:, changed] = shifted(f[:, changed]).astype("f4")
-            self._write_shifted(g, box)
-            self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
-            self._upload_raster(new, expand_box(box, 1, cfg.nx, cfg.ny))
+            self._upload_raster(new, expand_box(box, 2, cfg.nx, cfg.ny))
         self.body = new
         self.speed_capped = (new.capped if new is not None else False) or self.inflow_capped
         self._set_rects(None if new is None else new.raster.window)
@@ -529,4 +548,5 @@ class GLSolver(Solver):
         for obj in [*(o for d in self._draws for o in d), *self._objects, *self._programs.values()]:
             obj.release()
         self._draws, self._objects, self._programs = [], [], {}
-        self._field = self._check = None
+        self._field = None
+        self._pending, self._idle_queries = [], []

@@ -67,14 +67,17 @@ def test_steps_ignore_the_host_gl_state(gl_context, request):
     ctx.enable_only(moderngl.NOTHING)
 
 
-def test_divergence_raises(request):
-    cfg = FlowConfig(nx=32, ny=32, x_boundary="periodic", y_boundary="periodic")
-    s = make_solver("gl", cfg, request)
-    f = _disturbed(32, 32)
-    f[3, 10, 7] = np.nan
+@pytest.mark.parametrize("check", ["tiles", "discard"])
+def test_divergence_raises_with_the_step(gl_context, check):
+    cfg = FlowConfig(nx=40, ny=32, x_boundary="periodic", y_boundary="periodic")
+    s = create_solver("gl", cfg, ctx=gl_context, tuning={"divergence": check})
+    s.step(5)
+    f = s.distributions()
+    f[3, 10, 37] = np.inf
     s.set_distributions(f)
-    with pytest.raises(SolverDiverged):
-        s.step(1)
+    with pytest.raises(SolverDiverged) as err:
+        s.step(10)
+    assert err.value.step == 6
 
 
 def test_body_upload_touches_only_the_window(request):

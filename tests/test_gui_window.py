@@ -199,9 +199,16 @@ def test_vertex_handles_move_add_delete_and_undo(window, qtbot):
     assert sim.polygon[2] != before[2] and len(sim.polygon) == len(before)
     send_mouse(vp, "press", b, Qt.RightButton)          # delete the vertex
     assert len(sim.polygon) == len(before) - 1
-    window.undo.undo()
-    window.undo.undo()
+    from PySide6.QtTest import QTest
+
+    window.activateWindow()
+    vp.setFocus()
+    qtbot.waitUntil(vp.hasFocus, timeout=5000)
+    QTest.keyClick(vp, Qt.Key_Z, Qt.ControlModifier)     # Ctrl+Z twice: back to the start
+    QTest.keyClick(vp, Qt.Key_Z, Qt.ControlModifier)
     assert [tuple(v) for v in sim.polygon] == [tuple(v) for v in before]
+    QTest.keyClick(vp, Qt.Key_Z, Qt.ControlModifier | Qt.ShiftModifier)   # Ctrl+Shift+Z redoes the move
+    assert sim.polygon[2] != before[2] and len(sim.polygon) == len(before)
 
 
 def test_screenshot_shows_the_body_where_it_is(window, qtbot, tmp_path):
@@ -303,12 +310,19 @@ def test_settings_are_remembered(qtbot, tmp_path):
     qtbot.waitUntil(lambda: w.sim is not None, timeout=20000)
     w.panel.wind.setValue(0.07)
     w.panel.display.setCurrentIndex(w.panel.display.findData("vorticity"))
+    w.panel.shape.setCurrentIndex(w.panel.shape.findData("polygon"))
+    edited = [(x * 1.3, y) for x, y in w.sim.polygon]
+    assert w.edit_polygon(edited)
     w.save_settings()
     w2 = MainWindow(backend="numpy", settings=QSettings(path, QSettings.IniFormat))
     qtbot.addWidget(w2)
     assert w2.params.wind == pytest.approx(0.07) and w2.display_mode == "vorticity"
     assert w2.panel.wind.value() == pytest.approx(0.07) and w2.params.grid == GRID
     w.timer.stop()
+    w2.show()                                   # the custom polygon comes back too
+    qtbot.waitUntil(lambda: w2.sim is not None, timeout=20000)
+    assert w2.sim.params.shape == "polygon" and np.allclose(w2.sim.shape.vertices, edited)
+    w2.timer.stop()
 
 
 def test_without_a_display_one_line_and_exit_2():
@@ -406,3 +420,20 @@ def test_recording_a_session_saves_inputs_parameters_and_forces(window, qtbot, t
     assert "inflow_speed" in names
     assert len(session.inputs["step"]) > 0 and len(session.forces["step"]) > 0
     assert session.steps > 100
+
+
+def test_a_backend_that_cannot_run_is_a_dialog_and_a_clean_close(qtbot, tmp_path, monkeypatch):
+    from PySide6.QtCore import QSettings
+    from PySide6.QtWidgets import QMessageBox
+
+    from app.main_window import MainWindow
+
+    shown = []
+    monkeypatch.setattr(QMessageBox, "critical", lambda *a, **k: shown.append(a[2]))
+    w = MainWindow(backend="no-such-backend", settings=QSettings(str(tmp_path / "s.ini"), QSettings.IniFormat))
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitUntil(lambda: bool(shown), timeout=20000)
+    assert "cannot run here" in shown[0] and "unknown backend" in shown[0]
+    assert w.sim is None and w.startup_error
+    qtbot.waitUntil(lambda: not w.isVisible(), timeout=5000)

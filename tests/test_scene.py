@@ -9,7 +9,7 @@ from app.scene import load_scene, scene_from_dict
 from solver.motion import MotionScript, Phase
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-SCENES = sorted((ROOT / "scenes").glob("*.toml"))
+SCENES = sorted((ROOT / "scenes").rglob("*.toml"))
 
 
 def minimal(**sections):
@@ -25,7 +25,7 @@ def minimal(**sections):
     return d
 
 
-@pytest.mark.parametrize("path", SCENES, ids=[p.stem for p in SCENES])
+@pytest.mark.parametrize("path", SCENES, ids=[str(p.relative_to(ROOT / "scenes")) for p in SCENES])
 def test_example_scenes_load(path):
     scene = load_scene(path)
     assert scene.steps >= 1 and scene.config.nu > 0

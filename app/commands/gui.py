@@ -74,6 +74,13 @@ def main(args) -> int:
         test = SelfTest(window, seconds=args.seconds, screenshot=args.screenshot)
         window.show()
         app.exec()
+        if window.startup_error:
+            print(f"feelflow: {window.startup_error}", file=sys.stderr)
+            return 2
         return test.exit_code
     window.show()
-    return app.exec()
+    code = app.exec()
+    if window.startup_error:
+        print(f"feelflow: {window.startup_error}", file=sys.stderr)
+        return 2
+    return code
