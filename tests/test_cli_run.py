@@ -142,3 +142,29 @@ def test_validate_prints_a_table_and_writes_json(tmp_path):
     assert case["name"] == "taylor-green" and case["backend"] == "numpy" and case["resolution"] == 32
     assert case["steps"] > 0 and case["wall_seconds"] > 0 and case["mlups"] > 0
     assert abs(case["quantities"]["nu_rel_error"]) < 0.01 and case["passed"] is True
+
+
+@pytest.mark.gl
+def test_run_on_gl_matches_numpy(tmp_path):
+    """`--backend gl` (own EGL context) writes the same forces as the numpy reference, to the
+    float32 tolerance of docs/algorithm.md."""
+    pytest.importorskip("solver.gl_backend", reason="the gl backend is not built yet")
+    scene = write(tmp_path, SMALL)
+    tables = {}
+    for backend in ("numpy", "gl"):
+        out = tmp_path / f"{backend}.csv"
+        result = feelflow("run", scene, "--backend", backend, "--out", out)
+        assert result.returncode == 0, result.stderr
+        tables[backend] = [[float(v) for v in r] for r in list(csv.reader(out.open()))[1:]]
+    for a, b in zip(tables["numpy"], tables["gl"]):
+        assert b[:5] == pytest.approx(a[:5])
+        scale = max(abs(v) for v in a[5:])
+        assert max(abs(x - y) for x, y in zip(a[5:], b[5:])) <= 1e-4 * scale
+
+
+def test_validate_reports_a_blow_up_as_a_failed_case():
+    # 2D-2 (Re 100) at 10 cells per diameter needs tau = 0.515: the flow blows up
+    result = feelflow("validate", "--case", "schaefer-turek-2d2", "--resolution", "10")
+    assert result.returncode == 1
+    assert "Traceback" not in result.stderr and result.stderr == ""
+    assert "| stable | 0 | 1 .. 1 | **no** |" in result.stdout

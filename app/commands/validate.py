@@ -79,10 +79,33 @@ def write_json_atomic(path: Path, data) -> None:
         raise
 
 
+def run_case(name: str, factory, resolution, quick: bool, backend: str):
+    """One case; a flow that blows up is a failed case (stable = 0), not a traceback."""
+    import warnings
+
+    import numpy as np
+
+    from solver import backend as backends
+    from solver.validation import case_module
+    from solver.validation.base import CaseResult, Check
+
+    module = case_module(name)
+    try:
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return module.run(factory, resolution=resolution, quick=quick, backend=backend)
+    except backends.SolverDiverged as exc:
+        n = resolution or (module.QUICK_RESOLUTION if quick else module.DEFAULT_RESOLUTION)
+        result = CaseResult(name, backend, n, quantities={"stable": 0.0, "diverged_at_step": float(exc.step)},
+                            checks=[Check("stable", 1.0, 1.0, "the flow must not blow up")])
+        result.notes = str(exc)
+        return result
+
+
 def main(args) -> int:
     from app.commands.run import positive_int_option
     from app.headless import make_solver
-    from solver.validation import CASES, case_module
+    from solver.validation import CASES
 
     names = args.case or list(CASES)
     for name in names:
@@ -100,7 +123,7 @@ def main(args) -> int:
     results = []
     for name in names:
         print(f"running {name} ...", flush=True)
-        result = case_module(name).run(factory, resolution=resolution, quick=args.quick, backend=args.backend)
+        result = run_case(name, factory, resolution, args.quick, args.backend)
         results.append(result)
         print(f"  {name}: {'targets met' if result.passed else 'TARGETS NOT MET'} "
               f"({result.steps} steps, {result.wall_seconds:.1f} s)", flush=True)

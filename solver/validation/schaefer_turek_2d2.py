@@ -16,7 +16,7 @@ from solver.validation.schaefer_turek import INTERVALS_2D2, Geometry
 
 NAME = "schaefer-turek-2d2"
 DEFAULT_RESOLUTION = 40
-QUICK_RESOLUTION = 10
+QUICK_RESOLUTION = 20  # at 10 cells tau = 0.515 and the flow blows up
 RE = 100.0
 PERIODIC_TOL = 0.005
 MEASURE_PERIODS = 3
