@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from app.cli import UserError
+from solver.lattice import CS2
 
 MODELS = ("momentum_exchange", "momentum_exchange_classic", "macroscopic", "pressure")
 REFERENCE = "momentum_exchange"
@@ -114,14 +115,18 @@ def run_scene(scene, backend: str, log=print) -> dict:
 PARTS = ("protocol", "shapes", "sweep", "lift")
 
 
-def run_part(part: str, scenes_dir: Path, backend: str, quick: bool, phase_steps, log=print) -> dict:
-    """Run one part's experiments; JSON-ready raw series plus how they were run."""
+def run_part(part: str, scenes_dir: Path, backend: str, quick: bool, phase_steps, log=print,
+             keys=None) -> dict:
+    """Run one part's experiments (for the protocol: the diameters in `keys`, default all);
+    JSON-ready raw series plus how they were run."""
     q = QUICK if quick else {}
     over = {"ramp": q.get("ramp"), "interval": 10 if quick else None}
     runs: dict = {}
     t0 = time.perf_counter()
     if part == "protocol":
         for key, name in PROTOCOL:
+            if keys and key not in keys:
+                continue
             scene = load_scene_with(scenes_dir / name, phase_steps=q.get("phase_steps", phase_steps), **over)
             runs[key] = run_scene(scene, backend, log)
     elif part == "shapes":
@@ -143,20 +148,45 @@ def run_part(part: str, scenes_dir: Path, backend: str, quick: bool, phase_steps
 
 
 def save_part(folder: Path, data: dict) -> None:
+    """Store a part; the protocol one file per diameter (data-protocol-d16.json ...), so that
+    diameters can be run (or rerun) by separate processes."""
     folder.mkdir(parents=True, exist_ok=True)
+    if data["part"] == "protocol":
+        for key, run in data["runs"].items():
+            one = dict(data, runs={key: run}, wall_s=run["wall_s"])
+            write_text_atomic(folder / f"data-protocol-{key}.json", json.dumps(one, separators=(",", ":")))
+        return
     write_text_atomic(folder / f"data-{data['part']}.json", json.dumps(data, separators=(",", ":")))
 
 
+def _read_json(path: Path) -> dict:
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as exc:
+        raise UserError(f"{path}: not valid JSON ({exc.msg}); run that part again") from None
+
+
 def load_parts(folder: Path) -> dict:
-    """part -> stored data, for the parts that have been run."""
+    """part -> stored data, for the parts that have been run (protocol diameters merged; each
+    protocol run keeps how it was run in `provenance`)."""
     parts = {}
     for part in PARTS:
+        if part == "protocol":
+            runs, provenance = {}, {}
+            for key, _ in PROTOCOL:
+                path = folder / f"data-protocol-{key}.json"
+                if path.exists():
+                    one = _read_json(path)
+                    runs[key] = one["runs"][key]
+                    provenance[key] = one
+            if runs:
+                first = next(iter(provenance.values()))
+                parts[part] = dict(first, runs=runs, provenance=provenance,
+                                   wall_s=sum(p["wall_s"] for p in provenance.values()))
+            continue
         path = folder / f"data-{part}.json"
         if path.exists():
-            try:
-                parts[part] = json.loads(path.read_text(encoding="utf-8"))
-            except json.JSONDecodeError as exc:
-                raise UserError(f"{path}: not valid JSON ({exc.msg}); run that part again") from None
+            parts[part] = _read_json(path)
     return parts
 
 
@@ -178,13 +208,23 @@ def _forces(run: dict, model: str) -> np.ndarray:
     return np.asarray(run["forces"][model], dtype=np.float64).reshape(-1, 2)
 
 
+def acoustic_period(run: dict) -> float:
+    """Period of the tunnel's quarter-wave acoustic mode, 4 nx / c_s steps (README, 'Solver'):
+    the inlet and the outlet both reflect sound, and every start, stop and ramp rings it."""
+    return 4.0 * run["nx"] / math.sqrt(CS2)
+
+
 def tail_mean(run: dict, model: str, start: int, end: int) -> np.ndarray:
-    """Mean force over the rows whose step lies in the last half of [start, end]; nan for a run
-    that diverged (its rows stop early and end in the blow-up)."""
+    """Mean force at the end of [start, end]: over the longest whole number of acoustic periods
+    that fits in its last half (a ringing mode then averages out), else over the last half;
+    nan for a run that diverged (its rows stop early and end in the blow-up)."""
     if run.get("diverged_at") is not None:
         return np.array([math.nan, math.nan])
     steps = np.asarray(run["step"])
-    sel = (steps > start + (end - start) // 2) & (steps <= end)
+    half = (end - start) // 2
+    period = acoustic_period(run)
+    length = int(round(math.floor(half / period) * period)) if half >= period else half
+    sel = (steps > end - length) & (steps <= end)
     f = _forces(run, model)
     if not sel.any():
         return np.array([math.nan, math.nan])
@@ -194,6 +234,24 @@ def tail_mean(run: dict, model: str, start: int, end: int) -> np.ndarray:
 def phase_means(run: dict, model: str) -> list[np.ndarray]:
     bounds = np.concatenate([[0], np.cumsum(run["phases"])])
     return [tail_mean(run, model, int(bounds[k]), int(bounds[k + 1])) for k in range(len(run["phases"]))]
+
+
+#: the protocol plots show a running mean over this many steps: the impulsive starts and stops
+#: ring the tunnel's acoustic modes, whose force swings exceed the drag at U = 0.01
+PLOT_SMOOTH_STEPS = 1000
+
+
+def running_mean(run: dict, model: str, steps: int):
+    """(step, F_x) averaged over `steps` steps (centred, whole windows only)."""
+    step = np.asarray(run["step"], dtype=np.float64)
+    fx = _forces(run, model)[:, 0]
+    if len(step) < 2:
+        return step, fx
+    k = max(1, int(round(steps / (step[1] - step[0]))))
+    if k <= 1 or len(fx) < k:
+        return step, fx
+    kernel = np.ones(k) / k
+    return np.convolve(step, kernel, mode="valid"), np.convolve(fx, kernel, mode="valid")
 
 
 def power_fit(x, y) -> tuple[float, float]:
@@ -219,8 +277,8 @@ def analyse(parts: dict) -> dict:
             per_d = {}
             for key, run in runs.items():
                 f = [float(p[0]) for p in phase_means(run, m)]
-                per_d[key] = {"phases": f, "zero_rel_frac": f[1] / f[2] if f[2] else math.nan,
-                              "against_over_stopped": f[3] / f[2] if f[2] else math.nan,
+                per_d[key] = {"phases": f, "zero_rel_frac": _ratio(f[1], f[2]),
+                              "against_over_stopped": _ratio(f[3], f[2]),
                               "reynolds": run["reynolds"], "diameter": run["reference_length"]}
             out["protocol"][m] = per_d
             d = [v["diameter"] for v in per_d.values()]
@@ -242,7 +300,7 @@ def analyse(parts: dict) -> dict:
             for key, run in parts["shapes"]["runs"].items():
                 fx = float(tail_mean(run, m, 0, run["steps"])[0])
                 u, w = run["inflow_speed"], run["reference_length"]
-                shapes[key] = {"drag": fx, "cd": 2 * fx / (u * u * w), "reynolds": run["reynolds"]}
+                shapes[key] = {"drag": fx, "cd": _ratio(2 * fx, u * u * w), "reynolds": run["reynolds"]}
             out["shapes"][m] = shapes
     if "lift" in parts:
         run = parts["lift"]["runs"]["half_airfoil"]
@@ -250,7 +308,7 @@ def analyse(parts: dict) -> dict:
         for m in MODELS:
             fx, fy = (float(c) for c in tail_mean(run, m, 0, run["steps"]))
             u, chord = run["inflow_speed"], run["body"].get("chord", run["reference_length"])
-            out["lift"][m] = {"fx": fx, "fy": fy, "cl_chord": 2 * fy / (u * u * chord),
+            out["lift"][m] = {"fx": fx, "fy": fy, "cl_chord": _ratio(2 * fy, u * u * chord),
                               "reynolds_chord": u * chord / run["nu"]}
     return out
 
@@ -311,12 +369,15 @@ def make_plots(parts: dict, res: dict, folder: Path) -> list[str]:
     if "protocol" in parts:
         runs = parts["protocol"]["runs"]
         for m in MODELS:
-            w = _plot(pg, f"{m}: F_x over the seed protocol (stop | with | stop | against)", "step",
-                      "F_x (lattice units per step)")
+            w = _plot(pg, f"{m}: F_x over the seed protocol (stop | with | stop | against), "
+                          f"running mean over {PLOT_SMOOTH_STEPS} steps", "step", "F_x (lattice units per step)")
+            curves = []
             for key, run in runs.items():
-                w.plot(run["step"], _forces(run, m)[:, 0], pen=pg.mkPen(dcol[key], width=2, style=dash[key]),
+                steps, fx = running_mean(run, m, PLOT_SMOOTH_STEPS)
+                curves.append(fx)
+                w.plot(steps, fx, pen=pg.mkPen(dcol[key], width=2, style=dash[key]),
                        name=f"D = {run['reference_length']:g}")
-            vals = np.concatenate([_forces(run, m)[:, 0] for run in runs.values()])
+            vals = np.concatenate(curves)
             if vals.size:  # the start of each moving phase is a spike: show the plateaus
                 lo, hi = np.percentile(vals, [3, 97])
                 pad = 0.15 * (hi - lo) + 1e-12
@@ -414,10 +475,14 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
     add("Models (docs/force-models.md): `momentum_exchange` (the reference: Galilean-invariant momentum exchange), "
         "`momentum_exchange_classic` (the seed's), `macroscopic` (drag equation with tabulated C_D, velocity sampled "
         "4 cells off the wall), `pressure` (seed eq. 24 with beta = rho_0/6, i.e. the lattice pressure; no shear). "
-        "Forces in lattice units per step, means over the last half of each phase or run. "
+        "Forces in lattice units per step; means at the end of each phase or run, over the longest whole number "
+        "of periods of the tunnel's acoustic mode (4 nx / c_s steps) within its last half (else the last half). "
         "Parts not run yet are left out.\n")
     for part in PARTS:
-        if part in parts:
+        if part == "protocol" and part in parts:
+            for key, prov in parts[part]["provenance"].items():
+                add(f"- protocol {key}: {_provenance(prov)}")
+        elif part in parts:
             add(f"- {part}: {_provenance(parts[part])}")
     add("\n## Runs\n")
     L += _runs_table(parts)
@@ -489,6 +554,10 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
     return "\n".join(L)
 
 
+def _ratio(a: float, b: float) -> float:
+    return a / b if b else math.nan
+
+
 def verdict(m: str, res: dict) -> str:
     """One measured summary per model; the thresholds are stated in the words."""
     parts = []
@@ -511,6 +580,9 @@ def verdict(m: str, res: dict) -> str:
     if "shapes" in res:
         ref_order = sorted(res["shapes"][REFERENCE], key=lambda k: -res["shapes"][REFERENCE][k]["drag"])
         order = sorted(res["shapes"][m], key=lambda k: -res["shapes"][m][k]["drag"])
+        if m != REFERENCE:
+            rel = [_ratio(res["shapes"][m][k]["drag"], res["shapes"][REFERENCE][k]["drag"]) for k in ref_order]
+            parts.append("drag / reference drag: " + ", ".join(f"{k} {_g(r, 2)}" for k, r in zip(ref_order, rel)))
         parts.append("shape ordering " + (f"{' > '.join(order)}" if m == REFERENCE else
                                           "matches the reference" if order == ref_order else
                                           f"**differs from the reference** ({' > '.join(order)})"))

@@ -1,9 +1,10 @@
 """`feelflow report seed`: reproduce the seed's experiments with all four force models and write
 docs/report-seed.md with PNG plots (the work is in app/seed_report.py).
 
-Parts (`--only`): protocol, shapes, sweep, lift; each stores its series in
-OUT/report-seed/data-<part>.json, and the report is written from every part stored there, so
-parts can be run separately (or again) and `--replot` rebuilds text and plots without running.
+Parts (`--only`): protocol (or one diameter, protocol:d32), shapes, sweep, lift; each stores its
+series in OUT/report-seed/data-<part>.json (data-protocol-<d>.json per diameter), and the report
+is written from every part stored there, so parts can be run separately (or again, or in
+parallel) and `--replot` rebuilds text and plots without running.
 """
 from __future__ import annotations
 
@@ -23,7 +24,8 @@ def add_arguments(parser):
     parser.add_argument("--phase-steps", default=None, metavar="N",
                         help="steps per protocol phase instead of the scenes' 15000 (stated in the report)")
     parser.add_argument("--only", default=None, metavar="PART[,PART]",
-                        help="run only these parts: protocol, shapes, sweep, lift (default: all)")
+                        help="run only these parts: protocol (or protocol:d16, :d24, :d32), shapes, sweep, "
+                             "lift (default: all)")
     parser.add_argument("--scenes", default="scenes", metavar="DIR", help="folder holding the scenes (default: scenes)")
     parser.add_argument("--out", default="docs", metavar="DIR",
                         help="folder for report-seed.md and report-seed/ (default: docs)")
@@ -32,7 +34,7 @@ def add_arguments(parser):
 
 
 def main(args) -> int:
-    from app.seed_report import PARTS, run_part, save_part, write_report
+    from app.seed_report import PARTS, PROTOCOL, run_part, save_part, write_report
 
     out = Path(args.out)
     if not out.is_dir():
@@ -46,11 +48,16 @@ def main(args) -> int:
         if phase_steps < 1:
             raise UserError(f"--phase-steps: must be a positive integer, got {args.phase_steps!r}")
     parts = PARTS
+    keys = None  # protocol diameters
     if args.only is not None:
         parts = tuple(p.strip() for p in args.only.split(",") if p.strip())
-        bad = [p for p in parts if p not in PARTS]
+        diameters = tuple(key for key, _ in PROTOCOL)
+        keys = tuple(p.split(":", 1)[1] for p in parts if p.startswith("protocol:")) or None
+        parts = tuple(dict.fromkeys("protocol" if p.startswith("protocol:") else p for p in parts))
+        bad = [p for p in parts if p not in PARTS] + [k for k in keys or () if k not in diameters]
         if bad or not parts:
-            raise UserError(f"--only: unknown part {bad[0] if bad else args.only!r}; choose from {', '.join(PARTS)}")
+            raise UserError(f"--only: unknown part {bad[0] if bad else args.only!r}; choose from "
+                            f"{', '.join(PARTS)} (protocol:{'|'.join(diameters)} for one diameter)")
     if not args.replot:
         scenes = Path(args.scenes)
         if not scenes.is_dir():
@@ -58,7 +65,7 @@ def main(args) -> int:
         for part in parts:
             print(f"feelflow report seed: {part} on {args.backend}", file=sys.stderr, flush=True)
             data = run_part(part, scenes, args.backend, args.quick, phase_steps,
-                            log=lambda line: print(line, file=sys.stderr, flush=True))
+                            log=lambda line: print(line, file=sys.stderr, flush=True), keys=keys)
             save_part(out / "report-seed", data)
     path = write_report(out)
     print(f"{path}: written")
