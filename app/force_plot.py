@@ -192,6 +192,8 @@ class ForcePlot(QWidget):
             self._reset_legend(3 if len(shown) > 1 else 1)
         for model in shown:
             t, drag, lift = sim.history.drag_lift(model)
+            first = int(np.argmax(np.isfinite(drag))) if np.isfinite(drag).any() else len(t)
+            t, drag, lift = t[first:], drag[first:], lift[first:]   # from when the model was switched on
             cd, cl = MODEL_COLOURS.get(model, ((0, 0, 0), (90, 90, 90)))
             self._curve((model, "drag"), pg.mkPen(cd, width=2.5), self._name((model, "drag"))).setData(t, drag, connect="finite")
             self._curve((model, "lift"), pg.mkPen(cl, width=2.5, style=Qt.DashLine if len(shown) > 1 else Qt.SolidLine),

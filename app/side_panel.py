@@ -49,6 +49,8 @@ class SidePanel(QScrollArea):
         super().__init__(parent)
         inner = QWidget()
         col = QVBoxLayout(inner)
+        col.setSpacing(6)
+        col.setContentsMargins(4, 4, 4, 4)
         self.setWidget(inner)
         self.setWidgetResizable(True)
         self.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
@@ -143,6 +145,8 @@ class SidePanel(QScrollArea):
 
     @staticmethod
     def _group(title, layout):
+        layout.setVerticalSpacing(4)      # compact: every group fits a 800-pixel-high screen
+        layout.setContentsMargins(8, 4, 8, 4)
         box = QGroupBox(title)
         box.setLayout(layout)
         return box

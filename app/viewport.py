@@ -367,8 +367,10 @@ class Viewport(QOpenGLWidget):
         nx, ny = self.sim.config.nx, self.sim.config.ny
         sx, sy = r.width() / nx, r.height() / ny
         x0, y0 = r.left() + 0.5 * sx, r.bottom() - 0.5 * sy
-        lines = [QPointF(x0 + a * sx, y0 - b * sy) for a, b in np.stack([prev, pts], 1).reshape(-1, 2)]
+        lines = [QPointF(x0 + a * sx, y0 - b * sy) for a, b in np.stack([prev, pts], 1).reshape(-1, 2).tolist()]
+        p.setRenderHint(QPainter.Antialiasing, False)   # ~900 short streaks: plain lines are much cheaper
         p.drawLines(lines)
+        p.setRenderHint(QPainter.Antialiasing, True)
 
     # --- editor geometry ------------------------------------------------------------------------
     def body_to_world(self, verts):

@@ -81,15 +81,25 @@ def test_divergence_raises_with_the_step(gl_context, check):
 
 
 def test_body_upload_touches_only_the_window(request):
-    """Moving the body rewrites mask and q only near the old and new windows, and removing
-    it clears them."""
+    """Moving the body rewrites the mask (and q) only around the old and new windows; removing
+    the body clears them there."""
+    from solver.body import expand_box, union_box
+    from solver.gl_backend import node_mask
+
     cfg = FlowConfig(nx=64, ny=32)
     s = make_solver("gl", cfg, request)
     s.set_body(Cylinder(6.0, x=20.0, y=16.0))
-    s.set_body(Cylinder(6.0, x=21.5, y=16.0))
+    old_window = s.body.raster.window
+    sentinel = np.uint32(1 << 30)  # a bit the shader never reads
+    s._mask_tex.write(np.full((32, 64), sentinel, dtype="u4").tobytes())
+    s.set_body(Cylinder(6.0, x=23.5, y=15.0))
     mask = np.frombuffer(s._mask_tex.read(), dtype="u4").reshape(32, 64)
-    solid = s.body.raster.solid
-    assert np.array_equal((mask & 1).astype(bool), solid)
+    x0, y0, x1, y1 = expand_box(union_box(old_window, s.body.raster.window), 2, 64, 32)
+    inside = np.zeros((32, 64), bool)
+    inside[y0:y1, x0:x1] = True
+    assert np.all(mask[~inside] == sentinel)  # untouched outside the changed box
+    assert np.array_equal(mask[y0:y1, x0:x1], node_mask(s.body.raster.solid, s.body.raster.q, (x0, y0, x1, y1)))
+    assert np.array_equal((mask[y0:y1, x0:x1] & 1).astype(bool), s.body.raster.solid[y0:y1, x0:x1])
     s.set_body(None)
     mask = np.frombuffer(s._mask_tex.read(), dtype="u4").reshape(32, 64)
-    assert not mask.any()
+    assert not mask[y0:y1, x0:x1].any()

@@ -124,6 +124,7 @@ class RemoteSim:
         self.hand = _RemoteHand(self, workspace)
         self.forces = _RemoteForces(self)
         self._muted = False
+        self._last_state = {"last": [0.0, 0.0], "max": 0.0, "count": 0, "hand": [0.0, 0.0], "errors": []}
 
     def _send(self, cmd: dict) -> None:
         with self._lock:
@@ -135,9 +136,13 @@ class RemoteSim:
 
     def _state(self) -> dict:
         with self._lock:
-            self._proc.stdin.write(json.dumps({"op": "state"}) + "\n")
-            self._proc.stdin.flush()
-            return json.loads(self._proc.stdout.readline())
+            try:
+                self._proc.stdin.write(json.dumps({"op": "state"}) + "\n")
+                self._proc.stdin.flush()
+                self._last_state = json.loads(self._proc.stdout.readline())
+            except (OSError, ValueError):  # the simulator process has ended: what it last said
+                self._last_state = dict(self._last_state, errors=["simulator process ended"])
+            return self._last_state
 
     @property
     def errors(self):
