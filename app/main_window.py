@@ -255,6 +255,7 @@ class MainWindow(QMainWindow):
         if self.sim is not None and paused != self.paused:
             self.sim.solver.pause() if paused else self.sim.solver.resume()
         self.paused = paused
+        self.timer.setInterval(30 if paused else 0)   # paused: redraw at ~30 Hz, no busy loop
         if self.input_device is not None:
             self.input_device.pause(paused)
         self.pause_action.setChecked(paused)
