@@ -1,7 +1,7 @@
 """The fragment-shader backend: docs/algorithm.md in GLSL 330 core, run through moderngl.
 
 `GLSolver(config, ctx=moderngl_context)` implements `solver.backend.Solver` with the same extra
-methods as the numpy reference (`set_inflow_speed`, `add_force_model`, `body_window`). It never
+methods as the numpy reference (`add_force_model`, `body_window`). It never
 creates a GL context: the CLI and the tests hand it an EGL standalone one, the window Qt's.
 Arithmetic is float32 whatever `config.dtype` says.
 
@@ -51,7 +51,6 @@ from solver.gl_programs import create_program
 from solver.inflow import profile, ramp
 from solver.lattice import C, OPP, Q, RHO0, equilibrium
 from solver.numpy_backend import relaxation_rates
-from solver.speed_limit import cap_speed
 
 #: texture units (fixed; every pass binds all it samples)
 UNIT_G = (0, 1, 2)
@@ -171,8 +170,6 @@ class GLSolver(Solver):
         self._tiles = None
         self._pending, self._idle_queries = [], []  # divergence checks: (step, kind, object)
 
-        self.inflow_speed = float(cfg.inflow_speed)
-        self.inflow_capped = False
         self.body: BodyState | None = None
         self._impulse = (0.0, 0.0)
         self._models = {}
@@ -290,13 +287,6 @@ class GLSolver(Solver):
         self._qb_tex.use(location=UNIT_QB)
         self._inflow_tex.use(location=UNIT_INFLOW)
         self._omega_tex.use(location=UNIT_OMEGA)
-
-    # --- inflow -------------------------------------------------------------------
-    def set_inflow_speed(self, speed: float) -> None:
-        """Change the inlet speed U (tunnel), capped at config.max_speed (see inflow_capped)."""
-        u, _, capped = cap_speed(float(speed), 0.0, self.config.max_speed)
-        self.inflow_speed, self.inflow_capped = u, capped
-        self.speed_capped = capped or bool(self.body and self.body.capped)
 
     # --- stepping ---------------------------------------------------------------
     def _one_step(self):
