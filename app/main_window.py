@@ -224,6 +224,7 @@ class MainWindow(QMainWindow):
         r = bar.addMenu("&Run")
         self.pause_action = self._action(r, "Pause / run", self.toggle_pause, "Space", checkable=True)
         self._action(r, "Reset flow", self.reset_flow, "R")
+        self._action(r, "Stop device force", self.stop_device_force, "Esc")
         v = bar.addMenu("&View")
         self._action(v, "Full screen", self.toggle_fullscreen, "F11")
         v.addSeparator()
@@ -560,6 +561,12 @@ class MainWindow(QMainWindow):
         self.input_device.disconnected.connect(self._device_lost)
         self.set_hold_still(False)
         self.panel.input_note.setText("The device moves the body; you feel the selected force model.")
+
+    def stop_device_force(self, _=None):
+        """Esc: the haptic device's force goes to zero at once (haptics safety: the stop key)."""
+        if self.input_device is not None:
+            self.input_device.emergency_stop()
+            self.statusBar().showMessage("Device force stopped (Esc). Choose the device again to feel the flow.", 10000)
 
     def _device_lost(self, reason):
         self._close_device()
