@@ -6,7 +6,7 @@ creates a GL context: the CLI and the tests hand it an EGL standalone one, the w
 Arithmetic is float32 whatever `config.dtype` says.
 
 State on the GPU: the shifted post-collision populations g_i = f*_i - w_i RHO0 in three RGBA32F
-textures per ping-pong side (G0 = g0..g3, G1 = g4..g7, G2 = g8), written by one fused
+textures per side (three sides: see 'Steps run in blocks' below) (G0 = g0..g3, G1 = g4..g7, G2 = g8), written by one fused
 collide+stream pass through three colour attachments (MRT). llvmpipe executes both sides of a
 divergent branch, so the step is drawn as rectangles, each with the variant of
 `shaders/lbm_step.glsl` it needs: the interior (plain streaming, the fast path), the edge rows
@@ -17,7 +17,7 @@ takes the two-node interpolation) and the link fractions q (two RGBA32F: q[1..4]
 uploaded in `set_body` only, and only over the union of the old and new body windows. Wall
 velocities come from uniforms (V, Omega, centre). Refill, impulses and every force model run on
 the CPU on the read-back body window, with the numpy reference's code (`solver/body.py`,
-`solver/bouzidi.py`, `solver/forces/`): per step with forces, 3 small reads of the window.
+`solver/bouzidi.py`, `solver/forces/`): the windows of a block of steps are read at once.
 
 API for the app (a QOpenGLWidget sharing this context):
 - `field_texture()` -> moderngl.Texture, nx x ny, RGBA32F = (rho, ux, uy, vorticity), computed
@@ -29,13 +29,16 @@ API for the app (a QOpenGLWidget sharing this context):
   it samples (units 0..7) right before drawing. Nothing is restored: after `step()` or
   `field_texture()` the bound framebuffer is the solver's, so a paintGL must re-bind its own
   (`ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`) and its own textures.
-- Divergence: after every step a small pass sums g_0..g_3 over 16 x 16 tiles
-  (`shaders/finite_check.glsl`; NaN reaches every population of the neighbours within a step);
-  the sums are read one step late so the pipeline keeps running, and at the end of each
-  `step(n)`. A non-finite sum, or a non-finite body window (read each step that computes
-  forces), raises `solver.backend.SolverDiverged` with the step that produced it, as the
-  reference does. (An occlusion query counting fragments that a non-finite node discards,
-  tuning divergence="discard", halved the step's speed on llvmpipe: docs/performance.md.)
+- Steps run in blocks of up to CHECK_EVERY (32) steps with nothing read back inside a block
+  (every read drains llvmpipe's queue). With forces, a small pass per step copies the body
+  window into a check atlas; at the end of the block a pass sums g_0..g_3 of the final state over
+  tiles (`shaders/finite_check.glsl`; NaN reaches every population of the neighbours within a
+  step, so a NaN never vanishes from the fluid) and the atlas is read once. A non-finite sum
+  replays the block from its start state, which a third state side keeps, with a check after
+  every step: `solver.backend.SolverDiverged` names the exact step, as in the reference; a
+  non-finite body window raises it with the step of that window. (An occlusion query counting
+  fragments that a non-finite node discards, tuning divergence="discard", halved the step's
+  speed on llvmpipe: docs/performance.md.)
 """
 from __future__ import annotations
 
