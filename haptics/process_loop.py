@@ -180,6 +180,11 @@ def child_main(argv) -> int:
                     loop.set_tunnel(cmd["rect"], cmd.get("flip_y"))
                 elif op == "set_scaling":
                     loop.set_scaling(cmd["expected_peak"], cmd.get("comfort_fraction"))
+                elif op == "simulate_unplug":
+                    simulator = getattr(dev, "simulator", None)
+                    if simulator is None:
+                        raise DeviceError(f"{dev.url if hasattr(dev, 'url') else 'device'}: not a simulator")
+                    simulator.unplug()
             except (ValueError, DeviceError) as exc:
                 send({"command_error": str(exc)})
     finally:
@@ -315,6 +320,10 @@ class ProcessForceLoop:
 
     def clear_stop(self) -> None:
         self._cmd("clear_stop")
+
+    def simulate_unplug(self) -> None:
+        """sim:// devices only: unplug the simulated board (its real disconnect path, in the child)."""
+        self._cmd("simulate_unplug")
 
     def set_tunnel(self, rect, flip_y: bool | None = None) -> None:
         self._cmd("set_tunnel", rect=[float(v) for v in rect], flip_y=flip_y)

@@ -388,7 +388,11 @@ def test_haptic_device_moves_the_body_feels_the_force_and_unplugging_falls_back_
     assert dev is not None and dev.url == "sim://diyhid"
     qtbot.waitUntil(lambda: window.sim.target is not None and dev.loop.status().samples > 5, timeout=20000)
     assert dev.loop.status().running
-    dev.device.simulator.unplug()          # the real disconnect path of the simulated board
+    assert dev.loop.status().running
+    window.stop_device_force()             # Esc: the force goes to zero at once
+    qtbot.waitUntil(lambda: dev.loop.status().state == "stopped" and dev.loop.status().force == (0.0, 0.0),
+                    timeout=5000)
+    dev.loop.simulate_unplug()             # the real disconnect path of the simulated board
     qtbot.waitUntil(lambda: window.input_device is None, timeout=10000)
     assert panel.input.currentData() == "mouse"
     assert "disconnected" in panel.input_note.text()

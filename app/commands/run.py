@@ -26,6 +26,8 @@ def add_arguments(parser):
                         help="solver backend (default: the scene's run.backend, else numpy)")
     parser.add_argument("--steps", default=None, metavar="N", help="number of steps (default: the scene's)")
     parser.add_argument("--out", default="forces.csv", metavar="PATH", help="CSV file to write (default: forces.csv)")
+    parser.add_argument("--record", default=None, metavar="FILE.ffsession",
+                        help="also record the run as a session file (docs/sessions.md)")
 
 
 def positive_int_option(name: str, text):
@@ -75,6 +77,11 @@ def main(args) -> int:
         raise UserError(f"--out: directory {str(out.parent)!r} does not exist")
 
     solver = make_solver(backend, scene.config)
+    recorder = None
+    if args.record:
+        from app.session import record_headless
+
+        solver, recorder = record_headless(solver, scene, scene_toml=Path(args.scene).read_text())
     try:
         # a blow-up is detected and reported in one line, not as floating-point warnings
         with warnings.catch_warnings(), np.errstate(all="ignore"):
@@ -84,6 +91,13 @@ def main(args) -> int:
         solver.close()
 
     write_csv_atomic(out, header, rows)
+    if recorder is not None:
+        from app.session import SessionError
+
+        try:
+            recorder.save(args.record)
+        except SessionError as exc:
+            raise UserError(str(exc)) from None
     if diverged is not None:
         print(f"feelflow: the simulation diverged (NaN) within steps {diverged[0]}..{diverged[1]}; "
               f"the {len(rows)} rows before it are in {out}. Lower the speeds or raise the viscosity "
