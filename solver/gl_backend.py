@@ -6,7 +6,7 @@ creates a GL context: the CLI and the tests hand it an EGL standalone one, the w
 Arithmetic is float32 whatever `config.dtype` says.
 
 State on the GPU: the shifted post-collision populations g_i = f*_i - w_i RHO0 in three RGBA32F
-textures per ping-pong side (G0 = g0..g3, G1 = g4..g7, G2 = g8), written by one fused
+textures per side (three sides: see 'Steps run in blocks' below) (G0 = g0..g3, G1 = g4..g7, G2 = g8), written by one fused
 collide+stream pass through three colour attachments (MRT). llvmpipe executes both sides of a
 divergent branch, so the step is drawn as rectangles, each with the variant of
 `shaders/lbm_step.glsl` it needs: the interior (plain streaming, the fast path), the edge rows
@@ -17,7 +17,7 @@ takes the two-node interpolation) and the link fractions q (two RGBA32F: q[1..4]
 uploaded in `set_body` only, and only over the union of the old and new body windows. Wall
 velocities come from uniforms (V, Omega, centre). Refill, impulses and every force model run on
 the CPU on the read-back body window, with the numpy reference's code (`solver/body.py`,
-`solver/bouzidi.py`, `solver/forces/`): per step with forces, 3 small reads of the window.
+`solver/bouzidi.py`, `solver/forces/`): the windows of a block of steps are read at once.
 
 API for the app (a QOpenGLWidget sharing this context):
 - `field_texture()` -> moderngl.Texture, nx x ny, RGBA32F = (rho, ux, uy, vorticity), computed
@@ -29,13 +29,16 @@ API for the app (a QOpenGLWidget sharing this context):
   it samples (units 0..7) right before drawing. Nothing is restored: after `step()` or
   `field_texture()` the bound framebuffer is the solver's, so a paintGL must re-bind its own
   (`ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`) and its own textures.
-- Divergence: after every step a small pass sums g_0..g_3 over 16 x 16 tiles
-  (`shaders/finite_check.glsl`; NaN reaches every population of the neighbours within a step);
-  the sums are read one step late so the pipeline keeps running, and at the end of each
-  `step(n)`. A non-finite sum, or a non-finite body window (read each step that computes
-  forces), raises `solver.backend.SolverDiverged` with the step that produced it, as the
-  reference does. (An occlusion query counting fragments that a non-finite node discards,
-  tuning divergence="discard", halved the step's speed on llvmpipe: docs/performance.md.)
+- Steps run in blocks of up to CHECK_EVERY (32) steps with nothing read back inside a block
+  (every read drains llvmpipe's queue). With forces, a small pass per step copies the body
+  window into a check atlas; at the end of the block a pass sums g_0..g_3 of the final state over
+  tiles (`shaders/finite_check.glsl`; NaN reaches every population of the neighbours within a
+  step, so a NaN never vanishes from the fluid) and the atlas is read once. A non-finite sum
+  replays the block from its start state, which a third state side keeps, with a check after
+  every step: `solver.backend.SolverDiverged` names the exact step, as in the reference; a
+  non-finite body window raises it with the step of that window. (An occlusion query counting
+  fragments that a non-finite node discards, tuning divergence="discard", halved the step's
+  speed on llvmpipe: docs/performance.md.)
 """
 from __future__ import annotations
 
@@ -57,8 +60,8 @@ UNIT_G = (0, 1, 2)
 UNIT_MASK, UNIT_QA, UNIT_QB, UNIT_INFLOW, UNIT_OMEGA = 3, 4, 5, 6, 7
 #: region rectangles are aligned to llvmpipe's 4x4 shading blocks
 ALIGN = 4
-#: tile edge of the finite check
-CHECK_BLOCK = 16
+#: steps whose divergence checks and force windows are read back together (one GPU sync)
+CHECK_EVERY = 32
 _Y_MODE = {"no_slip": 0, "free_slip": 1, "periodic": 2}
 
 
@@ -71,6 +74,15 @@ def _box_minus(outer, inner):
         return [outer]
     rects = [(ox0, oy0, ox1, iy0), (ox0, iy1, ox1, oy1), (ox0, iy0, ix0, iy1), (ix1, iy0, ox1, iy1)]
     return [r for r in rects if r[0] < r[2] and r[1] < r[3]]
+
+
+def _tile_block(nx: int) -> tuple[int, int]:
+    """(BLOCK_X, BLOCK_Y) of the finite check: 256 nodes a tile, at least 128 tiles across
+    (two of llvmpipe's 64-pixel bins, so both threads reduce) where the grid allows."""
+    bx = 1
+    while bx < 16 and -(-nx // (2 * bx)) >= 128:
+        bx *= 2
+    return bx, 256 // bx
 
 
 def _triangles(rects) -> np.ndarray:
@@ -111,7 +123,8 @@ class GLSolver(Solver):
 
     name = "gl"
     #: default tuning (docs/performance.md measures each choice)
-    TUNING = {"split": True, "fetch_normalized": 2, "divergence": "tiles"}
+    TUNING = {"split": True, "fetch_normalized": 2, "divergence": "tiles", "check_every": CHECK_EVERY,
+              "window": "atlas"}
 
     def __init__(self, config, ctx=None, tuning: dict | None = None):
         super().__init__(config)
@@ -150,7 +163,9 @@ class GLSolver(Solver):
             self._objects.append(t)
             return t
 
-        self._g = [[tex((nx, ny), 4, repeat=True) for _ in range(3)] for _ in range(2)]
+        # three sides: two ping-pong within a block of steps, the third keeps the block's start
+        # state, from which a block whose final state is not finite is replayed step by step
+        self._g = [[tex((nx, ny), 4, repeat=True) for _ in range(3)] for _ in range(3)]
         self._fbo = [ctx.framebuffer(color_attachments=side) for side in self._g]
         self._objects += self._fbo
         self._cur = 0  # the side holding f*(t)
@@ -167,8 +182,13 @@ class GLSolver(Solver):
         self._draws, self._draw_regions = [], None
         self._field = None
         self._discard = self.tuning["divergence"] == "discard"
-        self._tiles = None
-        self._pending, self._idle_queries = [], []  # divergence checks: (step, kind, object)
+        # divergence checks and force windows of up to CHECK_EVERY steps, read back at once
+        self._tile_block = _tile_block(nx)
+        self._tile_grid = (-(-nx // self._tile_block[0]), -(-ny // self._tile_block[1]))
+        self._atlas, self._check_progs = None, None
+        self._check_every = max(1, min(CHECK_EVERY, int(self.tuning["check_every"])))
+        self._window_mode = self.tuning["window"]
+        self._pending, self._idle_queries = [], []  # divergence="discard": (step, query)
 
         self.body: BodyState | None = None
         self._impulse = (0.0, 0.0)
@@ -210,6 +230,13 @@ class GLSolver(Solver):
         x1, y1 = (nx - 1) // a * a, (ny - 1) // a * a
         if not self.tuning["split"] or x1 <= a or y1 <= a:
             return {(1, 1, sp): [(0, 0, nx, ny)]}
+        if self._wraps_free():  # periodic box: REPEAT samplers wrap, the fast path does the edges
+            parts = {(0, 0, 0): [(0, 0, nx, ny)]}
+            if window is not None and window[0] < window[2] and window[1] < window[3]:
+                w = (window[0] // a * a, window[1] // a * a, min(nx, -(-window[2] // a) * a),
+                     min(ny, -(-window[3] // a) * a))
+                parts = {(0, 0, 0): _box_minus((0, 0, nx, ny), w), (1, 0, 0): [w]}
+            return {k: v for k, v in parts.items() if v}
         interior = (a, a, x1, y1)
         edges = [(0, 0, nx, a), (0, y1, nx, ny), (0, a, a, y1), (x1, a, nx, y1)]
         parts = {(0, 0, 0): [interior], (0, 1, sp): edges}
@@ -230,6 +257,11 @@ class GLSolver(Solver):
                     sponge.append((max(r[0], xs), r[1], r[2], r[3]))
             parts[(0, 0, 0)], parts[(0, 0, 1)] = plain, sponge
         return {k: v for k, v in parts.items() if v}
+
+    def _wraps_free(self) -> bool:
+        """Both directions periodic and streamed through REPEAT samplers: no edge rules at all."""
+        d = self._defines
+        return bool(d["X_PERIODIC"] and d["Y_MODE"] == 2 and d["FETCH_NORMALIZED"] and not self._sponge)
 
     def _set_rects(self, window):
         """Vertex data of every region (see _regions), drawn in this order each step; kept
@@ -289,11 +321,11 @@ class GLSolver(Solver):
         self._omega_tex.use(location=UNIT_OMEGA)
 
     # --- stepping ---------------------------------------------------------------
-    def _one_step(self):
+    def _draw_step(self, dst: int):
+        """Queue step t -> t+1 from the current side into side `dst`."""
         self._update_inflow(self.time)
-        src, dst = self._cur, 1 - self._cur
         self._begin_pass(self._fbo[dst], (self.nx, self.ny))
-        self._bind_sources(src)
+        self._bind_sources(self._cur)
         if self._discard:
             query = self._idle_queries.pop() if self._idle_queries else self.ctx.query(samples=True)
             with query:
@@ -305,29 +337,64 @@ class GLSolver(Solver):
         self._cur = dst
         self.time += 1
         if self._discard:
-            self._pending.append((self.time, "query", query))
-        else:
-            self._pending.append((self.time, "tiles", self._issue_tile_check()))
-        self._resolve_check()
+            self._pending.append((self.time, query))
 
     def step(self, n: int = 1) -> None:
+        """Steps in blocks of up to `check_every`: nothing is read back inside a block (a read
+        drains llvmpipe's queue). Per step, with forces, one pass copies the body window into
+        the check atlas; at the end of the block the final state's tile sums are queued and the
+        atlas read once. A non-finite final state replays the block from its start state (kept
+        in the third side) with a check after every step, so SolverDiverged names the exact step."""
         n = int(n)
         sums = {name: [0.0, 0.0] for name in self._models}
-        for _ in range(n):
-            src, impulse = self._cur, self._impulse
-            self._impulse = (0.0, 0.0)
-            self._one_step()  # queued; the forces of f*(t) are computed while the GPU runs it
-            if self._models and self.body is not None:
-                win = self._window(src, impulse)
-                if not np.all(np.isfinite(win.f)):
-                    raise SolverDiverged(self.time - 1, "non-finite populations around the body")
+        done = 0
+        while done < n:
+            k = min(n - done, self._check_every)
+            with_forces = bool(self._models) and self.body is not None
+            self._ensure_atlas(k, with_forces)
+            t0, start, impulses = self.time, self._cur, []
+            others = [side for side in range(3) if side != start]
+            read_now = []  # tuning window="read": each window read right after its step is queued
+            for band in range(k):
+                impulses.append(self._impulse)
+                self._impulse = (0.0, 0.0)
+                src = self._cur
+                self._draw_step(others[band % 2])
+                if with_forces and self._window_mode == "read":
+                    read_now.append(self._window(src, impulses[-1]))
+                    if not np.all(np.isfinite(read_now[-1].f)):
+                        raise SolverDiverged(self.time - 1, "non-finite populations around the body")
+                elif with_forces:
+                    self._queue_checks(band, src, tiles=False)
+            self._queue_checks(0, None, tiles=not self._discard)
+            try:
+                windows = self._resolve_checks(t0, k, impulses if with_forces and not read_now else None)
+                windows = read_now or windows
+            except SolverDiverged as exc:
+                if exc.step == self.time and not self._discard:  # only the final state is known bad
+                    self._replay(start, t0, k)
+                raise
+            for win in windows:
                 for name, model in self._models.items():
                     fx, fy = model.compute(win)
                     sums[name][0] += fx
                     sums[name][1] += fy
+            done += k
         if n > 0:
-            self._resolve_check(wait_all=True)
             self._forces = {name: (s[0] / n, s[1] / n) for name, s in sums.items()}
+
+    def _replay(self, start: int, t0: int, k: int):
+        """Rerun the k steps after time t0 from side `start`, checking each state: raises
+        SolverDiverged with the first step whose state is not finite (the GPU is deterministic)."""
+        end = self.time
+        self._cur, self.time = start, t0
+        others = [side for side in range(3) if side != start]
+        for band in range(k):
+            self._draw_step(others[band % 2])
+            self._queue_checks(0, None, tiles=True)
+            if not self._tiles_finite(0):
+                raise SolverDiverged(self.time, "density is no longer finite")
+        raise SolverDiverged(end, "density is no longer finite (not reproduced on replay)")
 
     def time_variant(self, key, draws: int) -> float:
         """Seconds to draw step variant `key` = (body, edges, sponge) over the whole grid
@@ -340,10 +407,11 @@ class GLSolver(Solver):
         self.finish()
         t0 = time.perf_counter()
         for _ in range(draws):
-            self._begin_pass(self._fbo[1 - self._cur], (self.nx, self.ny))
+            dst = (self._cur + 1) % 3
+            self._begin_pass(self._fbo[dst], (self.nx, self.ny))
             self._bind_sources(self._cur)
             vao.render(moderngl.TRIANGLES)
-            self._cur = 1 - self._cur
+            self._cur = dst
         self.finish()
         elapsed = time.perf_counter() - t0
         vao.release()
@@ -369,36 +437,114 @@ class GLSolver(Solver):
                        body_force=tuple(float(v) for v in self.config.body_force))
         return prog, tex, fbo, vao
 
-    def _issue_tile_check(self):
-        """Queue the tile sums of g_0..g_3 of the current state into one of two targets."""
-        if self._tiles is None:
-            size = (-(-self.nx // CHECK_BLOCK), -(-self.ny // CHECK_BLOCK))
-            first = self._aux_pass("finite_check.glsl", size, {"BLOCK": CHECK_BLOCK})
-            tex = self.ctx.texture(size, 4, dtype="f4")
-            fbo = self.ctx.framebuffer(color_attachments=[tex])
-            self._objects += [fbo, tex]
-            self._tiles = [first, (first[0], tex, fbo, first[3])]
-        self._tiles.reverse()
-        prog, tex, fbo, vao = self._tiles[0]
-        self._begin_pass(fbo, tex.size)
-        self._g[self._cur][0].use(location=UNIT_G[0])
-        vao.render(moderngl.TRIANGLES)
-        return fbo
+    def _ensure_atlas(self, bands: int, with_window: bool):
+        """The check atlas: per step one band of tile sums (columns [0, TW)) and, with forces,
+        one band of the body window (columns [TW, TW + w)), 3 RGBA32F attachments."""
+        tw, th = self._tile_grid
+        ww, wh = (0, 0)
+        if with_window:
+            x0, y0, x1, y1 = self.body.window
+            ww, wh = x1 - x0, y1 - y0
+        need = (tw + ww, max(th, wh) * CHECK_EVERY)
+        if self._atlas is None or any(a < b for a, b in zip(self._atlas["size"], need)):
+            if self._atlas is not None:
+                for obj in self._atlas["objects"]:
+                    obj.release()
+            size = (max(need[0], self._atlas["size"][0] if self._atlas else 0),
+                    max(need[1], self._atlas["size"][1] if self._atlas else 0))
+            texs = [self.ctx.texture(size, 4, dtype="f4") for _ in range(3)]
+            fbo = self.ctx.framebuffer(color_attachments=texs)
+            self._atlas = {"size": size, "fbo": fbo, "objects": [fbo, *texs]}
+        if self._check_progs is None:
+            tiles = self._aux_program("finite_check.glsl", {"BLOCK_X": self._tile_block[0],
+                                                             "BLOCK_Y": self._tile_block[1]})
+            window = self._aux_program("copy_window.glsl")
+            self._check_progs = (tiles, window)
+        size = self._atlas["size"]
+        for vao, _ in self._check_progs:
+            self._uniforms(vao.program, grid_size=(float(size[0]), float(size[1])))
+        if (size, ww, wh) != self._atlas.get("layout"):
+            self._atlas["layout"] = (size, ww, wh)
+            for _, vbo in self._check_progs:
+                band_h = max(th, wh)
+                rects = [(0, b * band_h, tw, b * band_h + th) for b in range(CHECK_EVERY)]
+                rects += [(tw, b * band_h, tw + ww, b * band_h + wh) for b in range(CHECK_EVERY)]
+                vbo.orphan(len(rects) * 6 * 8)
+                vbo.write(_triangles(rects).tobytes())
+        self._atlas["window"] = (ww, wh)
 
-    def _resolve_check(self, wait_all=False):
-        """Divergence check of earlier steps (algorithm.md, 'Divergence'), read one step late so
-        the pipeline keeps running (all pending when `wait_all`): the tile sums must be finite,
-        or (tuning divergence="discard") every node must have written its fragment."""
-        while self._pending and (wait_all or len(self._pending) > 1):
-            step, kind, obj = self._pending.pop(0)
-            if kind == "query":
-                self._idle_queries.append(obj)
-                bad = obj.samples != self.nx * self.ny
-            else:
-                bad = not np.all(np.isfinite(np.frombuffer(obj.read(components=4, dtype="f4"), dtype="f4")))
-            if bad:
-                self._pending = []
-                raise SolverDiverged(step, "density is no longer finite")
+    def _aux_program(self, fragment, defines=None):
+        """(vao, vbo) of a pass into the check atlas; the vbo holds one rectangle per band."""
+        prog = create_program(self.ctx, "rect_vertex.glsl", fragment, defines)
+        vbo = self.ctx.buffer(reserve=2 * CHECK_EVERY * 6 * 8)
+        vao = self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
+        self._objects += [vao, vbo, prog]
+        self._uniforms(prog, G0=UNIT_G[0], G1=UNIT_G[1], G2=UNIT_G[2], N=(self.nx, self.ny))
+        return vao, vbo
+
+    def _queue_checks(self, band: int, window_side: int | None, tiles: bool):
+        """Into band `band` of the check atlas: the tile sums of the current state (`tiles`)
+        and the body window of `window_side` (one pass: both draws share llvmpipe's scene)."""
+        tw, th = self._tile_grid
+        ww, wh = self._atlas["window"]
+        band_h = max(th, wh)
+        (tile_vao, _), (window_vao, _) = self._check_progs
+        self._begin_pass(self._atlas["fbo"], self._atlas["size"])
+        if tiles:
+            self._g[self._cur][0].use(location=UNIT_G[0])
+            tile_vao.program["band"].value = (0, band * band_h)
+            tile_vao.render(moderngl.TRIANGLES, vertices=6, first=6 * band)
+        if window_side is not None:
+            for unit, texture in zip(UNIT_G, self._g[window_side]):
+                texture.use(location=unit)
+            x0, y0 = self.body.window[:2]
+            window_vao.program["shift"].value = (x0 - tw, y0 - band * band_h)
+            window_vao.render(moderngl.TRIANGLES, vertices=6, first=6 * (CHECK_EVERY + band))
+
+    def _tiles_finite(self, band: int) -> bool:
+        tw, th = self._tile_grid
+        band_h = max(th, self._atlas["window"][1])
+        data = self._atlas["fbo"].read(viewport=(0, band * band_h, tw, th), components=4, attachment=0, dtype="f4")
+        return bool(np.all(np.isfinite(np.frombuffer(data, dtype="f4"))))
+
+    def _resolve_checks(self, t0: int, bands: int, impulses):
+        """Read the atlas after a block of `bands` steps from time t0 and check it (algorithm.md,
+        'Divergence'): the tile sums of the final state finite (or, tuning divergence="discard",
+        every node of every step written), and each step's body window finite. Raises
+        SolverDiverged with the earliest bad step known; else returns the BodyWindows."""
+        tw, th = self._tile_grid
+        ww, wh = self._atlas["window"]
+        band_h = max(th, wh)
+        height = (bands - 1) * band_h + wh
+        bad = []
+        if self._discard:
+            for step, query in self._pending:
+                self._idle_queries.append(query)
+                if query.samples != self.nx * self.ny and not bad:
+                    bad.append((step, "density is no longer finite"))
+            self._pending = []
+        elif not self._tiles_finite(0):
+            bad.append((self.time, "density is no longer finite"))
+        windows = []
+        if impulses:
+            g = np.empty((12, height, ww), dtype="f4")
+            for k in range(3):
+                data = self._atlas["fbo"].read(viewport=(tw, 0, ww, height), components=4, attachment=k,
+                                               dtype="f4")
+                g[4 * k:4 * k + 4] = np.moveaxis(np.frombuffer(data, dtype="f4").reshape(height, ww, 4), -1, 0)
+            b_ = self.body
+            solid, q = b_.window_arrays()
+            for b, impulse in enumerate(impulses):
+                gb = g[:Q, b * band_h:b * band_h + wh]
+                if not np.all(np.isfinite(gb)):
+                    bad.append((t0 + b, "non-finite populations around the body"))
+                    break
+                windows.append(BodyWindow(x0=b_.window[0], y0=b_.window[1], f=unshifted(gb), solid=solid, q=q,
+                                          shape=b_.shape, velocity=b_.velocity, omega=b_.omega, impulse=impulse,
+                                          config=self.config, links=b_.links))
+        if bad:
+            raise SolverDiverged(*min(bad))
+        return windows
 
     # --- body -------------------------------------------------------------------
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
@@ -539,4 +685,8 @@ class GLSolver(Solver):
             obj.release()
         self._draws, self._objects, self._programs = [], [], {}
         self._field = None
+        if self._atlas is not None:
+            for obj in self._atlas["objects"]:
+                obj.release()
+        self._atlas, self._check_progs = None, None
         self._pending, self._idle_queries = [], []

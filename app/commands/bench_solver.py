@@ -186,7 +186,9 @@ VARIANTS = {
     "one program, texelFetch (no regions)": {"split": False, "fetch_normalized": 0},
     "regions, texelFetch": {"split": True, "fetch_normalized": 0},
     "regions, texture() + REPEAT": {"split": True, "fetch_normalized": 1},
-    "regions, textureOffset() + REPEAT (default)": {},
+    "regions, textureOffset() + REPEAT, read back every step": {"check_every": 1, "window": "read"},
+    "default, force window read right after each step": {"window": "read"},
+    "regions, textureOffset() + REPEAT, blocks of 32 steps (default)": {},
     "default, divergence by discard + occlusion query": {"divergence": "discard"},
 }
 #: step variants (body, edges, sponge) whose cost per node the variants run measures
