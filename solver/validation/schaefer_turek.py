@@ -16,7 +16,7 @@ import numpy as np
 
 from solver import units
 from solver.config import FlowConfig
-from solver.lattice import equilibrium
+from solver.lattice import CS2, equilibrium
 
 #: peak inflow speed in lattice units: Ma = 0.13, compressibility error ~ Ma^2 / 3 (stated, not tuned)
 U_MAX = 0.075
@@ -66,6 +66,22 @@ class Geometry:
         """A solver with the channel flow developed and the cylinder in place."""
         solver = make_solver(self.config(**config_overrides))
         solver.set_distributions(self.initial_populations())
+        solver.set_body(self.cylinder())
+        solver.enable_force_models(["momentum_exchange"])
+        return solver
+
+    def acoustic_period(self) -> float:
+        """Steps of the tunnel's slowest acoustic mode: the velocity inlet (a closed end for
+        sound) and the pressure outlet (an open end) make a quarter-wave resonator, 4 nx / c_s."""
+        return 4.0 * self.nx / math.sqrt(CS2)
+
+    def start_from_rest(self, make_solver, ramp_steps: int, **config_overrides):
+        """A solver with the fluid at rest and the cylinder in place; the inflow rises over
+        `ramp_steps` ((1 - cos)/2, docs/algorithm.md 'Inflow'). Slow against
+        `acoustic_period()`, this excites the tunnel's sound modes far less than `start`."""
+        solver = make_solver(self.config(inflow_ramp_steps=int(ramp_steps), **config_overrides))
+        rest = np.zeros((self.ny, self.nx))
+        solver.set_distributions(equilibrium(np.ones_like(rest), rest, rest))
         solver.set_body(self.cylinder())
         solver.enable_force_models(["momentum_exchange"])
         return solver

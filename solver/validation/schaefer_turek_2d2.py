@@ -1,10 +1,23 @@
 """Schaefer-Turek 2D-2: periodic vortex shedding at Re = 100; C_D,max, C_L,max and St.
 
-Runs until the lift oscillation is periodic (successive periods and lift amplitudes agree
-within `PERIODIC_TOL`), then measures over the last `MEASURE_PERIODS` periods: the Strouhal
-number St = D f / U_mean from upward zero crossings of C_L (linearly interpolated), and the
-largest C_D and C_L. Targets: the published intervals (Schaefer & Turek 1996, benchmarks.md),
-checked at 40 cells per diameter as the issue asks.
+Starts from fluid at rest and raises the inflow over `RAMP_ACOUSTIC_PERIODS` periods of the
+tunnel's slowest sound mode (`Geometry.acoustic_period`), then runs until the lift oscillation
+is periodic (successive periods and lift amplitudes agree within `PERIODIC_TOL`) and measures
+over the last `MEASURE_PERIODS` periods: the Strouhal number St = D f / U_mean from upward zero
+crossings of C_L (linearly interpolated), the largest C_D and C_L, and the mean C_D. Targets:
+the published intervals (Schaefer & Turek 1996, benchmarks.md), checked at 40 cells per
+diameter as the issue asks.
+
+Why the smooth start (measured, README 'Validation'): the benchmark quantities are maxima of
+the periodic signal. Started impulsively (the cylinder put into the developed channel flow),
+the tunnel rings: the velocity inlet and the pressure outlet both reflect sound, the lattice
+damps long sound waves only over ~1e5 steps, and the modes (at 2.1, 3.0, 3.8, 9-11 times the
+shedding frequency; they move with the Mach number, so they are sound, not shedding) ride on
+the force with amplitudes ~0.015 in C_D each. That raised the measured C_D,max by ~0.06 at 20
+and 40 cells (3-period maxima scattering by 0.02 from period to period) while the mean C_D and
+the shedding were unchanged. Ramped in over two acoustic periods, the residual around the
+periodic signal falls from 0.013 to 0.0004 (rms, C_D, 20 cells) and successive periods agree
+to 0.1 step, hence the tighter `PERIODIC_TOL`.
 """
 from __future__ import annotations
 
@@ -18,7 +31,8 @@ NAME = "schaefer-turek-2d2"
 DEFAULT_RESOLUTION = 40
 QUICK_RESOLUTION = 20  # at 10 cells tau = 0.515 and the flow blows up
 RE = 100.0
-PERIODIC_TOL = 0.005
+PERIODIC_TOL = 0.001
+RAMP_ACOUSTIC_PERIODS = 2.0
 MEASURE_PERIODS = 3
 SOURCE = "Schaefer & Turek 1996, published intervals"
 
@@ -35,7 +49,7 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
     geo = Geometry(d, RE)
     sample = max(1, d // 4)  # about 130 samples per shedding period
     max_steps = int(max_convective_times * d / geo.u_mean)
-    solver = geo.start(make_solver)
+    solver = geo.start_from_rest(make_solver, round(RAMP_ACOUSTIC_PERIODS * geo.acoustic_period()))
     watch = Stopwatch()
     times, cds, cls = [], [], []
     periodic = False
@@ -68,13 +82,15 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
         window = (t >= ups[-k - 1]) & (t < ups[-1])
         period = (ups[-1] - ups[-k - 1]) / k
         quantities.update(cd_max=float(c[window].max()), cl_max=float(y[window].max()),
+                          cd_mean=float(c[window].mean()),
                           st=units.strouhal(1.0 / period, d, geo.u_mean))
     else:  # no shedding (too coarse or too short)
-        quantities.update(cd_max=float("nan"), cl_max=float("nan"), st=float("nan"))
+        quantities.update(cd_max=float("nan"), cl_max=float("nan"), cd_mean=float("nan"), st=float("nan"))
     result = CaseResult(NAME, backend, d, quantities=quantities)
     if d >= 40:
         for q, (lo, hi) in INTERVALS_2D2.items():
             result.checks.append(Check(q, lo, hi, SOURCE))
     result.checks.append(Check("periodic", 1.0, 1.0, f"periods and amplitudes within {PERIODIC_TOL:.1%}"))
-    result.notes = f"U_m = {geo.u_max}, TRT, {geo.nx} x {geo.ny}, sampled every {sample} steps"
+    result.notes = (f"U_m = {geo.u_max}, TRT, {geo.nx} x {geo.ny}, from rest, inflow ramp "
+                    f"{RAMP_ACOUSTIC_PERIODS:g} acoustic periods, sampled every {sample} steps")
     return watch.fill(result)
