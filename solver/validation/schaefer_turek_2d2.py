@@ -10,14 +10,14 @@ diameter as the issue asks.
 
 Why the smooth start (measured, README 'Validation'): the benchmark quantities are maxima of
 the periodic signal. Started impulsively (the cylinder put into the developed channel flow),
-the tunnel rings: the velocity inlet and the pressure outlet both reflect sound, the lattice
-damps long sound waves only over ~1e5 steps, and the modes (at 2.1, 3.0, 3.8, 9-11 times the
+the tunnel rings: the velocity inlet and the pressure outlet both reflect sound, long sound
+waves are hardly damped (still rms 0.012 in C_D after 44 000 steps at 40 cells), and the modes (at 2.1, 3.0, 3.8, 9-11 times the
 shedding frequency; they move with the Mach number, so they are sound, not shedding) ride on
-the force with amplitudes ~0.015 in C_D each. That raised the measured C_D,max by ~0.06 at 20
-and 40 cells (3-period maxima scattering by 0.02 from period to period) while the mean C_D and
-the shedding were unchanged. Ramped in over two acoustic periods, the residual around the
-periodic signal falls from 0.013 to 0.0004 (rms, C_D, 20 cells) and successive periods agree
-to 0.1 step, hence the tighter `PERIODIC_TOL`.
+the force with amplitudes ~0.015 in C_D each. That raised C_D,max at 40 cells from 3.2655 to
+3.337 and made three-period maxima scatter by 0.02 - 0.03 from period to period, while the mean
+C_D and the shedding were unchanged. Ramped in over two acoustic periods, the rms of C_D around
+its period-averaged signal falls from 0.013 to 0.0004 (20 cells) and successive periods agree to
+0.02 %, hence the tighter `PERIODIC_TOL`. Diagnostics: `tools/st2d2_diagnose.py`.
 """
 from __future__ import annotations
 

@@ -1,0 +1,100 @@
+"""Diagnose Schaefer-Turek 2D-2 (README 'Validation'): record C_D(t), C_L(t) and analyse them.
+
+    python tools/st2d2_diagnose.py record --d 20 [--u 0.075] [--ramp-periods 2 | --impulsive]
+        [--sponge CELLS] [--length-d 22] [--conv-times 60] [--sample 2] --out series.npz
+    python tools/st2d2_diagnose.py analyse series.npz [...]
+
+`analyse` folds the last three shedding periods (upward zero crossings of C_L) into a
+period-averaged signal and prints: per-period C_D maxima, mean C_D, C_D,max and C_L,max of the
+raw and the period-averaged signal, the rms of C_D around the period-averaged signal (what does
+not repeat: sound), and the strongest lines of the C_D spectrum in units of the shedding
+frequency. Run from the repository root (numpy backend).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from solver.validation.schaefer_turek import Geometry  # noqa: E402
+from solver.validation.schaefer_turek_2d2 import RE, upward_zero_crossings  # noqa: E402
+
+
+def record(a) -> None:
+    from app.headless import make_solver
+
+    geo = Geometry(a.d, RE, u_max=a.u)
+    geo.nx = int(round(a.length_d * a.d))
+    over = dict(sponge_cells=a.sponge, sponge_strength=10.0) if a.sponge else {}
+    factory = lambda c: make_solver("numpy", c)  # noqa: E731
+    if a.impulsive:
+        solver = geo.start(factory, **over)
+    else:
+        solver = geo.start_from_rest(factory, round(a.ramp_periods * geo.acoustic_period()), **over)
+    steps = int(a.conv_times * a.d / geo.u_mean)
+    t, cd, cl, n = [], [], [], 0
+    while n < steps:
+        solver.step(a.sample)
+        n += a.sample
+        c = geo.coefficients(solver.forces()["momentum_exchange"])
+        t.append(n - a.sample / 2)
+        cd.append(c[0])
+        cl.append(c[1])
+    solver.close()
+    np.savez(a.out, t=np.array(t), cd=np.array(cd), cl=np.array(cl), d=a.d, u_mean=geo.u_mean)
+
+
+def analyse(path: str, periods: int = 3) -> None:
+    z = np.load(path)
+    t, cd, cl, d, um = z["t"], z["cd"], z["cl"], int(z["d"]), float(z["u_mean"])
+    ups = upward_zero_crossings(t, cl)
+    k0 = len(ups) - 1 - periods
+    T = (ups[-1] - ups[k0]) / periods
+    w = (t >= ups[k0]) & (t < ups[-1])
+    phase = np.linspace(0, 1, 600, endpoint=False)
+    fold_cd = np.mean([np.interp(ups[k0] + (j + phase) * T, t, cd) for j in range(periods)], axis=0)
+    fold_cl = np.mean([np.interp(ups[k0] + (j + phase) * T, t, cl) for j in range(periods)], axis=0)
+    resid = cd[w] - np.interp(((t[w] - ups[k0]) / T) % 1, phase, fold_cd, period=1)
+    per_max = [cd[(t >= a) & (t < b)].max() for a, b in zip(ups[k0:-1], ups[k0 + 1:])]
+    print(f"{path}: D {d}, {t[-1]:.0f} steps, St {d / T / um:.4f}, periods {np.round(np.diff(ups[k0:]), 1)}")
+    print(f"  C_D max per period {np.round(per_max, 4)}, mean {cd[w].mean():.4f}")
+    print(f"  raw: C_D,max {cd[w].max():.4f} C_L,max {cl[w].max():.4f}; period-averaged: "
+          f"C_D,max {fold_cd.max():.4f} C_L,max {fold_cl.max():.4f}; rms of C_D around it {resid.std():.4f}")
+    k0 = max(0, len(ups) - 9)  # spectrum over up to 8 periods
+    w = (t >= ups[k0]) & (t < ups[-1])
+    x = cd[w] - cd[w].mean()
+    amp = np.abs(np.fft.rfft(x)) * 2 / len(x)
+    freq = np.fft.rfftfreq(len(x), t[1] - t[0]) * T
+    top = sorted(np.argsort(amp)[::-1][:8])
+    print("  C_D lines (f / f_shedding: amplitude):", ", ".join(f"{freq[i]:.2f}: {amp[i]:.4f}" for i in top))
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("record")
+    r.add_argument("--d", type=int, default=20)
+    r.add_argument("--u", type=float, default=0.075)
+    r.add_argument("--ramp-periods", type=float, default=2.0)
+    r.add_argument("--impulsive", action="store_true", help="developed channel flow at t = 0 (the old start)")
+    r.add_argument("--sponge", type=int, default=0)
+    r.add_argument("--length-d", type=float, default=22.0)
+    r.add_argument("--conv-times", type=float, default=60.0)
+    r.add_argument("--sample", type=int, default=2)
+    r.add_argument("--out", required=True)
+    an = sub.add_parser("analyse")
+    an.add_argument("paths", nargs="+")
+    a = p.parse_args()
+    if a.cmd == "record":
+        record(a)
+    else:
+        for path in a.paths:
+            analyse(path)
+
+
+if __name__ == "__main__":
+    main()
