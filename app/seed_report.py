@@ -17,7 +17,6 @@ import json
 import math
 import os
 import platform
-import tempfile
 import time
 import tomllib
 from pathlib import Path
@@ -25,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from app.cli import UserError
+from app.files import write_text_atomic
 from solver.lattice import CS2
 
 MODELS = ("momentum_exchange", "momentum_exchange_classic", "macroscopic", "pressure")
@@ -340,19 +340,16 @@ def _export(plot_widget, path: Path, width=900):
     from pyqtgraph.exporters import ImageExporter
     from pyqtgraph.Qt import QtWidgets
 
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png", dir=path.parent)
-    os.close(fd)
+    from app.files import atomic_path
+
     plot_widget.show()  # lay the plot out (title, axes) before rendering it
     QtWidgets.QApplication.processEvents()
     try:
-        exporter = ImageExporter(plot_widget.getPlotItem())
-        exporter.parameters()["width"] = width
-        exporter.export(tmp)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
+        with atomic_path(path, suffix=".png") as tmp:
+            exporter = ImageExporter(plot_widget.getPlotItem())
+            exporter.parameters()["width"] = width
+            exporter.export(str(tmp))
     finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
         plot_widget.close()
         plot_widget.deleteLater()
         QtWidgets.QApplication.processEvents()
@@ -441,19 +438,6 @@ def _g(v, digits=3) -> str:
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "n/a"
     return f"{v:.{digits}g}"
-
-
-def write_text_atomic(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)  # mkstemp makes it private; a report is for reading
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 def _provenance(data: dict) -> str:

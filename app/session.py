@@ -21,7 +21,6 @@ import dataclasses
 import io
 import json
 import math
-import os
 import zipfile
 import zlib
 from dataclasses import dataclass, field
@@ -557,11 +556,6 @@ def _fmt(v) -> str:
 
 # --- files ------------------------------------------------------------------------------------
 
-#: the process umask (read once: os.umask can only be read by setting it)
-_UMASK = os.umask(0o022)
-os.umask(_UMASK)
-
-
 def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
     """Write `data` through `app.files.atomic_path` (temp file beside, fsync, os.replace): never
     half a file. SessionError naming the path if it cannot (the old file is left as it was)."""
@@ -571,13 +565,8 @@ def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
     if path.is_dir():
         raise SessionError(f"{path}: is a directory")
     try:
-        mode = path.stat().st_mode & 0o777 if path.exists() else 0o666 & ~_UMASK
         with atomic_path(path, suffix=".tmp") as tmp:
-            os.chmod(tmp, mode)  # mkstemp makes 0600; a saved file gets the usual permissions
-            with open(tmp, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
+            tmp.write_bytes(data)
     except OSError as exc:
         raise SessionError(f"{path}: cannot write {what} ({exc.strerror or exc})") from None
     return path

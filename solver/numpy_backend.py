@@ -164,7 +164,7 @@ class NumpySolver(Solver):
     def _step_once(self) -> None:
         g, gin = self.g, self._gin
         cfg = self.config
-        nx, ny = cfg.nx, cfg.ny
+        nx = cfg.nx
         t = self.time
         # e/f: periodic shift of every population (pull: gin_i(x) = g_i(x - c_i))
         for i in range(Q):

@@ -201,7 +201,9 @@ def test_atomic_write_keeps_the_old_file_when_writing_fails(good, tmp_path, monk
     def disk_full(*_a, **_k):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(session_mod.os, "fsync", disk_full)
+    import app.files
+
+    monkeypatch.setattr(app.files.os, "fsync", disk_full)  # the fsync of every atomic write
     with pytest.raises(SessionError, match="No space left on device") as info:
         rec.save(target)
     assert "\n" not in str(info.value)

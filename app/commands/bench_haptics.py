@@ -10,7 +10,6 @@ Targets (issue 6): rate within 1 % of 1 kHz, p99 jitter < 1 ms, force never abov
 """
 from __future__ import annotations
 
-import json
 import math
 import os
 import platform
@@ -243,8 +242,7 @@ def main(args) -> int:
           f"loop as a thread {c['thread']['worst_p99_jitter_ms']:.2f} ms, "
           f"as a child process {c['process']['worst_p99_jitter_ms']:.2f} ms")
     if args.json:
-        tmp = args.json + ".tmp"
-        with open(tmp, "w") as fh:
-            json.dump(r, fh, indent=2)
-        os.replace(tmp, args.json)
+        from app.files import write_json_atomic
+
+        write_json_atomic(args.json, r)
     return 0 if r["force_within_max"] else 1

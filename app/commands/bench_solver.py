@@ -283,10 +283,7 @@ def main(args) -> int:
         for key, ratio in result["speedups"].items():
             print(f"gl / numpy, {key}: {ratio}x")
     if getattr(args, "json", None):
-        from pathlib import Path
+        from app.files import write_json_atomic
 
-        path = Path(args.json)
-        tmp = path.with_name(path.name + ".tmp")
-        tmp.write_text(json.dumps(result, indent=2))
-        os.replace(tmp, path)
+        write_json_atomic(args.json, result)
     return 0

@@ -5,10 +5,7 @@ The exit code is 0 when every target is met, 1 otherwise.
 """
 from __future__ import annotations
 
-import json
-import os
 import platform
-import tempfile
 from pathlib import Path
 
 from app.cli import UserError
@@ -67,16 +64,9 @@ def write_json_atomic(path: Path, data) -> None:
     directory = path.parent if str(path.parent) else Path(".")
     if not directory.is_dir():
         raise UserError(f"--json: directory {str(directory)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(data, fh, indent=2)
-            fh.write("\n")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    from app import files
+
+    files.write_json_atomic(path, data)
 
 
 def run_case(name: str, factory, resolution, quick: bool, backend: str):
