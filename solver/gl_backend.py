@@ -646,27 +646,14 @@ class GLSolver(Solver):
             data = np.ascontiguousarray(np.moveaxis(padded[4 * k:4 * k + 4], 0, -1))
             self._g[self._cur][k].write(data.tobytes(), viewport=(x0, y0, w, h))
 
-    def distributions(self) -> np.ndarray:
-        return unshifted(self._read_shifted())
+    def shifted_distributions(self) -> np.ndarray:
+        return self._read_shifted()
 
     def set_distributions(self, f: np.ndarray) -> None:
         f = np.asarray(f, dtype=np.float64)
         if f.shape != (Q, self.ny, self.nx):
             raise ValueError(f"distributions must have shape {(Q, self.ny, self.nx)}, got {f.shape}")
         self._write_shifted(shifted(f).astype("f4"))
-
-    def macroscopic(self):
-        """(rho, ux, uy) as Solver.macroscopic, summed on the shifted storage in float64."""
-        g = self._read_shifted()
-        rho = g.sum(axis=0, dtype=np.float64) + RHO0
-        fx, fy = self.config.body_force
-        jx = np.tensordot(C[:, 0].astype(np.float64), g, axes=1) - 0.5 * fx
-        jy = np.tensordot(C[:, 1].astype(np.float64), g, axes=1) - 0.5 * fy
-        return rho, jx / rho, jy / rho
-
-    def total_mass(self) -> float:
-        """sum f over the grid, accumulated in float64 on the shifted storage."""
-        return float(self._read_shifted().sum(dtype=np.float64)) + RHO0 * self.nx * self.ny
 
     @property
     def grid_size(self):
