@@ -22,7 +22,7 @@ from app.presets import PRESETS
 from app.bodies import default_polygon
 from app.shape_editor import SetPolygon
 from app.side_panel import SidePanel
-from app.simulation import FORCE_MODELS, Params, Simulation
+from app.simulation import Params, Simulation
 from app.viewport import DISPLAY_MODES, Viewport
 from shapes.base import ShapeError
 from solver.backend import SolverDiverged  # noqa: E402

@@ -100,7 +100,8 @@ class SelfTest:
         steps, frames = sim.solver.time - s0, w.viewport.frames - f0
         nodes = sim.config.nx * sim.config.ny
         self.results.update(grid=f"{sim.config.nx}x{sim.config.ny}", fps=frames / dt, steps_per_s=steps / dt,
-                            mlups=steps * nodes / dt / 1e6, steps_per_frame=steps / max(1, frames))
+                            mlups=steps * nodes / dt / 1e6, steps_per_frame=steps / max(1, frames),
+                            step_ms=1e3 * w._step_cost, rest_of_frame_ms=1e3 * w._other_cost)
         ok, why = field_is_alive(w)
         if not ok:
             self.failures.append(why)
@@ -143,6 +144,8 @@ class SelfTest:
         if "fps" in r:
             print(f"selftest: {r['fps']:.1f} frames/s, {r['steps_per_s']:.0f} solver steps/s "
                   f"({r['mlups']:.1f} MLUPS, {r['steps_per_frame']:.1f} steps/frame)", file=self.out)
+            print(f"selftest: frame budget: {r['step_ms']:.2f} ms per solver step, "
+                  f"{r['rest_of_frame_ms']:.1f} ms per frame for everything else (drawing, Qt)", file=self.out)
         if "body_moved_cells" in r:
             print(f"selftest: body moved {r['body_moved_cells']:.1f} cells when dragged", file=self.out)
         if "screenshot" in r:

@@ -79,29 +79,40 @@ class Solver(ABC):
 
     # --- fields ---------------------------------------------------------------
     @abstractmethod
+    def shifted_distributions(self) -> np.ndarray:
+        """The stored state g = f* - w_i RHO0 (9, ny, nx), in the backend's storage precision
+        (docs/algorithm.md, 'Lattice, storage'); a view or a fresh read-back, never modified."""
+
     def distributions(self) -> np.ndarray:
         """Full (unshifted) post-collision populations f*, float64 array (9, ny, nx)."""
+        from solver.lattice import RHO0, W
+
+        return self.shifted_distributions().astype(np.float64) + (W * RHO0)[:, None, None]
 
     @abstractmethod
     def set_distributions(self, f: np.ndarray) -> None:
         """Replace the state with full populations f (9, ny, nx)."""
 
     def macroscopic(self):
-        """(rho, ux, uy), each (ny, nx) float64, from the stored post-collision populations.
+        """(rho, ux, uy), each (ny, nx) float64, from the stored post-collision populations,
+        summed on the shifted storage in float64 (no cancellation against RHO0).
 
         With a body force F (Guo et al. 2002) the collision adds F to the momentum, so the
-        fluid velocity of the step is u = (sum_i c_i f*_i - F/2) / rho."""
-        from solver.lattice import C
+        fluid velocity of the step is u = (sum_i c_i f*_i - F/2) / rho (sum_i c_i w_i = 0)."""
+        from solver.lattice import C, RHO0
 
-        f = self.distributions()
-        rho = f.sum(axis=0)
+        g = self.shifted_distributions()
+        rho = g.sum(axis=0, dtype=np.float64) + RHO0
         fx, fy = self.config.body_force
-        ux = (np.tensordot(C[:, 0].astype(float), f, axes=1) - 0.5 * fx) / rho
-        uy = (np.tensordot(C[:, 1].astype(float), f, axes=1) - 0.5 * fy) / rho
-        return rho, ux, uy
+        jx = np.tensordot(C[:, 0].astype(np.float64), g, axes=1) - 0.5 * fx
+        jy = np.tensordot(C[:, 1].astype(np.float64), g, axes=1) - 0.5 * fy
+        return rho, jx / rho, jy / rho
 
     def total_mass(self) -> float:
-        return float(self.distributions().sum())
+        """sum f over the grid, accumulated in float64 on the shifted storage."""
+        from solver.lattice import RHO0
+
+        return float(self.shifted_distributions().sum(dtype=np.float64)) + RHO0 * self.config.nx * self.config.ny
 
     def close(self) -> None:
         """Release resources (GL objects); the solver is unusable after."""

@@ -349,9 +349,8 @@ class GLSolver(Solver):
         sums = {name: [0.0, 0.0] for name in self._models}
         done = 0
         while done < n:
-            k = min(n - done, self._check_every)
             with_forces = bool(self._models) and self.body is not None
-            self._ensure_atlas(k, with_forces)
+            k = min(n - done, self._check_every, self._ensure_atlas(with_forces))
             t0, start, impulses = self.time, self._cur, []
             others = [side for side in range(3) if side != start]
             read_now = []  # tuning window="read": each window read right after its step is queued
@@ -437,21 +436,24 @@ class GLSolver(Solver):
                        body_force=tuple(float(v) for v in self.config.body_force))
         return prog, tex, fbo, vao
 
-    def _ensure_atlas(self, bands: int, with_window: bool):
+    def _ensure_atlas(self, with_window: bool) -> int:
         """The check atlas: per step one band of tile sums (columns [0, TW)) and, with forces,
-        one band of the body window (columns [TW, TW + w)), 3 RGBA32F attachments."""
+        one band of the body window (columns [TW, TW + w)), 3 RGBA32F attachments. Returns how
+        many bands (steps) fit: CHECK_EVERY, fewer for a body window too tall for the texture."""
         tw, th = self._tile_grid
         ww, wh = (0, 0)
         if with_window:
             x0, y0, x1, y1 = self.body.window
             ww, wh = x1 - x0, y1 - y0
-        need = (tw + ww, max(th, wh) * CHECK_EVERY)
+        limit = int(self.ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
+        bands = max(1, min(CHECK_EVERY, limit // max(th, wh)))
+        need = (tw + ww, max(th, wh) * bands)
         if self._atlas is None or any(a < b for a, b in zip(self._atlas["size"], need)):
             if self._atlas is not None:
                 for obj in self._atlas["objects"]:
                     obj.release()
-            size = (max(need[0], self._atlas["size"][0] if self._atlas else 0),
-                    max(need[1], self._atlas["size"][1] if self._atlas else 0))
+            size = (min(limit, max(need[0], self._atlas["size"][0] if self._atlas else 0)),
+                    min(limit, max(need[1], self._atlas["size"][1] if self._atlas else 0)))
             texs = [self.ctx.texture(size, 4, dtype="f4") for _ in range(3)]
             fbo = self.ctx.framebuffer(color_attachments=texs)
             self._atlas = {"size": size, "fbo": fbo, "objects": [fbo, *texs]}
@@ -472,6 +474,7 @@ class GLSolver(Solver):
                 vbo.orphan(len(rects) * 6 * 8)
                 vbo.write(_triangles(rects).tobytes())
         self._atlas["window"] = (ww, wh)
+        return bands
 
     def _aux_program(self, fragment, defines=None):
         """(vao, vbo) of a pass into the check atlas; the vbo holds one rectangle per band."""
@@ -643,27 +646,14 @@ class GLSolver(Solver):
             data = np.ascontiguousarray(np.moveaxis(padded[4 * k:4 * k + 4], 0, -1))
             self._g[self._cur][k].write(data.tobytes(), viewport=(x0, y0, w, h))
 
-    def distributions(self) -> np.ndarray:
-        return unshifted(self._read_shifted())
+    def shifted_distributions(self) -> np.ndarray:
+        return self._read_shifted()
 
     def set_distributions(self, f: np.ndarray) -> None:
         f = np.asarray(f, dtype=np.float64)
         if f.shape != (Q, self.ny, self.nx):
             raise ValueError(f"distributions must have shape {(Q, self.ny, self.nx)}, got {f.shape}")
         self._write_shifted(shifted(f).astype("f4"))
-
-    def macroscopic(self):
-        """(rho, ux, uy) as Solver.macroscopic, summed on the shifted storage in float64."""
-        g = self._read_shifted()
-        rho = g.sum(axis=0, dtype=np.float64) + RHO0
-        fx, fy = self.config.body_force
-        jx = np.tensordot(C[:, 0].astype(np.float64), g, axes=1) - 0.5 * fx
-        jy = np.tensordot(C[:, 1].astype(np.float64), g, axes=1) - 0.5 * fy
-        return rho, jx / rho, jy / rho
-
-    def total_mass(self) -> float:
-        """sum f over the grid, accumulated in float64 on the shifted storage."""
-        return float(self._read_shifted().sum(dtype=np.float64)) + RHO0 * self.nx * self.ny
 
     @property
     def grid_size(self):

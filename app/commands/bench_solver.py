@@ -263,13 +263,13 @@ def main(args) -> int:
     if getattr(args, "variants", False):
         result = run_variants(quick, seconds)
         print(f"gl tuning variants, moving-cylinder tunnel {result['grid']}, {result['renderer']}")
-        print(f"  {'variant':48s} {'MLUPS (wall) best/median':>26s} {'per CPU-s best/median':>24s}")
+        print(f"  {'variant':62s} {'MLUPS (wall) best/median':>26s} {'per CPU-s best/median':>24s}")
         for name, v in result["variants"].items():
             w, c = v["wall"], v["per_cpu_s"]
-            print(f"  {name:48s} {w['best']:12.1f} {w['median']:9.1f} {c['best']:14.1f} {c['median']:9.1f}")
+            print(f"  {name:62s} {w['best']:12.1f} {w['median']:9.1f} {c['best']:14.1f} {c['median']:9.1f}")
         print("  step variant drawn over the whole grid (MLUPS per CPU-s, best/median):")
         for name, v in result["step_variants_full_grid_mlups_per_cpu_s"].items():
-            print(f"    {name:46s} {v['best']:12.1f} {v['median']:9.1f}")
+            print(f"    {name:60s} {v['best']:12.1f} {v['median']:9.1f}")
         for lp, mlups in result["lp_num_threads_wall_mlups"].items():
             print(f"  LP_NUM_THREADS={lp:2s} (moving tunnel, wall MLUPS) {mlups if mlups is not None else 'failed'}")
     else:
