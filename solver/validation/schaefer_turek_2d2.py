@@ -17,7 +17,7 @@ the force with amplitudes ~0.015 in C_D each. That raised C_D,max at 40 cells fr
 3.337 and made three-period maxima scatter by 0.02 - 0.03 from period to period, while the mean
 C_D and the shedding were unchanged. Ramped in over two acoustic periods, the rms of C_D around
 its period-averaged signal falls from 0.013 to 0.0004 (20 cells) and successive periods agree to
-0.02 %, hence the tighter `PERIODIC_TOL`. Diagnostics: `tools/st2d2_diagnose.py`.
+0.02 %, hence the tighter `PERIODIC_TOL`. Diagnostics: `python -m solver.validation.st2d2_diagnose`.
 """
 from __future__ import annotations
 

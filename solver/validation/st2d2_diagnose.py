@@ -1,8 +1,8 @@
 """Diagnose Schaefer-Turek 2D-2 (README 'Validation'): record C_D(t), C_L(t) and analyse them.
 
-    python tools/st2d2_diagnose.py record --d 20 [--u 0.075] [--ramp-periods 2 | --impulsive]
+    python -m solver.validation.st2d2_diagnose record --d 20 [--u 0.075] [--ramp-periods 2 | --impulsive]
         [--sponge CELLS] [--length-d 22] [--conv-times 60] [--sample 2] --out series.npz
-    python tools/st2d2_diagnose.py analyse series.npz [...]
+    python -m solver.validation.st2d2_diagnose analyse series.npz [...]
 
 `analyse` folds the last three shedding periods (upward zero crossings of C_L) into a
 period-averaged signal and prints: per-period C_D maxima, mean C_D, C_D,max and C_L,max of the
@@ -13,24 +13,20 @@ frequency. Run from the repository root (numpy backend).
 from __future__ import annotations
 
 import argparse
-import sys
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from solver.validation.schaefer_turek import Geometry  # noqa: E402
-from solver.validation.schaefer_turek_2d2 import RE, upward_zero_crossings  # noqa: E402
+from solver.validation.schaefer_turek import Geometry
+from solver.validation.schaefer_turek_2d2 import RE, upward_zero_crossings
 
 
 def record(a) -> None:
-    from app.headless import make_solver
+    from solver.backend import create_solver
 
     geo = Geometry(a.d, RE, u_max=a.u)
     geo.nx = int(round(a.length_d * a.d))
     over = dict(sponge_cells=a.sponge, sponge_strength=10.0) if a.sponge else {}
-    factory = lambda c: make_solver("numpy", c)  # noqa: E731
+    factory = lambda c: create_solver("numpy", c)  # noqa: E731
     if a.impulsive:
         solver = geo.start(factory, **over)
     else:
