@@ -63,6 +63,16 @@ class Solver(ABC):
         """Place the body (a `shapes` shape at its pose, or None) moving at `velocity`,
         rotating at `omega`; covers/uncovers nodes and books their momentum (algorithm.md)."""
 
+    def _body_state(self, shape, velocity, omega, raster=None):
+        """The rasterised, speed-capped body state for `set_body` (None without a body), with a
+        force window wide enough for every enabled model (solver/body.py)."""
+        if shape is None:
+            return None
+        from solver.body import make_body_state, window_margin
+
+        return make_body_state(shape, velocity, omega, self.config,
+                               window_margin(getattr(self, "_models", {}).values()), raster)
+
     # --- stepping -------------------------------------------------------------
     @abstractmethod
     def step(self, n: int = 1) -> None:

@@ -553,9 +553,7 @@ class GLSolver(Solver):
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
         cfg = self.config
         old = self.body
-        new = None
-        if shape is not None:
-            new = make_body_state(shape, velocity, omega, cfg, window_margin(self._models.values()), raster)
+        new = self._body_state(shape, velocity, omega, raster)
         read = {}
 
         def read_window(x0, y0, x1, y1):  # the refill box, read back once

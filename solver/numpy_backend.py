@@ -89,9 +89,7 @@ class NumpySolver(Solver):
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
         cfg = self.config
         old = self.body
-        new = None
-        if shape is not None:
-            new = make_body_state(shape, velocity, omega, cfg, window_margin(self._models.values()), raster)
+        new = self._body_state(shape, velocity, omega, raster)
         jx, jy = move_body(old, new, cfg, self._read_window, self._write_nodes)
         self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         self.body = new
