@@ -128,6 +128,11 @@ def open_device(url: str):
             dev.name = sm.PRODUCTS.get((vid, pid), "SpaceMouse")
     else:
         raise BadDeviceURL(f"unknown device URL scheme in '{url}' (serial://, hid://, sim://, loop://)")
+    return _opened(dev)
+
+
+def _opened(dev):
+    """Open a device; if that fails, close what it had opened (transport, simulator) and re-raise."""
     try:
         dev.open()
     except DeviceError:
@@ -167,9 +172,4 @@ def _open_sim(kind: str, url: str, drivers):
         sim = SpaceMouseSim() if kind == "spacemouse" else DiyHidSim()
         dev = drivers[kind](HidTransport(device=sim, name=url), url)
     dev.simulator = sim
-    try:
-        dev.open()
-    except DeviceError:
-        dev.close()
-        raise
-    return dev
+    return _opened(dev)
