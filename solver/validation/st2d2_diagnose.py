@@ -1,7 +1,8 @@
 """Diagnose Schaefer-Turek 2D-2 (README 'Validation'): record C_D(t), C_L(t) and analyse them.
 
     python -m solver.validation.st2d2_diagnose record --d 20 [--u 0.075] [--ramp-periods 2 | --impulsive]
-        [--sponge CELLS] [--length-d 22] [--conv-times 60] [--sample 2] --out series.npz
+        [--sponge CELLS] [--length-d 22] [--conv-times 60] [--sample 2]
+        [--collision trt|bgk] [--magic 0.1875] --out series.npz
     python -m solver.validation.st2d2_diagnose analyse series.npz [...]
 
 `analyse` folds the last three shedding periods (upward zero crossings of C_L) into a
@@ -26,6 +27,7 @@ def record(a) -> None:
     geo = Geometry(a.d, RE, u_max=a.u)
     geo.nx = int(round(a.length_d * a.d))
     over = dict(sponge_cells=a.sponge, sponge_strength=10.0) if a.sponge else {}
+    over.update(collision=a.collision, trt_magic=a.magic)
     factory = lambda c: create_solver("numpy", c)  # noqa: E731
     if a.impulsive:
         solver = geo.start(factory, **over)
@@ -81,6 +83,8 @@ def main() -> None:
     r.add_argument("--length-d", type=float, default=22.0)
     r.add_argument("--conv-times", type=float, default=60.0)
     r.add_argument("--sample", type=int, default=2)
+    r.add_argument("--collision", choices=("trt", "bgk"), default="trt")
+    r.add_argument("--magic", type=float, default=3.0 / 16.0, help="TRT magic parameter Lambda")
     r.add_argument("--out", required=True)
     an = sub.add_parser("analyse")
     an.add_argument("paths", nargs="+")
