@@ -161,7 +161,7 @@ class ForcePlot(QWidget):
             return math.nan, math.nan
         w = np.asarray(sim.history.wind[-last:], float)
         u = float(np.hypot(w[:, 0], w[:, 1]).mean())
-        if u < 0.005:
+        if u < 0.005 or sim.shape is None:
             return math.nan, math.nan
         area = sim.shape.frontal_area(tuple(drag_direction(w[-1])[0]))
         q = 0.5 * u * u * area

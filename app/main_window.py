@@ -1,6 +1,11 @@
 """The FeelFlow window: the wind-tunnel viewport in the middle, the side panel, the live force
 plot below, presets, status bar, keyboard shortcuts, remembered settings, and the frame loop
 with adaptive stepping (as many solver steps per frame as keep the window at >= 30 fps).
+
+A recorded session replays in the window (File > Replay session): an
+`app.replay_simulation.ReplaySimulation` takes the live simulation's place in the viewport and
+the plot at the same steps-per-frame budget, the live one waits untouched, and Stop replay (Esc)
+brings it back as it was.
 """
 from __future__ import annotations
 
@@ -11,7 +16,7 @@ import time
 import numpy as np
 from PySide6.QtCore import QPoint, QSettings, Qt, QTimer, Signal
 from PySide6.QtGui import QAction, QKeySequence, QPainter, QUndoStack
-from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox
+from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox, QToolBar
 
 from app.qt_runtime import make_none_immortal
 
@@ -53,6 +58,8 @@ class MainWindow(QMainWindow):
         self.tracer_rng = np.random.default_rng(1)
         self.undo = QUndoStack(self)
         self.input_device = None
+        self.replay = None           # the ReplaySimulation while a session replays
+        self._device_seen = None     # the device's target when the replay began
 
         self.viewport = Viewport()
         self.setCentralWidget(self.viewport)
@@ -71,6 +78,9 @@ class MainWindow(QMainWindow):
         self.status = {k: QLabel() for k in ("steps", "mlups", "fps", "re", "ma", "renderer")}
         for label in self.status.values():
             self.statusBar().addPermanentWidget(label)
+        self.replay_label = QLabel()   # "Replaying <name>: step N / M" (hidden by passing messages)
+        self.statusBar().addWidget(self.replay_label, 1)
+        self.replay_label.hide()
         self._build_menus()
 
         self.params = params or self._params_from_settings()
@@ -83,6 +93,7 @@ class MainWindow(QMainWindow):
         self.viewport.contextFailed.connect(self._cannot_start)
         self.startup_error = None
         self.viewport.polygonEdited.connect(self.edit_polygon)
+        self.viewport.inputRefused.connect(lambda: self._refuse_in_replay("the mouse does not move the body"))
         geometry = self.settings.value("geometry")
         if geometry is not None:
             self.restoreGeometry(geometry)
@@ -142,6 +153,9 @@ class MainWindow(QMainWindow):
         self.save_settings()
         self.timer.stop()
         self.slow_timer.stop()
+        if self.replay is not None:
+            self._make_current()
+            self.replay.close()
         if self.input_device is not None:
             self._close_device()
         super().closeEvent(ev)
@@ -212,19 +226,23 @@ class MainWindow(QMainWindow):
         self._action(f, "Save screenshot\u2026", self.screenshot_dialog)
         f.addSeparator()
         self.record_action = self._action(f, "Record session", self.toggle_recording, checkable=True)
+        self.replay_action = self._action(f, "Replay session\u2026", self.replay_session_dialog)
+        self.stop_replay_action = self._action(f, "Stop replay", self.stop_replay)
+        self.stop_replay_action.setToolTip("Stop the replay and return to the live tunnel (Esc)")
+        self.stop_replay_action.setEnabled(False)
         f.addSeparator()
         self._action(f, "Quit", self.close, "Ctrl+Q")
         e = bar.addMenu("&Edit")
-        undo = self.undo.createUndoAction(self, "Undo")
+        self.undo_action = undo = self.undo.createUndoAction(self, "Undo")
         undo.setShortcut(QKeySequence("Ctrl+Z"))
-        redo = self.undo.createRedoAction(self, "Redo")
+        self.redo_action = redo = self.undo.createRedoAction(self, "Redo")
         redo.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])
         e.addAction(undo)
         e.addAction(redo)
         r = bar.addMenu("&Run")
         self.pause_action = self._action(r, "Pause / run", self.toggle_pause, "Space", checkable=True)
         self._action(r, "Reset flow", self.reset_flow, "R")
-        self._action(r, "Stop device force", self.stop_device_force, "Esc")
+        self._action(r, "Stop device force / replay", self.escape, "Esc")
         v = bar.addMenu("&View")
         self._action(v, "Full screen", self.toggle_fullscreen, "F11")
         v.addSeparator()
@@ -233,6 +251,12 @@ class MainWindow(QMainWindow):
         p = bar.addMenu("&Presets")
         for key, preset in PRESETS.items():
             self._action(p, preset.title, lambda _=False, k=key: self.apply_preset(k))
+        self.replay_toolbar = QToolBar("Replay", self)   # shown only while a session replays
+        self.replay_toolbar.setMovable(False)
+        self.replay_toolbar.addAction(self.pause_action)
+        self.replay_toolbar.addAction(self.stop_replay_action)
+        self.addToolBar(Qt.TopToolBarArea, self.replay_toolbar)
+        self.replay_toolbar.hide()
 
     def toggle_pause(self, _=None):
         self.set_paused(not self.paused)
@@ -241,6 +265,9 @@ class MainWindow(QMainWindow):
         if self.sim is None:
             return
         solver = self.sim.solver
+        if self._refuse_in_replay("recording is for the live tunnel"):
+            self.record_action.setChecked(solver.recorder is not None)
+            return
         if solver.recorder is None:
             solver.start_recording(renderer=self.viewport.renderer())
             self.record_action.setChecked(True)
@@ -252,7 +279,154 @@ class MainWindow(QMainWindow):
         if path:
             self._try(lambda: recorder.save(path), "Could not save the session")
 
+    # --- replaying a session -------------------------------------------------------------------
+    @property
+    def shown(self):
+        """What the viewport and the plot show: the replay while one runs, else the live tunnel."""
+        return self.replay if self.replay is not None else self.sim
+
+    def replay_session_dialog(self, _=None):
+        if self.sim is None:
+            return
+        path, _ = QFileDialog.getOpenFileName(self, "Replay session", "", "Sessions (*.ffsession)")
+        if path:
+            self.start_replay(path)
+
+    def start_replay(self, path) -> bool:
+        """Replay the session file at `path` in the window; a bad file is a one-line dialog and
+        changes nothing. The live tunnel waits, untouched, until `stop_replay`."""
+        if self.sim is None:
+            return False
+        if self.sim.solver.recorder is not None:
+            QMessageBox.warning(self, "Could not replay the session",
+                                "A session is being recorded: stop the recording (File > Record session) first.")
+            return False
+        replay = self._try(lambda: self._open_replay(path), "Could not replay the session")
+        if replay is None:
+            return False
+        if self.replay is not None:
+            self.stop_replay()
+        self.set_editing(False)
+        self.viewport._grab = None
+        self.sim.target = None
+        self.replay = replay
+        if self.input_device is not None:   # its force fades out; its moves are refused
+            self.input_device.pause(True)
+            self._device_seen = self.input_device.target()
+        self.undo_action.setEnabled(False)
+        self.redo_action.setEnabled(False)
+        self._show(replay)
+        self.pause_action.setChecked(False)
+        self.stop_replay_action.setEnabled(True)
+        self.replay_toolbar.show()
+        self.replay_label.show()
+        self.timer.setInterval(0)
+        self._show_replay_progress()
+        return True
+
+    def _open_replay(self, path):
+        from app.replay_simulation import ReplaySimulation
+        from app.session import SessionError, load_session
+        from solver.backend import BackendError
+
+        session = load_session(path)
+        self._make_current()
+        try:
+            return ReplaySimulation(session, self.backend, ctx=self.viewport.ctx if self.backend == "gl" else None)
+        except BackendError as exc:
+            raise SessionError(f"{path}: the {self.backend} solver cannot replay it "
+                               f"({str(exc).splitlines()[0]})") from None
+
+    def stop_replay(self, _=None):
+        """Back to the live tunnel exactly as it was when the replay began."""
+        replay, self.replay = self.replay, None
+        if replay is None:
+            return
+        self._make_current()
+        self._show(self.sim)
+        replay.close()
+        self.viewport.banner = None
+        self.replay_label.hide()
+        self.replay_toolbar.hide()
+        self.stop_replay_action.setEnabled(False)
+        self.undo_action.setEnabled(self.undo.canUndo())
+        self.redo_action.setEnabled(self.undo.canRedo())
+        self.pause_action.setChecked(self.paused)
+        self.timer.setInterval(30 if self.paused else 0)
+        if self.input_device is not None:
+            self.input_device.pause(self.paused)
+        self.panel.show_params(self.sim.params, self.display_mode)
+        self._after_rebuild()
+        self.statusBar().showMessage("Replay stopped: back to the live tunnel.", 4000)
+
+    def _show(self, sim):
+        """Point the viewport and the plot at `sim` (live or replay) and draw it."""
+        self.viewport.sim = self.plot.sim = sim
+        self.viewport.locked = sim is self.replay
+        self.viewport.tracers = self.viewport.arrow_forces = None
+        self._last_tick = None
+        self._upload_field()
+        self.plot.refresh(force=True)
+        self.viewport.update()
+
+    def _show_replay_progress(self):
+        r = self.replay
+        if r is None:
+            return
+        where = f"step {r.step} / {r.total_steps}"
+        if r.done:
+            text = f"Replay of {r.name} finished at {where}: Stop replay (Esc) returns to the live tunnel."
+            self.viewport.banner = f"replay finished ({where})"
+        else:
+            text = f"Replaying {r.name}: {where}" + (" (paused: space to run)" if r.paused else "")
+            self.viewport.banner = f"replay: {where}" + (", paused" if r.paused else "")
+        if r.player.diverged_at is not None:
+            text += f"; the flow diverged at step {r.player.diverged_at}"
+        self.replay_label.setText(text)
+
+    def _refuse_in_replay(self, why: str) -> bool:
+        """During a replay: say in the status bar why a request is refused, put the controls back
+        as they were and return True; otherwise False."""
+        r = self.replay
+        if r is None:
+            return False
+        self.statusBar().showMessage(f"Replaying {r.name}: {why}. Stop replay (Esc) to return to the live tunnel.",
+                                     6000)
+        p = self.panel
+        if self.sim is not None:
+            p.show_params(self.sim.params, self.display_mode)
+            for box, on in ((p.hold_still, self.sim.hold_still), (p.edit, self.viewport.editing)):
+                box.blockSignals(True)
+                box.setChecked(on)
+                box.blockSignals(False)
+        box = p.input
+        box.blockSignals(True)
+        box.setCurrentIndex(max(0, box.findData(self.input_device.url if self.input_device is not None else "mouse")))
+        box.blockSignals(False)
+        return True
+
+    def _watch_device(self):
+        """A device moved during a replay: say that it does not move the body now."""
+        dev = self.input_device
+        target = dev.target() if dev is not None else None
+        if target is None:
+            return
+        if self._device_seen is not None and math.dist(target, self._device_seen) > 3.0:
+            self._refuse_in_replay("the device does not move the body")
+        self._device_seen = target
+
+    def escape(self, _=None):
+        """Esc: the device's force to zero at once (haptics safety: the stop key), and the
+        replay, if one runs, stopped."""
+        self.stop_device_force()
+        self.stop_replay()
+
     def set_paused(self, paused: bool):
+        if self.replay is not None:   # Space pauses the replay; the live tunnel keeps its own state
+            self.replay.paused = paused
+            self.pause_action.setChecked(paused or self.replay.done)
+            self._show_replay_progress()
+            return
         if self.sim is not None and paused != self.paused:
             self.sim.solver.pause() if paused else self.sim.solver.resume()
         self.paused = paused
@@ -266,7 +440,7 @@ class MainWindow(QMainWindow):
         self.showNormal() if self.isFullScreen() else self.showFullScreen()
 
     def reset_flow(self):
-        if self.sim is None:
+        if self.sim is None or self._refuse_in_replay("the flow follows the recording"):
             return
         self._make_current()
         self.sim.reset_flow()
@@ -295,7 +469,7 @@ class MainWindow(QMainWindow):
         p.inputChanged.connect(self.set_input)
 
     def _with_sim(self, fn):
-        if self.sim is not None:
+        if self.sim is not None and not self._refuse_in_replay("the scene cannot be changed"):
             self._make_current()
             fn(self.sim)
             self.refresh_readouts()
@@ -306,7 +480,7 @@ class MainWindow(QMainWindow):
         self.panel.show_params(self.sim.params, self.display_mode)
 
     def _apply_shape(self, **changes):
-        if self.sim is None:
+        if self.sim is None or self._refuse_in_replay("the body follows the recording"):
             return False
         self._make_current()
         try:
@@ -319,7 +493,7 @@ class MainWindow(QMainWindow):
         return True
 
     def set_shape_kind(self, kind):
-        if self.sim is None:
+        if self.sim is None or self._refuse_in_replay("the body follows the recording"):
             return
         if kind == "polygon" and self.sim.polygon is None:
             self._install_default_polygon()
@@ -338,7 +512,7 @@ class MainWindow(QMainWindow):
         self.panel.show_params(self.sim.params, self.display_mode)
 
     def _apply_flow(self, **changes):
-        if self.sim is None:
+        if self.sim is None or self._refuse_in_replay("the flow follows the recording"):
             return
         self._make_current()
         try:
@@ -349,7 +523,7 @@ class MainWindow(QMainWindow):
         self._after_rebuild()
 
     def set_grid(self, grid):
-        if self.sim is None:
+        if self.sim is None or self._refuse_in_replay("the grid is the recording's"):
             return
         self._make_current()
         try:
@@ -368,6 +542,8 @@ class MainWindow(QMainWindow):
         self.viewport.update()
 
     def set_hold_still(self, on):
+        if self._refuse_in_replay("the body follows the recording"):
+            return
         if self.sim is not None:
             self.sim.hold_still = bool(on)
         self.panel.hold_still.setChecked(bool(on))
@@ -382,6 +558,8 @@ class MainWindow(QMainWindow):
 
     # --- polygon editor ---------------------------------------------------------------------
     def set_editing(self, on):
+        if on and self._refuse_in_replay("the body follows the recording"):
+            return
         self.viewport.editing = bool(on) and self.sim is not None and self.sim.params.shape == "polygon"
         self.panel.edit.setChecked(self.viewport.editing)
         if self.viewport.editing:
@@ -397,6 +575,8 @@ class MainWindow(QMainWindow):
 
     def edit_polygon(self, verts, text="edit polygon"):
         """Push an undoable polygon edit, or refuse it with a dialog (the previous shape stays)."""
+        if self._refuse_in_replay("the body follows the recording"):
+            return False
         try:
             self.check_polygon(verts)
         except (ShapeError, ValueError) as exc:
@@ -434,6 +614,8 @@ class MainWindow(QMainWindow):
     def load_shape(self, path):
         from shapes import io as shape_io
 
+        if self._refuse_in_replay("the body follows the recording"):
+            return False
         try:
             shape = shape_io.load_shape(path)
         except (OSError, ShapeError, ValueError) as exc:
@@ -485,10 +667,12 @@ class MainWindow(QMainWindow):
                 raise OSError(f"cannot write {path}")
 
     def _try(self, fn, title):
+        """fn()'s result, or None after a one-line dialog when it raised OSError or ValueError."""
         try:
-            fn()
+            return fn()
         except (OSError, ValueError) as exc:   # ValueError: ShapeError, SessionError (one line each)
             QMessageBox.warning(self, title, str(exc))
+            return None
 
     # --- presets ------------------------------------------------------------------------------
     def apply_preset(self, key):
@@ -497,7 +681,7 @@ class MainWindow(QMainWindow):
         from app.scene import load_scene
 
         lesson = PRESETS[key]
-        if self.sim is None:
+        if self.sim is None or self._refuse_in_replay("lessons run in the live tunnel"):
             return False
         try:
             scene = load_scene(lesson.path)
@@ -547,6 +731,8 @@ class MainWindow(QMainWindow):
 
         from app.device_input import DeviceInput
 
+        if self._refuse_in_replay("the input cannot be changed"):
+            return
         self._close_device()
         if url == "mouse" or self.sim is None:
             self.panel.input_note.setText("")
@@ -594,12 +780,13 @@ class MainWindow(QMainWindow):
             self.viewport.makeCurrent()
 
     def _upload_field(self):
-        if self.sim is None:
+        sim = self.shown
+        if sim is None:
             return None
         if self.backend == "gl":
-            self.viewport.use_texture(self.sim.solver.field_texture())
+            self.viewport.use_texture(sim.solver.field_texture())
             return None
-        rgba = self.sim.field_rgba()
+        rgba = sim.field_rgba()
         self.viewport.makeCurrent()
         self.viewport.upload_field(rgba)
         return rgba
@@ -607,6 +794,9 @@ class MainWindow(QMainWindow):
     def tick(self):
         now = time.perf_counter()
         if self.sim is None:
+            return
+        if self.replay is not None:
+            self._tick_replay(now)
             return
         if self.paused:
             self.viewport.update()
@@ -634,6 +824,35 @@ class MainWindow(QMainWindow):
             f = forces.get(self.sim.params.force_model)
             if f is not None:
                 self.input_device.submit(f, self.sim.solver.time)
+        self._frame_done(now, t0, t1, n, forces, rgba)
+
+    def _tick_replay(self, now):
+        """One frame of the replay, at the live tunnel's steps-per-frame budget."""
+        from app.session import SessionError
+
+        r = self.replay
+        self._watch_device()
+        if r.paused or r.done:
+            self.viewport.update()
+            self._last_tick = None
+            return
+        self._make_current()
+        t0 = time.perf_counter()
+        try:
+            forces = r.advance(self.steps_per_frame)
+        except SessionError as exc:   # the file asks for something impossible: one line
+            self.stop_replay()
+            QMessageBox.warning(self, "Could not replay the session", str(exc))
+            return
+        t1 = time.perf_counter()
+        rgba = self._upload_field()
+        self._frame_done(now, t0, t1, max(1, r.last_steps), forces, rgba)
+        self._show_replay_progress()
+        if r.done:
+            self.pause_action.setChecked(True)
+
+    def _frame_done(self, now, t0, t1, n, forces, rgba):
+        """After n steps took t1 - t0 s: tracers, arrows, redraw, and the next frame's budget."""
         if self.display_mode == "tracers":
             self._advance_tracers(rgba, n)
         if self.display_mode == "pressure" and self.viewport.frames % 5 == 0:
@@ -653,14 +872,14 @@ class MainWindow(QMainWindow):
         w[2] += 1
         if now - w[0] >= 1.0:
             dt = now - w[0]
-            nodes = self.sim.config.nx * self.sim.config.ny
+            nodes = self.shown.config.nx * self.shown.config.ny
             self.rates = {"steps_per_s": w[1] / dt, "fps": w[2] / dt, "mlups": w[1] * nodes / dt / 1e6}
             self._rate_window = [now, 0, 0]
 
     def _free_stream_density(self, rgba) -> float:
         """Median density of the fluid: the reference of the pressure coefficient (the lattice's
         mean density drifts by a fraction of a percent, which alone is Cp ~ 1 at U = 0.05)."""
-        sim = self.sim
+        sim = self.shown
         if rgba is None:
             nx, ny = sim.config.nx, sim.config.ny
             rgba = np.frombuffer(sim.solver.field_texture().read(), np.float32).reshape(ny, nx, 4)
@@ -681,11 +900,12 @@ class MainWindow(QMainWindow):
             self.set_paused(False)
 
     def _arrows(self, forces):
-        f = forces.get(self.sim.params.force_model)
-        if f is None:
+        sim = self.shown
+        f = forces.get(sim.params.force_model)
+        if f is None or not all(math.isfinite(v) for v in f):
             self.viewport.arrow_forces = None
             return
-        w = self.sim.relative_wind()
+        w = sim.relative_wind()
         s = math.hypot(*w)
         ax, ay = (w[0] / s, w[1] / s) if s > 1e-9 else (1.0, 0.0)
         drag = f[0] * ax + f[1] * ay
@@ -693,7 +913,7 @@ class MainWindow(QMainWindow):
         self.viewport.arrow_forces = {"drag": (drag * ax, drag * ay), "lift": (-lift * ay, lift * ax)}
 
     def _advance_tracers(self, rgba, n):
-        sim = self.sim
+        sim = self.shown
         nx, ny = sim.config.nx, sim.config.ny
         if rgba is None:
             rgba = np.frombuffer(sim.solver.field_texture().read(), np.float32).reshape(ny, nx, 4)
@@ -707,7 +927,9 @@ class MainWindow(QMainWindow):
         u = rgba[iy, ix, 1:3].astype(float)
         pts = pts + u * n
         bad = (pts[:, 0] < 0) | (pts[:, 0] > nx - 1) | (pts[:, 1] < 0) | (pts[:, 1] > ny - 1) \
-            | sim.shape.contains(pts[:, 0], pts[:, 1]) | ~np.isfinite(pts).all(axis=1)
+            | ~np.isfinite(pts).all(axis=1)
+        if sim.shape is not None:
+            bad |= sim.shape.contains(pts[:, 0], pts[:, 1])
         k = int(bad.sum())
         if k:
             pts[bad] = np.c_[rng.uniform(0, 3, k), rng.uniform(0, ny - 1, k)]
@@ -715,11 +937,11 @@ class MainWindow(QMainWindow):
         self.viewport.tracers = (pts, tail)
 
     def refresh_readouts(self):
-        sim = self.sim
+        sim = self.shown
         if sim is None:
             return
         p = sim.params
-        if abs(self.panel.wind.value() - p.wind) > 5e-4:   # a sweep or a lesson changed it
+        if sim is self.sim and abs(self.panel.wind.value() - p.wind) > 5e-4:   # a sweep or a lesson changed it
             self.panel.show_params(p, self.display_mode)
         self.panel.show_numbers(sim.reynolds(), sim.mach(), sim.config.mach_limit)
         t, drag, lift = sim.history.drag_lift(p.force_model)

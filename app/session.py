@@ -215,6 +215,10 @@ class SessionRecorder:
         self._forces.append((seq, self.step, n, tuple(float(v) for v in body),
                              {k: (float(v[0]), float(v[1])) for k, v in forces.items()}))
 
+    def rows(self, start: int = 0) -> list[tuple]:
+        """Force rows recorded so far, from the `start`-th: (step, n, body, {model: (fx, fy)})."""
+        return [(step, n, body, dict(forces)) for _, step, n, body, forces in self._forces[start:]]
+
     # --- output ---------------------------------------------------------------
     def session(self) -> "Session":
         """The recording so far as a `Session` (what `load_session` would return)."""
@@ -886,89 +890,17 @@ class ReplayResult:
 
 def replay(session: Session, backend: str | None = None, *, factory=None, ctx=None, progress=None) -> ReplayResult:
     """Re-simulate `session` on `backend` (default: the recorded one) by feeding its events
-    through a `SessionSolver` in recorded order; compare the force series."""
-    backend = backend or session.backend
-    if factory is None:
-        kwargs = {"ctx": ctx} if ctx is not None else {}
-        factory = lambda config: create_solver(backend, config, **kwargs)  # noqa: E731
-    start = session.start
-    placed = session.body if start is not None and start["body_placed"] else None
-    if start is None:
-        solver = factory(session.config)
-    else:  # the flow as it was when recording began, then its placement as it was
-        solver = _carry_flow(factory, session.config, session.state, start["time"], placed)
-    rec = SessionRecorder(session.config, session.body, session.force_models, backend=backend,
-                          scene_toml=session.manifest["scene"].get("toml"),
-                          scene_source=session.manifest["scene"].get("source"))
-    driver = SessionSolver(solver, rec, factory=factory)
-    if start is not None:
-        rec.start, rec.state = start, session.state
-        driver.models, driver.inflow_speed = tuple(start["force_models"]), start["inflow_speed"]
-        driver.shape, driver.velocity, driver.omega = placed, tuple(start["velocity"]), start["omega"]
-        driver._reapply(solver)
-    geometry = session.body
-    diverged_at = None
-    events = session.events()
-    try:
-        for k, ev in enumerate(events):
-            kind = ev[0]
-            if kind == "input":
-                (x, y, angle), (vx, vy, omega) = ev[2], ev[3]
-                if geometry is None:
-                    raise SessionError(f"{session.source}: input at step {ev[1]} moves a body the session has not got")
-                driver.set_body(geometry.moved(x=x, y=y, angle=angle), (vx, vy), omega)
-            elif kind == "parameter":
-                name, value = ev[2], ev[3]
-                if name == "body":
-                    if value is None:
-                        driver.set_body(None)
-                        geometry = None
-                    else:
-                        geometry = _shape_from_dict(value, "body", None)
-                elif name == "inflow_speed":
-                    driver.set_inflow_speed(value)
-                elif name == "nu":
-                    driver.set_viscosity(value)
-                elif name == "force_models":
-                    driver.enable_force_models(value)
-                elif name == "reset":
-                    driver.reset()
-                    diverged_at = None
-                elif name == "rebuild":
-                    driver.rebuild(config_from_dict(value["config"]), value["keep_flow"])
-                    diverged_at = None
-                elif name == "pause":
-                    driver.pause()
-                elif name == "resume":
-                    driver.resume()
-            else:
-                try:
-                    driver.step(ev[2])
-                except SolverDiverged:
-                    diverged_at = driver.clock
+    through a `SessionSolver` in recorded order (app/session_player.py, the one code path the
+    window's replay runs too); compare the force series. `progress(events done, events)` is
+    called after each force row."""
+    from app.session_player import SessionPlayer
+
+    with SessionPlayer(session, backend, factory=factory, ctx=ctx) as player:
+        while not player.done:
+            player.advance(1)
             if progress is not None:
-                progress(k + 1, len(events))
-    except SessionError:
-        raise
-    except ValueError as exc:  # ShapeError, ConfigError: the file asks for something impossible
-        raise SessionError(f"{session.source}: event {k} ({ev[0]} at step {ev[1]}) cannot be replayed: "
-                           f"{str(exc).splitlines()[0]}") from None
-    finally:
-        driver.close()
-    replayed = rec.session()
-    values = np.full_like(session.forces["values"], np.nan)
-    for j, m in enumerate(session.models):
-        if m in replayed.models:
-            i = replayed.models.index(m)
-            values[:, 2 * j:2 * j + 2] = replayed.forces["values"][:, 2 * i:2 * i + 2]
-    recorded = session.forces["values"]
-    both_nan = np.isnan(values) & np.isnan(recorded)
-    diff = np.where(both_nan, 0.0, np.abs(values - recorded))
-    diff = np.where(np.isnan(diff), np.inf, diff)
-    max_dev = float(diff.max()) if diff.size else 0.0
-    finite = recorded[np.isfinite(recorded)]
-    max_force = float(np.abs(finite).max()) if finite.size else 0.0
-    return ReplayResult(replayed, values, max_dev, max_force, diverged_at)
+                progress(player.events_done, player.events_total)
+        return player.result()
 
 
 def export_csv(session: Session, path, values=None) -> Path:

@@ -377,9 +377,14 @@ class Simulation:
         return units.mach(self.params.wind)
 
     def field_rgba(self) -> np.ndarray:
-        """(ny, nx, 4) float32: rho, ux, uy, vorticity (numpy path; the gl backend has a texture)."""
-        rho, ux, uy = self.solver.macroscopic()
-        out = np.empty(rho.shape + (4,), np.float32)
-        out[..., 0], out[..., 1], out[..., 2] = rho, ux, uy
-        out[..., 3] = np.gradient(uy, axis=1) - np.gradient(ux, axis=0)
-        return out
+        return field_rgba(self.solver)
+
+
+def field_rgba(solver) -> np.ndarray:
+    """(ny, nx, 4) float32: rho, ux, uy, vorticity of `solver`'s flow (numpy path; the gl
+    backend has a texture)."""
+    rho, ux, uy = solver.macroscopic()
+    out = np.empty(rho.shape + (4,), np.float32)
+    out[..., 0], out[..., 1], out[..., 2] = rho, ux, uy
+    out[..., 3] = np.gradient(uy, axis=1) - np.gradient(ux, axis=0)
+    return out

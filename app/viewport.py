@@ -58,6 +58,7 @@ class Viewport(QOpenGLWidget):
     contextReady = Signal(object)   # the moderngl.Context, once initializeGL ran
     bodyGrabbed = Signal(bool)
     polygonEdited = Signal(object)  # new vertex list (body frame) from the editor handles
+    inputRefused = Signal()         # a press or wheel turn while `locked` (a replay shows)
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -71,6 +72,8 @@ class Viewport(QOpenGLWidget):
         self.frames = 0
         self.field_texture = None
         self.rho_ref = 1.0             # free-stream density for the pressure view (set by the window)
+        self.locked = False            # True while a replay shows: the mouse does not move the body
+        self.banner = None             # a line painted over the field (the replay's progress)
         self._grab = None              # offset from body centre to the pressed point
         self._edit_vertex = None       # index of the vertex being dragged
         self._edit_preview = None
@@ -211,7 +214,7 @@ class Viewport(QOpenGLWidget):
         if self.mode == "tracers" and self.tracers is not None:
             self._paint_tracers(p)
         self._paint_body(p)
-        if self.show_arrows and self.arrow_forces:
+        if self.show_arrows and self.arrow_forces and self.sim.shape is not None:
             self._paint_arrows(p)
         self._paint_colour_bar(p)
         self._paint_notes(p)
@@ -222,6 +225,8 @@ class Viewport(QOpenGLWidget):
 
     def _paint_body(self, p: QPainter):
         sim = self.sim
+        if sim.shape is None:   # a replayed session that removed its body
+            return
         if sim.target is not None and not sim.hold_still:
             a, b = self.to_widget(*sim.pos), self.to_widget(*sim.target)
             p.setPen(QPen(QColor(255, 255, 255, 200), 2, Qt.DashLine))
@@ -345,7 +350,7 @@ class Viewport(QOpenGLWidget):
     def _paint_notes(self, p: QPainter):
         sim = self.sim
         r = self.lattice_rect()
-        notes = []
+        notes = [(self.banner, QColor(255, 230, 120))] if self.banner else []
         if sim.capped:
             notes.append(("speed limit reached (Mach %.2f)" % sim.config.mach_limit, QColor(255, 170, 40)))
         if sim.hold_still:
@@ -398,6 +403,9 @@ class Viewport(QOpenGLWidget):
     def mousePressEvent(self, ev):
         if self.sim is None:
             return
+        if self.locked:
+            self.inputRefused.emit()
+            return
         pos = ev.position()
         x, y = self.to_lattice(pos)
         if self.editing and self.sim.polygon is not None:
@@ -437,6 +445,8 @@ class Viewport(QOpenGLWidget):
 
     def mouseDoubleClickEvent(self, ev):
         """Editor: a double click adds a vertex on the nearest edge."""
+        if self.locked:
+            return
         if not (self.editing and self.sim is not None and self.sim.polygon is not None):
             return
         x, y = self.to_lattice(ev.position())
@@ -453,6 +463,10 @@ class Viewport(QOpenGLWidget):
 
     def wheelEvent(self, ev):
         if self.sim is None:
+            return
+        if self.locked:
+            self.inputRefused.emit()
+            ev.accept()
             return
         steps = ev.angleDelta().y() / 120.0
         self.sim.rotate_by(2.0 * steps)

@@ -1,0 +1,225 @@
+"""Replaying a session a bounded number of solver steps at a time, so that a window can draw
+between two calls (`feelflow session replay` runs the same player to the end in one go).
+
+`SessionPlayer` feeds the events of a `Session` in recorded order (`seq`) through the same
+`SessionSolver` that recorded them (app/session.py), so on the recording backend and machine
+the force series comes out bit for bit (docs/sessions.md, "Replay and playback"). A force row
+is one `step(n)` call: the player never splits it, so one `advance` may run past its budget by
+at most the steps of one row.
+
+Qt-free: used by `app.session.replay`, the window's replay (app/replay_simulation.py) and tests.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from app.session import (ReplayResult, Session, SessionError, SessionRecorder, SessionSolver,
+                         _carry_flow, _shape_from_dict, config_from_dict)
+from solver.backend import SolverDiverged, create_solver
+
+
+class ReplayedRow(NamedTuple):
+    """One replayed `step(n)` call: the session step at its end, the steps it covered, the body
+    (x, y, vx, vy) during it (NaN: no body), {model: (fx, fy)} (mean over the call; NaN where the
+    flow diverged) and the inflow speed in use."""
+
+    step: int
+    n: int
+    body: tuple
+    forces: dict
+    inflow_speed: float
+
+
+class SessionPlayer:
+    """An incremental replay of `session` on `backend` (default: the recorded one).
+
+    `advance(max_steps)` applies events until about `max_steps` solver steps are simulated;
+    `solver` is the flow to draw, `shape` the body as placed now, `rows` the force rows replayed
+    so far. A file that asks for something impossible raises `SessionError` (one line naming the
+    event). Close it (or use it as a context manager) to free the backend."""
+
+    def __init__(self, session: Session, backend: str | None = None, *, factory=None, ctx=None):
+        self.session = session
+        self.backend = backend or session.backend
+        if factory is None:
+            kwargs = {"ctx": ctx} if ctx is not None else {}
+            factory = lambda config: create_solver(self.backend, config, **kwargs)  # noqa: E731
+        start = session.start
+        placed = session.body if start is not None and start["body_placed"] else None
+        try:
+            if start is None:
+                solver = factory(session.config)
+            else:  # the flow as it was when recording began, then its placement as it was
+                solver = _carry_flow(factory, session.config, session.state, start["time"], placed)
+        except ValueError as exc:  # ShapeError, ConfigError: the scene cannot be built here
+            raise SessionError(f"{session.source}: the recorded scene cannot be built: "
+                               f"{str(exc).splitlines()[0]}") from None
+        self.recorder = SessionRecorder(session.config, session.body, session.force_models, backend=self.backend,
+                                        scene_toml=session.manifest["scene"].get("toml"),
+                                        scene_source=session.manifest["scene"].get("source"))
+        self._driver = SessionSolver(solver, self.recorder, factory=factory)
+        if start is not None:
+            d = self._driver
+            self.recorder.start, self.recorder.state = start, session.state
+            d.models, d.inflow_speed = tuple(start["force_models"]), start["inflow_speed"]
+            d.shape, d.velocity, d.omega = placed, tuple(start["velocity"]), start["omega"]
+            d._reapply(solver)
+        self.geometry = session.body   # the geometry the next input places
+        self.diverged_at: int | None = None
+        self.rows: list[ReplayedRow] = []
+        self._events = session.events()
+        # steps of the first force row at or after each event (0 after the last row)
+        self._row_ahead = [0] * (len(self._events) + 1)
+        for k in range(len(self._events) - 1, -1, -1):
+            ev = self._events[k]
+            self._row_ahead[k] = ev[2] if ev[0] == "forces" else self._row_ahead[k + 1]
+        self._next = 0
+        self._closed = False
+
+    # --- where the replay is --------------------------------------------------------------
+    @property
+    def solver(self) -> SessionSolver:
+        """The flow being replayed (draw `solver.field_texture()` or `solver.macroscopic()`)."""
+        return self._driver
+
+    @property
+    def step(self) -> int:
+        """Session steps replayed so far."""
+        return self._driver.clock
+
+    @property
+    def total_steps(self) -> int:
+        return self.session.steps
+
+    @property
+    def events_done(self) -> int:
+        return self._next
+
+    @property
+    def events_total(self) -> int:
+        return len(self._events)
+
+    @property
+    def done(self) -> bool:
+        return self._next >= len(self._events)
+
+    @property
+    def shape(self):
+        """The body as last placed (its pose during the last replayed row), or None."""
+        return self._driver.shape
+
+    @property
+    def velocity(self):
+        return self._driver.velocity
+
+    @property
+    def inflow_speed(self) -> float:
+        d = self._driver
+        return float(d.inflow_speed if d.inflow_speed is not None else d.solver.config.inflow_speed)
+
+    @property
+    def models(self) -> tuple[str, ...]:
+        """The force models enabled now."""
+        return self._driver.models
+
+    # --- running ---------------------------------------------------------------------------
+    def advance(self, max_steps: int) -> int:
+        """Apply events until `max_steps` solver steps are simulated (at least one force row
+        unless done; a row is never split) and return the steps simulated. It stops right after
+        a row, before the inputs that lead to the next one, so `shape` is the pose the flow last
+        felt."""
+        steps = 0
+        events = self._events
+        while self._next < len(events):
+            ev = events[self._next]
+            if steps and steps + self._row_ahead[self._next] > max_steps:
+                break
+            self._apply(self._next, ev)
+            self._next += 1
+            if ev[0] == "forces":
+                steps += ev[2]
+                if steps >= max_steps:
+                    break
+        return steps
+
+    def _apply(self, k: int, ev) -> None:
+        driver, kind = self._driver, ev[0]
+        try:
+            if kind == "input":
+                (x, y, angle), (vx, vy, omega) = ev[2], ev[3]
+                if self.geometry is None:
+                    raise SessionError(f"{self.session.source}: input at step {ev[1]} moves a body "
+                                       "the session has not got")
+                driver.set_body(self.geometry.moved(x=x, y=y, angle=angle), (vx, vy), omega)
+            elif kind == "parameter":
+                self._parameter(ev[2], ev[3])
+            else:
+                try:
+                    driver.step(ev[2])
+                except SolverDiverged:
+                    self.diverged_at = driver.clock
+                step, n, body, forces = self.recorder.rows(len(self.rows))[0]
+                self.rows.append(ReplayedRow(step, n, body, forces, self.inflow_speed))
+        except SessionError:
+            raise
+        except ValueError as exc:  # ShapeError, ConfigError: the file asks for something impossible
+            raise SessionError(f"{self.session.source}: event {k} ({ev[0]} at step {ev[1]}) cannot be replayed: "
+                               f"{str(exc).splitlines()[0]}") from None
+
+    def _parameter(self, name, value) -> None:
+        driver = self._driver
+        if name == "body":
+            if value is None:
+                driver.set_body(None)
+                self.geometry = None
+            else:
+                self.geometry = _shape_from_dict(value, "body", None)
+        elif name == "inflow_speed":
+            driver.set_inflow_speed(value)
+        elif name == "nu":
+            driver.set_viscosity(value)
+        elif name == "force_models":
+            driver.enable_force_models(value)
+        elif name == "reset":
+            driver.reset()
+            self.diverged_at = None
+        elif name == "rebuild":
+            driver.rebuild(config_from_dict(value["config"]), value["keep_flow"])
+            self.diverged_at = None
+        elif name == "pause":
+            driver.pause()
+        elif name == "resume":
+            driver.resume()
+
+    # --- the outcome -----------------------------------------------------------------------
+    def result(self) -> ReplayResult:
+        """The replayed series next to the recorded one (meaningful once `done`)."""
+        session = self.session
+        replayed = self.recorder.session()
+        values = np.full_like(session.forces["values"], np.nan)
+        for j, m in enumerate(session.models):
+            if m in replayed.models:
+                i = replayed.models.index(m)
+                values[:len(replayed.forces["values"]), 2 * j:2 * j + 2] = replayed.forces["values"][:, 2 * i:2 * i + 2]
+        recorded = session.forces["values"]
+        both_nan = np.isnan(values) & np.isnan(recorded)
+        diff = np.where(both_nan, 0.0, np.abs(values - recorded))
+        diff = np.where(np.isnan(diff), np.inf, diff)
+        max_dev = float(diff.max()) if diff.size else 0.0
+        finite = recorded[np.isfinite(recorded)]
+        max_force = float(np.abs(finite).max()) if finite.size else 0.0
+        return ReplayResult(replayed, values, max_dev, max_force, self.diverged_at)
+
+    def close(self) -> None:
+        """Free the backend (idempotent)."""
+        if not self._closed:
+            self._closed = True
+            self._driver.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

@@ -1,0 +1,205 @@
+"""Replaying a recorded session in the real window (Xvfb, numpy solver, small grid): the
+viewport and the plot show the replayed flow, body and forces, input is refused while it runs,
+and Stop replay (Esc) returns to the live tunnel as it was."""
+from __future__ import annotations
+
+import dataclasses
+import os
+
+import numpy as np
+import pytest
+
+pytestmark = [pytest.mark.gui,
+              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+
+if os.environ.get("DISPLAY"):
+    from test_gui_window import window  # noqa: F401  (the window fixture: set up for Qt there)
+
+
+def record_in_window(window, qtbot, path, monkeypatch):
+    """File > Record session: drag the body, change the wind, stop and save to `path`."""
+    from PySide6.QtWidgets import QFileDialog
+
+    from app.selftest import send_mouse
+
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(path), ""))
+    vp, sim = window.viewport, window.sim
+    window.record_action.trigger()
+    t0 = sim.solver.time
+    send_mouse(vp, "press", vp.to_widget(*sim.pos))
+    send_mouse(vp, "move", vp.to_widget(sim.pos[0] + 15, sim.pos[1] + 4))
+    qtbot.waitUntil(lambda: sim.solver.time > t0 + 80, timeout=20000)
+    send_mouse(vp, "release", vp.to_widget(*sim.pos))
+    window.panel.wind.setValue(0.06)
+    t1 = sim.solver.time
+    qtbot.waitUntil(lambda: sim.solver.time > t1 + 40, timeout=20000)
+    window.record_action.trigger()
+    assert path.exists()
+
+
+def replayed_values(history, models):
+    return np.column_stack([np.asarray(history.forces[m], float) for m in models])
+
+
+def test_replay_in_the_window_and_stop_returns_to_the_live_tunnel(window, qtbot, tmp_path, monkeypatch):
+    from PySide6.QtCore import Qt
+    from PySide6.QtTest import QTest
+    from PySide6.QtWidgets import QFileDialog
+
+    from app.selftest import send_mouse
+    from app.session import load_session
+
+    path = tmp_path / "lesson.ffsession"
+    record_in_window(window, qtbot, path, monkeypatch)
+    session = load_session(path)
+    assert np.ptp(session.inputs["pose"][:, 0]) > 1.0   # the body really moved while recording
+
+    live = window.sim
+    window.panel.size.setValue(14)                       # the live scene moves on after recording
+    before = (dataclasses.replace(live.params), live.shape, live.shape.to_dict(), live.config, live.pos)
+    history_before = list(live.history.time)
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", lambda *a, **k: (str(path), ""))
+    window.replay_action.trigger()
+    replay = window.replay
+    assert replay is not None and window.viewport.sim is replay and window.plot.sim is replay
+    assert window.viewport.locked and window.replay_toolbar.isVisible()
+
+    # while it runs: progress in the status bar, the body at the recorded pose of the last row
+    seen = []
+
+    def poses_follow_the_recording():
+        rows = replay.player.rows
+        if rows and replay.shape is not None:
+            k = len(rows) - 1
+            seen.append(((replay.shape.x, replay.shape.y), tuple(session.forces["body"][k][:2])))
+        return len(seen) >= 3
+    qtbot.waitUntil(poses_follow_the_recording, timeout=20000)
+    assert all(a == b for a, b in seen), seen[:3]
+    assert window.replay_label.text().startswith(f"Replaying lesson.ffsession: step ")
+    assert f"/ {session.steps}" in window.replay_label.text()
+    t_live = live.solver.time
+
+    # input is refused: the mouse, the panel, the reset key
+    vp = window.viewport
+    send_mouse(vp, "press", vp.to_widget(*replay.pos))
+    send_mouse(vp, "move", vp.to_widget(replay.pos[0] + 10, replay.pos[1]))
+    send_mouse(vp, "release", vp.to_widget(replay.pos[0] + 10, replay.pos[1]))
+    assert "the mouse does not move the body" in window.statusBar().currentMessage()
+    assert live.target is None
+    window.panel.wind.setValue(0.03)
+    assert "Replaying lesson.ffsession" in window.statusBar().currentMessage()
+    assert window.panel.wind.value() == pytest.approx(before[0].wind) and live.params.wind == before[0].wind
+    window.panel.shape.setCurrentIndex(window.panel.shape.findData("plate"))
+    assert live.shape is before[1] and window.panel.shape.currentData() == before[0].shape
+    window.reset_flow()
+    assert live.solver.time == t_live                     # the live flow waits, untouched
+
+    # the end: paused on the last frame, with a message; the plot holds the replayed forces
+    qtbot.waitUntil(lambda: replay.done, timeout=30000)
+    assert replay.step == session.steps
+    assert "finished" in window.replay_label.text() and window.pause_action.isChecked()
+    assert (replay.shape.x, replay.shape.y) == tuple(session.forces["body"][-1][:2])
+    h = replay.history
+    assert h.time == [int(t) for t in session.forces["step"]]
+    values = replayed_values(h, session.models)
+    assert np.nanmax(np.abs(values)) > 0
+    np.testing.assert_array_equal(values, session.forces["values"])   # numpy: bit for bit
+    curve = window.plot.curves[(session.models[0], "drag")]
+    window.refresh_readouts()
+    x, y = curve.getData()
+    np.testing.assert_array_equal(x, h.time)                        # the plot shows the replay
+    assert np.isfinite(y).all()
+    frames = window.viewport.frames
+    qtbot.waitUntil(lambda: window.viewport.frames > frames, timeout=5000)
+
+    # Esc: back to the live tunnel, parameters, shape, grid and history as they were
+    window.activateWindow()
+    vp.setFocus()
+    qtbot.waitUntil(vp.hasFocus, timeout=5000)
+    QTest.keyClick(vp, Qt.Key_Escape)
+    assert window.replay is None and window.viewport.sim is live and window.plot.sim is live
+    assert not window.viewport.locked and not window.replay_toolbar.isVisible()
+    p, shape, shape_dict, config, pos = before
+    assert live.params == p and live.shape is shape and live.shape.to_dict() == shape_dict
+    assert live.config == config and live.pos == pos
+    assert live.history.time[:len(history_before)] == history_before
+    assert window.panel.size.value() == 14 and window.panel.wind.value() == pytest.approx(p.wind)
+    assert live.solver.time == t_live
+    qtbot.waitUntil(lambda: live.solver.time > t_live + 10, timeout=20000)   # and it runs on
+    assert window.viewport.field_texture is not None
+
+
+def test_a_bad_session_file_is_one_line_and_changes_nothing(window, tmp_path, monkeypatch):
+    from PySide6.QtWidgets import QMessageBox
+
+    warnings = []
+    monkeypatch.setattr(QMessageBox, "warning", lambda *a, **k: warnings.append((a[1], a[2])))
+    bad = tmp_path / "broken.ffsession"
+    bad.write_bytes(b"this is not a zip archive")
+    live = window.sim
+    assert not window.start_replay(str(bad))
+    assert len(warnings) == 1
+    title, text = warnings[0]
+    assert title == "Could not replay the session" and "not a FeelFlow session file" in text and "\n" not in text
+    assert window.replay is None and window.viewport.sim is live and not window.viewport.locked
+    assert not window.replay_label.isVisible()
+
+
+@pytest.mark.gl
+def test_gl_window_replays_in_its_own_context(qtbot, tmp_path, monkeypatch):
+    """The gl backend: the replay runs in the viewport's own GL context and the viewport draws
+    the replay's field texture, then the live one again."""
+    from PySide6.QtCore import QSettings
+
+    from app.main_window import MainWindow
+    from app.session import load_session
+    from app.simulation import Params
+    from test_gui_window import GRID
+
+    w = MainWindow(backend="gl", settings=QSettings(str(tmp_path / "s.ini"), QSettings.IniFormat),
+                   params=Params(grid=GRID, size=12))
+    qtbot.addWidget(w)
+    w.resize(1100, 700)
+    w.show()
+    qtbot.waitUntil(lambda: w.sim is not None and w.sim.solver.time > 20, timeout=30000)
+    path = tmp_path / "gl.ffsession"
+    record_in_window(w, qtbot, path, monkeypatch)
+    session = load_session(path)
+    live_texture = w.sim.solver.field_texture()
+    assert w.start_replay(str(path))
+    replay = w.replay
+    assert replay.solver.name == "gl" and replay.solver.ctx is w.viewport.ctx
+    qtbot.waitUntil(lambda: replay.done, timeout=30000)
+    assert w.viewport.field_texture is replay.solver.field_texture()
+    values = replayed_values(replay.history, session.models)
+    np.testing.assert_array_equal(values, session.forces["values"])   # same backend, same machine
+    w.stop_replay()
+    assert w.viewport.field_texture is live_texture
+    t = w.sim.solver.time
+    qtbot.waitUntil(lambda: w.sim.solver.time > t + 10, timeout=20000)
+    w.timer.stop()
+    w.slow_timer.stop()
+
+
+def test_a_haptic_device_is_paused_and_refused_during_a_replay(window, qtbot, tmp_path, monkeypatch):
+    """With the simulated DIY board as input: the replay fades its force out (loop 'paused'),
+    a device move is refused in the status bar and leaves the replayed body alone; Stop hands
+    the body back to the device."""
+    path = tmp_path / "dev.ffsession"
+    record_in_window(window, qtbot, path, monkeypatch)
+    panel = window.panel
+    panel.input.setCurrentIndex(panel.input.findData("sim://diyhid"))
+    dev = window.input_device
+    qtbot.waitUntil(lambda: dev.target() is not None and dev.loop.status().samples > 5, timeout=20000)
+    assert window.start_replay(str(path))
+    qtbot.waitUntil(lambda: dev.loop.status().state == "paused", timeout=5000)
+    x, y = dev.target()
+    monkeypatch.setattr(dev, "target", lambda: (x + 10.0, y))   # the student pushes the handle
+    qtbot.waitUntil(lambda: "the device does not move the body" in window.statusBar().currentMessage(),
+                    timeout=5000)
+    replay = window.replay
+    qtbot.waitUntil(lambda: replay.done, timeout=30000)
+    assert window.sim.target is None or window.sim.target != (x + 10.0, y)
+    window.stop_replay()
+    qtbot.waitUntil(lambda: dev.loop.status().state != "paused", timeout=5000)
+    qtbot.waitUntil(lambda: window.sim.target == (x + 10.0, y), timeout=5000)   # live again
