@@ -17,6 +17,12 @@
 //     0: texelFetch() (docs/performance.md compares them).
 //   DIVERGENCE_DISCARD 1: a node with a non-finite density discards its fragment (an
 //     occlusion-query divergence check; measured slower than the tile check, not the default).
+//   PAIRED 1: a layout probe, not used by the solver (solver/gl_layout_probe.py,
+//     docs/performance.md): two nodes per fragment, a = (2k, y) and b = (2k+1, y), in five
+//     RGBA32F textures of width nx/2, fully periodic fast path only:
+//     G0 (g1a g1b g3a g3b), G1 (g5a g5b g6a g6b), G2 (g7a g7b g8a g8b), G3 (g2a g2b g4a g4b),
+//     G4 (g0a g0b - -). Directions sharing a row offset share texels: 12 fetches per 2 nodes
+//     instead of 18, 5 writes instead of 6.
 // @LATTICE
 
 uniform sampler2D G0;
@@ -47,6 +53,12 @@ uniform float inflow_ramp;     // ramp(t): u_in(iy, t) = ramp(t) profile(iy)
 layout(location = 0) out vec4 out0;
 layout(location = 1) out vec4 out1;
 layout(location = 2) out vec4 out2;
+#if PAIRED
+uniform sampler2D G3;
+uniform sampler2D G4;
+layout(location = 3) out vec4 out3;
+layout(location = 4) out vec4 out4;
+#endif
 
 float pop(int j, ivec2 p) {  // stored g_j at node p (inside the grid)
     if (j < 4) return texelFetch(G0, p, 0)[j];
@@ -105,7 +117,7 @@ void store(float g[9]) {
 // pair by pair (i, OPP[i]), with the operations in the order of the numpy reference
 // (solver/numpy_backend.py, _collide) so that float32 rounding agrees:
 //   feq+ - w RHO0 = w (drho + rho (cu^2/2 - usq)), feq- = w rho cu, cu = 3 c.u, usq = 3/2 u.u.
-void collide_and_store(float f[9], ivec2 x) {
+void collide(inout float f[9], ivec2 x) {
     float drho = f[0];
     for (int i = 1; i < Q; ++i) drho += f[i];
 #if DIVERGENCE_DISCARD
@@ -174,7 +186,6 @@ void collide_and_store(float f[9], ivec2 x) {
         f[i] = fi;
         f[ib] = fb;
     }
-    store(f);
 }
 
 #if BODY
@@ -203,6 +214,38 @@ int reflect_y(int i) {  // j with C[j] = (C[i].x, -C[i].y)
 }
 #endif
 
+#if PAIRED
+void main() {  // the layout probe (see the header): pull both nodes, collide each, store
+    ivec2 x = ivec2(gl_FragCoord.xy);
+    vec2 p = gl_FragCoord.xy * inv_n;
+    float a[9];
+    float b[9];
+    vec4 z = texture(G4, p);
+    a[0] = z.x; b[0] = z.y;
+    vec4 l = textureOffset(G0, p, ivec2(-1, 0));  // row y: g1 (+1, 0), g3 (-1, 0)
+    vec4 m = texture(G0, p);
+    vec4 r = textureOffset(G0, p, ivec2(1, 0));
+    a[1] = l.y; b[1] = m.x; a[3] = m.w; b[3] = r.z;
+    l = textureOffset(G1, p, ivec2(-1, -1));      // row y - 1: g5 (+1, +1), g6 (-1, +1)
+    m = textureOffset(G1, p, ivec2(0, -1));
+    r = textureOffset(G1, p, ivec2(1, -1));
+    a[5] = l.y; b[5] = m.x; a[6] = m.w; b[6] = r.z;
+    l = textureOffset(G2, p, ivec2(-1, 1));       // row y + 1: g7 (-1, -1), g8 (+1, -1)
+    m = textureOffset(G2, p, ivec2(0, 1));
+    r = textureOffset(G2, p, ivec2(1, 1));
+    a[7] = m.y; b[7] = r.x; a[8] = l.w; b[8] = m.z;
+    vec4 s = textureOffset(G3, p, ivec2(0, -1));  // g2 (0, +1) from row y - 1
+    vec4 n = textureOffset(G3, p, ivec2(0, 1));   // g4 (0, -1) from row y + 1
+    a[2] = s.x; b[2] = s.y; a[4] = n.z; b[4] = n.w;
+    collide(a, ivec2(2 * x.x, x.y));
+    collide(b, ivec2(2 * x.x + 1, x.y));
+    out0 = vec4(a[1], b[1], a[3], b[3]);
+    out1 = vec4(a[5], b[5], a[6], b[6]);
+    out2 = vec4(a[7], b[7], a[8], b[8]);
+    out3 = vec4(a[2], b[2], a[4], b[4]);
+    out4 = vec4(a[0], b[0], 0.0, 0.0);
+}
+#else
 void main() {
     ivec2 x = ivec2(gl_FragCoord.xy);
     float gin[9];
@@ -283,5 +326,7 @@ void main() {
 #endif
     }
 #endif
-    collide_and_store(gin, x);
+    collide(gin, x);
+    store(gin);
 }
+#endif

@@ -10,7 +10,8 @@ written per second) and reports each MLUPS as a fraction of the D2Q9 bound, 72 b
 and step (9 float32 read + 9 written). GPU work is timed up to `glFinish`.
 
 `--variants` instead compares the gl backend's tuning choices on the moving-cylinder tunnel,
-interleaved in the same run, and the llvmpipe thread count in subprocesses
+interleaved in the same run, with the periodic box and a two-nodes-per-fragment layout probe
+(solver/gl_layout_probe.py), and llvmpipe's thread count and SIMD width in subprocesses
 (docs/performance.md). Figures from a shared machine are indicative.
 """
 from __future__ import annotations
@@ -204,9 +205,10 @@ def _stats(values):
 def run_variants(quick: bool, seconds: float | None):
     """Interleaved rounds of every tuning variant on the moving-cylinder tunnel (MLUPS per wall
     and per CPU second), the cost per node of each step variant, the force readback's cost,
-    and the llvmpipe thread count (subprocesses)."""
+    and llvmpipe's thread count and vector width (subprocesses)."""
     from shapes import Cylinder
     from solver.gl_backend import GLSolver
+    from solver.gl_layout_probe import PairedLayoutProbe
 
     seconds = seconds if seconds is not None else (0.3 if quick else 1.0)
     rounds = 2 if quick else 5
@@ -221,6 +223,8 @@ def run_variants(quick: bool, seconds: float | None):
     no_force.solver.enable_force_models([])
     runs["default, no force model (no window readback)"] = no_force
     runs["empty periodic box (default)"] = SceneRun("box", GLSolver(scene_config("box", nx, ny), ctx=ctx))
+    runs["empty periodic box, layout probe: two nodes per fragment"] = SceneRun(
+        "box", PairedLayoutProbe(scene_config("box", nx, ny), ctx))
     wall = {name: [] for name in runs}
     per_cpu = {name: [] for name in runs}
     for run in runs.values():
@@ -244,17 +248,31 @@ def run_variants(quick: bool, seconds: float | None):
     result = {"grid": f"{nx}x{ny}", "renderer": ctx.info.get("GL_RENDERER"), "machine": machine(),
               "variants": {n: {"wall": _stats(wall[n]), "per_cpu_s": _stats(per_cpu[n])} for n in runs},
               "step_variants_full_grid_mlups_per_cpu_s": {n: _stats(v) for n, v in cost.items()}}
-    threads = {}
-    for lp in ("1", "2", "4"):
-        env = {**os.environ, "LP_NUM_THREADS": lp}
-        code = ("import json; from app.commands.bench_solver import _gl_context, SceneRun, scene_config, measure; "
-                "from solver.gl_backend import GLSolver; ctx, _ = _gl_context(); "
-                f"r = SceneRun('tunnel', GLSolver(scene_config('tunnel', {nx}, {ny}), ctx=ctx)); "
-                f"print(json.dumps(measure(r, {seconds * rounds})))")
-        out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
-        threads[lp] = json.loads(out.stdout.strip().splitlines()[-1])["mlups"] if out.returncode == 0 else None
-    result["lp_num_threads_wall_mlups"] = threads
+    result["llvmpipe_knobs"] = {
+        f"{var}={value}": _subprocess_tunnel(nx, ny, seconds * rounds, {var: value})
+        for var, values in LLVMPIPE_KNOBS.items() for value in values}
     return result
+
+
+#: llvmpipe environment variables measured by `--variants` in subprocesses (llvmpipe reads them
+#: once, when it loads): rasteriser threads, and the SIMD width of its generated code
+#: ("256 bits" in the renderer string; AVX-512 machines accept 512)
+LLVMPIPE_KNOBS = {"LP_NUM_THREADS": ("1", "2", "4"), "LP_NATIVE_VECTOR_WIDTH": ("128", "256", "512")}
+
+
+def _subprocess_tunnel(nx: int, ny: int, seconds: float, env_extra: dict):
+    """The default moving-cylinder tunnel in a fresh process with `env_extra` set: wall MLUPS,
+    MLUPS per CPU-s and the renderer string, or None where the process failed."""
+    code = ("import json; from app.commands.bench_solver import _gl_context, SceneRun, scene_config, measure; "
+            "from solver.gl_backend import GLSolver; ctx, _ = _gl_context(); "
+            f"r = SceneRun('tunnel', GLSolver(scene_config('tunnel', {nx}, {ny}), ctx=ctx)); "
+            f"m = measure(r, {seconds}); m['renderer'] = ctx.info.get('GL_RENDERER'); print(json.dumps(m))")
+    out = subprocess.run([sys.executable, "-c", code], env={**os.environ, **env_extra},
+                         capture_output=True, text=True)
+    if out.returncode != 0:
+        return None
+    m = json.loads(out.stdout.strip().splitlines()[-1])
+    return {"mlups": m["mlups"], "mlups_per_cpu_s": m["mlups_per_cpu_s"], "renderer": m["renderer"]}
 
 
 def main(args) -> int:
@@ -270,8 +288,10 @@ def main(args) -> int:
         print("  step variant drawn over the whole grid (MLUPS per CPU-s, best/median):")
         for name, v in result["step_variants_full_grid_mlups_per_cpu_s"].items():
             print(f"    {name:60s} {v['best']:12.1f} {v['median']:9.1f}")
-        for lp, mlups in result["lp_num_threads_wall_mlups"].items():
-            print(f"  LP_NUM_THREADS={lp:2s} (moving tunnel, wall MLUPS) {mlups if mlups is not None else 'failed'}")
+        print("  llvmpipe settings, default moving tunnel in a fresh process (MLUPS wall, per CPU-s, renderer):")
+        for knob, m in result["llvmpipe_knobs"].items():
+            print(f"    {knob:28s} " + (f"{m['mlups']:8.1f} {m['mlups_per_cpu_s']:8.1f}  {m['renderer']}"
+                                         if m is not None else "failed"))
     else:
         m = machine()
         print(f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}, Python {m['python']}, "
