@@ -325,17 +325,13 @@ class MainWindow(QMainWindow):
         return True
 
     def _open_replay(self, path):
+        """A ReplaySimulation of the file on the window's backend; SessionError (one line)."""
         from app.replay_simulation import ReplaySimulation
-        from app.session import SessionError, load_session
-        from solver.backend import BackendError
+        from app.session import load_session
 
         session = load_session(path)
         self._make_current()
-        try:
-            return ReplaySimulation(session, self.backend, ctx=self.viewport.ctx if self.backend == "gl" else None)
-        except BackendError as exc:
-            raise SessionError(f"{path}: the {self.backend} solver cannot replay it "
-                               f"({str(exc).splitlines()[0]})") from None
+        return ReplaySimulation(session, self.backend, ctx=self.viewport.ctx if self.backend == "gl" else None)
 
     def stop_replay(self, _=None):
         """Back to the live tunnel exactly as it was when the replay began."""

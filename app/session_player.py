@@ -17,7 +17,7 @@ import numpy as np
 
 from app.session import (ReplayResult, Session, SessionError, SessionRecorder, SessionSolver,
                          _carry_flow, _shape_from_dict, config_from_dict)
-from solver.backend import SolverDiverged, create_solver
+from solver.backend import BackendError, SolverDiverged, create_solver
 
 
 class ReplayedRow(NamedTuple):
@@ -53,7 +53,7 @@ class SessionPlayer:
                 solver = factory(session.config)
             else:  # the flow as it was when recording began, then its placement as it was
                 solver = _carry_flow(factory, session.config, session.state, start["time"], placed)
-        except ValueError as exc:  # ShapeError, ConfigError: the scene cannot be built here
+        except (ValueError, BackendError) as exc:  # ShapeError, ConfigError, or not on this backend
             raise SessionError(f"{session.source}: the recorded scene cannot be built: "
                                f"{str(exc).splitlines()[0]}") from None
         self.recorder = SessionRecorder(session.config, session.body, session.force_models, backend=self.backend,
@@ -164,7 +164,7 @@ class SessionPlayer:
                 self.rows.append(ReplayedRow(step, n, body, forces, self.inflow_speed))
         except SessionError:
             raise
-        except ValueError as exc:  # ShapeError, ConfigError: the file asks for something impossible
+        except (ValueError, BackendError) as exc:  # the file asks for something impossible (here)
             raise SessionError(f"{self.session.source}: event {k} ({ev[0]} at step {ev[1]}) cannot be replayed: "
                                f"{str(exc).splitlines()[0]}") from None
 

@@ -13,7 +13,7 @@ pytestmark = [pytest.mark.gui,
               pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
 
 if os.environ.get("DISPLAY"):
-    from test_gui_window import window  # noqa: F401  (the window fixture: set up for Qt there)
+    from test_gui_window import window  # noqa: F401,F811  (the window fixture; Qt is set up there)
 
 
 def record_in_window(window, qtbot, path, monkeypatch):
@@ -75,7 +75,7 @@ def test_replay_in_the_window_and_stop_returns_to_the_live_tunnel(window, qtbot,
         return len(seen) >= 3
     qtbot.waitUntil(poses_follow_the_recording, timeout=20000)
     assert all(a == b for a, b in seen), seen[:3]
-    assert window.replay_label.text().startswith(f"Replaying lesson.ffsession: step ")
+    assert window.replay_label.text().startswith("Replaying lesson.ffsession: step ")
     assert f"/ {session.steps}" in window.replay_label.text()
     t_live = live.solver.time
 
@@ -203,3 +203,26 @@ def test_a_haptic_device_is_paused_and_refused_during_a_replay(window, qtbot, tm
     window.stop_replay()
     qtbot.waitUntil(lambda: dev.loop.status().state != "paused", timeout=5000)
     qtbot.waitUntil(lambda: window.sim.target == (x + 10.0, y), timeout=5000)   # live again
+
+
+def test_an_impossible_event_mid_replay_is_one_line_and_back_to_live(window, qtbot, tmp_path, monkeypatch):
+    """A file that loads but asks for the impossible later (the body across the inlet): the
+    replay stops with a one-line dialog and the live tunnel is back."""
+    from PySide6.QtWidgets import QMessageBox
+
+    from app.session import load_session, save_session
+
+    path = tmp_path / "lesson.ffsession"
+    record_in_window(window, qtbot, path, monkeypatch)
+    s = load_session(path)
+    k = len(s.inputs["step"]) // 2
+    s.inputs["pose"][k, 0] = 1.0          # on the grid, so it loads; across the inlet, so it cannot run
+    save_session(s, tmp_path / "edge.ffsession")
+    warnings = []
+    monkeypatch.setattr(QMessageBox, "warning", lambda *a, **k: warnings.append(a[2]))
+    assert window.start_replay(str(tmp_path / "edge.ffsession"))
+    qtbot.waitUntil(lambda: window.replay is None, timeout=30000)
+    assert len(warnings) == 1 and "cannot be replayed" in warnings[0] and "\n" not in warnings[0]
+    assert window.viewport.sim is window.sim and not window.viewport.locked
+    t = window.sim.solver.time
+    qtbot.waitUntil(lambda: window.sim.solver.time > t + 10, timeout=20000)
