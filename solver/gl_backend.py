@@ -30,10 +30,15 @@ API for the app (a QOpenGLWidget sharing this context):
   `field_texture()` the bound framebuffer is the solver's, so a paintGL must re-bind its own
   (`ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`) and its own textures.
 - Steps run in blocks of up to CHECK_EVERY (32) steps with nothing read back inside a block
-  (every read drains llvmpipe's queue). With forces, a small pass per step copies the body
-  window into a check atlas; at the end of the block a pass sums g_0..g_3 of the final state over
+  (every read drains llvmpipe's queue). With forces, the pass of each step also copies the body
+  window of its source state (f*(t), what the forces of step t use) into a slot of the *band
+  area*: BAND_WIDTH columns right of the lattice in every state texture, so the lattice's
+  textures are nx + BAND_WIDTH wide for tunnels. One pass a step keeps llvmpipe at one scene a
+  step (a separate copy pass into an atlas, which x-periodic grids, whose texture must be nx
+  wide for the REPEAT wrap, and windows wider than the band area still use, cost the moving
+  tunnel 25-30 %: docs/performance.md). At the end of the block a pass sums g_0..g_3 of the final state over
   tiles (`shaders/finite_check.glsl`; NaN reaches every population of the neighbours within a
-  step, so a NaN never vanishes from the fluid) and the atlas is read once. A non-finite sum
+  step, so a NaN never vanishes from the fluid) and the windows and sums are read once. A non-finite sum
   replays the block from its start state, which a third state side keeps, with a check after
   every step: `solver.backend.SolverDiverged` names the exact step, as in the reference; a
   non-finite body window raises it with the step of that window. (An occlusion query counting
@@ -62,6 +67,9 @@ UNIT_MASK, UNIT_QA, UNIT_QB, UNIT_INFLOW, UNIT_OMEGA = 3, 4, 5, 6, 7
 ALIGN = 4
 #: steps whose divergence checks and force windows are read back together (one GPU sync)
 CHECK_EVERY = 32
+#: width of the band area right of the lattice in each state texture (tuning window="state"):
+#: each step's draw copies the body window of its source state into a slot there
+BAND_WIDTH = 128
 _Y_MODE = {"no_slip": 0, "free_slip": 1, "periodic": 2}
 
 
@@ -124,7 +132,7 @@ class GLSolver(Solver):
     name = "gl"
     #: default tuning (docs/performance.md measures each choice)
     TUNING = {"split": True, "fetch_normalized": 2, "divergence": "tiles", "check_every": CHECK_EVERY,
-              "window": "atlas"}
+              "window": "state"}
 
     def __init__(self, config, ctx=None, tuning: dict | None = None):
         super().__init__(config)
@@ -149,10 +157,15 @@ class GLSolver(Solver):
         self._sponge = sponge
         self._programs = {}
         op, om = relaxation_rates(cfg)
+        # tunnels keep a band area right of the lattice in every state texture (window="state");
+        # an x-periodic grid needs the texture to be exactly nx wide (REPEAT wraps it)
+        self._band_w = min(nx, BAND_WIDTH) if self.tuning["window"] == "state" and cfg.x_boundary != "periodic" else 0
+        self._tex_size = (nx + self._band_w, ny)
+        tex_w = float(self._tex_size[0])
         self._uniform_values = dict(
             G0=UNIT_G[0], G1=UNIT_G[1], G2=UNIT_G[2], MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
-            INFLOW=UNIT_INFLOW, OMEGA=UNIT_OMEGA, N=(nx, ny), grid_size=(float(nx), float(ny)),
-            inv_n=(1.0 / nx, 1.0 / ny), body_force=tuple(float(v) for v in cfg.body_force),
+            INFLOW=UNIT_INFLOW, OMEGA=UNIT_OMEGA, N=(nx, ny), grid_size=(tex_w, float(ny)),
+            inv_n=(1.0 / tex_w, 1.0 / ny), body_force=tuple(float(v) for v in cfg.body_force),
             omega_plus=float(np.ravel(op)[0]), omega_minus=float(np.ravel(om)[0]))  # column 0: no sponge
         self._objects = []  # GL objects to release
 
@@ -165,7 +178,7 @@ class GLSolver(Solver):
 
         # three sides: two ping-pong within a block of steps, the third keeps the block's start
         # state, from which a block whose final state is not finite is replayed step by step
-        self._g = [[tex((nx, ny), 4, repeat=True) for _ in range(3)] for _ in range(3)]
+        self._g = [[tex(self._tex_size, 4, repeat=True) for _ in range(3)] for _ in range(3)]
         self._fbo = [ctx.framebuffer(color_attachments=side) for side in self._g]
         self._objects += self._fbo
         self._cur = 0  # the side holding f*(t)
@@ -188,6 +201,7 @@ class GLSolver(Solver):
         self._atlas, self._check_progs = None, None
         self._check_every = max(1, min(CHECK_EVERY, int(self.tuning["check_every"])))
         self._window_mode = self.tuning["window"]
+        self._band_copy = None  # (vao, vbo, slot layout) of the window copy into the band area
         self._pending, self._idle_queries = [], []  # divergence="discard": (step, query)
 
         self.body: BodyState | None = None
@@ -321,10 +335,12 @@ class GLSolver(Solver):
         self._omega_tex.use(location=UNIT_OMEGA)
 
     # --- stepping ---------------------------------------------------------------
-    def _draw_step(self, dst: int):
-        """Queue step t -> t+1 from the current side into side `dst`."""
+    def _draw_step(self, dst: int, slot: int | None = None):
+        """Queue step t -> t+1 from the current side into side `dst`; with `slot`, the same
+        pass copies the body window of the current side (f*(t), what the forces of step t use)
+        into that slot of dst's band area (one llvmpipe scene per step, not two)."""
         self._update_inflow(self.time)
-        self._begin_pass(self._fbo[dst], (self.nx, self.ny))
+        self._begin_pass(self._fbo[dst], self._tex_size)
         self._bind_sources(self._cur)
         if self._discard:
             query = self._idle_queries.pop() if self._idle_queries else self.ctx.query(samples=True)
@@ -334,6 +350,11 @@ class GLSolver(Solver):
         else:
             for vao, _ in self._draws:
                 vao.render(moderngl.TRIANGLES)
+        if slot is not None:
+            vao, _, (cols, ww, wh) = self._band_copy
+            x0, y0 = self.body.window[:2]
+            vao.program["shift"].value = (x0 - self.nx - (slot % cols) * ww, y0 - (slot // cols) * wh)
+            vao.render(moderngl.TRIANGLES, vertices=6, first=6 * slot)
         self._cur = dst
         self.time += 1
         if self._discard:
@@ -350,7 +371,10 @@ class GLSolver(Solver):
         done = 0
         while done < n:
             with_forces = bool(self._models) and self.body is not None
-            k = min(n - done, self._check_every, self._ensure_atlas(with_forces))
+            slots = self._band_slots() if with_forces else 0
+            k = min(n - done, self._check_every, self._ensure_atlas(with_forces and not slots))
+            if slots:
+                k = min(k, 2 * slots)
             t0, start, impulses = self.time, self._cur, []
             others = [side for side in range(3) if side != start]
             read_now = []  # tuning window="read": each window read right after its step is queued
@@ -358,7 +382,9 @@ class GLSolver(Solver):
                 impulses.append(self._impulse)
                 self._impulse = (0.0, 0.0)
                 src = self._cur
-                self._draw_step(others[band % 2])
+                self._draw_step(others[band % 2], band // 2 if slots else None)
+                if slots:
+                    continue
                 if with_forces and self._window_mode == "read":
                     read_now.append(self._window(src, impulses[-1]))
                     if not np.all(np.isfinite(read_now[-1].f)):
@@ -367,7 +393,8 @@ class GLSolver(Solver):
                     self._queue_checks(band, src, tiles=False)
             self._queue_checks(0, None, tiles=not self._discard)
             try:
-                windows = self._resolve_checks(t0, k, impulses if with_forces and not read_now else None)
+                windows = self._resolve_checks(t0, k, impulses if with_forces and not read_now else None,
+                                               others if slots else None)
                 windows = read_now or windows
             except SolverDiverged as exc:
                 if exc.step == self.time and not self._discard:  # only the final state is known bad
@@ -381,6 +408,52 @@ class GLSolver(Solver):
             done += k
         if n > 0:
             self._forces = {name: (s[0] / n, s[1] / n) for name, s in sums.items()}
+
+    def _band_slots(self) -> int:
+        """Slots for the body window in one side's band area (0: the window does not fit, or
+        no band area: the atlas path); builds the copy pass's rectangles for this window size."""
+        if not self._band_w:
+            return 0
+        x0, y0, x1, y1 = self.body.window
+        ww, wh = x1 - x0, y1 - y0
+        cols, rows = self._band_w // ww, self.ny // wh
+        if cols * rows == 0:
+            return 0
+        layout = (cols, ww, wh)
+        if self._band_copy is None or self._band_copy[2] != layout:
+            if self._band_copy is None:
+                prog = create_program(self.ctx, "rect_vertex.glsl", "copy_window.glsl")
+                self._uniforms(prog, G0=UNIT_G[0], G1=UNIT_G[1], G2=UNIT_G[2],
+                               grid_size=(float(self._tex_size[0]), float(self.ny)))
+                vbo = self.ctx.buffer(reserve=1)
+                self._objects.append(prog)
+            else:
+                vao, vbo, _ = self._band_copy
+                prog = vao.program
+                vao.release()
+            rects = [(self.nx + c * ww, r * wh, self.nx + (c + 1) * ww, (r + 1) * wh)
+                     for r in range(rows) for c in range(cols)]
+            data = _triangles(rects).tobytes()
+            vbo.orphan(len(data))
+            vbo.write(data)
+            self._band_copy = (self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")]), vbo, layout)
+        return cols * rows
+
+    def _band_windows(self, sides, bands: int) -> list[np.ndarray]:
+        """The stored g (9, wh, ww) of each step's body window from the band areas: step b's
+        window is slot b // 2 of side sides[b % 2]; each side's used rows are read once."""
+        _, _, (cols, ww, wh) = self._band_copy
+        out = []
+        areas = {}
+        for b in range(bands):
+            side, slot = sides[b % 2], b // 2
+            if side not in areas:
+                used = (bands - 1 - b % 2) // 2 + 1  # slots this side holds
+                h = -(-used // cols) * wh
+                areas[side] = self._read_shifted((self.nx, 0, self.nx + cols * ww, h), side)
+            c, r = slot % cols, slot // cols
+            out.append(areas[side][:, r * wh:(r + 1) * wh, c * ww:(c + 1) * ww])
+        return out
 
     def _replay(self, start: int, t0: int, k: int):
         """Rerun the k steps after time t0 from side `start`, checking each state: raises
@@ -407,7 +480,7 @@ class GLSolver(Solver):
         t0 = time.perf_counter()
         for _ in range(draws):
             dst = (self._cur + 1) % 3
-            self._begin_pass(self._fbo[dst], (self.nx, self.ny))
+            self._begin_pass(self._fbo[dst], self._tex_size)
             self._bind_sources(self._cur)
             vao.render(moderngl.TRIANGLES)
             self._cur = dst
@@ -510,11 +583,12 @@ class GLSolver(Solver):
         data = self._atlas["fbo"].read(viewport=(0, band * band_h, tw, th), components=4, attachment=0, dtype="f4")
         return bool(np.all(np.isfinite(np.frombuffer(data, dtype="f4"))))
 
-    def _resolve_checks(self, t0: int, bands: int, impulses):
+    def _resolve_checks(self, t0: int, bands: int, impulses, band_sides=None):
         """Read the atlas after a block of `bands` steps from time t0 and check it (algorithm.md,
         'Divergence'): the tile sums of the final state finite (or, tuning divergence="discard",
-        every node of every step written), and each step's body window finite. Raises
-        SolverDiverged with the earliest bad step known; else returns the BodyWindows."""
+        every node of every step written), and each step's body window finite (from the atlas,
+        or with `band_sides` from the band areas of those two sides). Raises SolverDiverged
+        with the earliest bad step known; else returns the BodyWindows."""
         tw, th = self._tile_grid
         ww, wh = self._atlas["window"]
         band_h = max(th, wh)
@@ -529,16 +603,20 @@ class GLSolver(Solver):
         elif not self._tiles_finite(0):
             bad.append((self.time, "density is no longer finite"))
         windows = []
-        if impulses:
+        if impulses and band_sides is not None:
+            step_windows = self._band_windows(band_sides, bands)
+        elif impulses:
             g = np.empty((12, height, ww), dtype="f4")
             for k in range(3):
                 data = self._atlas["fbo"].read(viewport=(tw, 0, ww, height), components=4, attachment=k,
                                                dtype="f4")
                 g[4 * k:4 * k + 4] = np.moveaxis(np.frombuffer(data, dtype="f4").reshape(height, ww, 4), -1, 0)
+            step_windows = [g[:Q, b * band_h:b * band_h + wh] for b in range(bands)]
+        if impulses:
             b_ = self.body
             solid, q = b_.window_arrays()
             for b, impulse in enumerate(impulses):
-                gb = g[:Q, b * band_h:b * band_h + wh]
+                gb = step_windows[b]
                 if not np.all(np.isfinite(gb)):
                     bad.append((t0 + b, "non-finite populations around the body"))
                     break
@@ -677,4 +755,8 @@ class GLSolver(Solver):
             for obj in self._atlas["objects"]:
                 obj.release()
         self._atlas, self._check_progs = None, None
+        if self._band_copy is not None:
+            self._band_copy[0].release()
+            self._band_copy[1].release()
+            self._band_copy = None
         self._pending, self._idle_queries = [], []

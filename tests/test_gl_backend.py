@@ -105,13 +105,16 @@ def test_body_upload_touches_only_the_window(request):
     assert not mask[y0:y1, x0:x1].any()
 
 
-def test_blocks_of_steps_give_the_forces_and_state_of_single_steps(gl_context):
-    """step(n) reads back once per block of up to 32 steps (force windows batched on the GPU,
-    one check per block): 40 steps in blocks (32 + 8) give the same state and the same mean
-    force, impulses of the moves included, as single steps whose window is read directly."""
+@pytest.mark.parametrize("window", ["state", "atlas"])
+def test_blocks_of_steps_give_the_forces_and_state_of_single_steps(gl_context, window):
+    """step(n) reads back once per block of steps (force windows batched on the GPU, one check
+    per block): 40 steps in blocks give the same state and the same mean force, impulses of the
+    moves included, as single steps whose window is read directly. window="state" (default):
+    each step's pass copies the window into a slot of its destination's band area (10 slots a
+    side here, blocks of 20); "atlas": a separate pass per step (blocks of 32 + 8)."""
     cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)
     runs = []
-    for tuning in ({}, {"check_every": 1, "window": "read"}):
+    for tuning in ({"window": window}, {"check_every": 1, "window": "read"}):
         s = create_solver("gl", cfg, ctx=gl_context, tuning=tuning)
         s.enable_force_models(["momentum_exchange"])
         s.set_body(Cylinder(6.0, x=20.0, y=16.0))
@@ -123,3 +126,23 @@ def test_blocks_of_steps_give_the_forces_and_state_of_single_steps(gl_context):
     assert np.array_equal(g_block, g_single)
     assert np.allclose(f_block, f_single, rtol=1e-12, atol=0)
     assert abs(f_block[0]) > 0  # the cylinder feels the flow
+
+
+def test_window_wider_than_the_band_area_falls_back_to_the_atlas(gl_context):
+    """A body window wider than the band area (BAND_WIDTH) takes the atlas path, same numbers."""
+    from shapes import FlatPlate
+    from solver.gl_backend import BAND_WIDTH
+
+    cfg = FlowConfig(nx=BAND_WIDTH + 64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)
+    plate = FlatPlate(length=BAND_WIDTH + 10.0, thickness=2.0, x=cfg.nx / 2, y=16.0, angle=np.pi / 2)
+    runs = []
+    for tuning in ({}, {"check_every": 1, "window": "read"}):
+        s = create_solver("gl", cfg, ctx=gl_context, tuning=tuning)
+        s.enable_force_models(["momentum_exchange"])
+        s.set_body(plate)
+        assert s.body.window[2] - s.body.window[0] > BAND_WIDTH
+        s.step(12)
+        runs.append((s.forces()["momentum_exchange"], s.distributions()))
+    (f_block, g_block), (f_single, g_single) = runs
+    assert np.array_equal(g_block, g_single)
+    assert np.allclose(f_block, f_single, rtol=1e-12, atol=0)

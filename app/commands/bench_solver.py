@@ -189,7 +189,8 @@ VARIANTS = {
     "regions, texture() + REPEAT": {"split": True, "fetch_normalized": 1},
     "regions, textureOffset() + REPEAT, read back every step": {"check_every": 1, "window": "read"},
     "default, force window read right after each step": {"window": "read"},
-    "regions, textureOffset() + REPEAT, blocks of 32 steps (default)": {},
+    "blocks of 32, a pass per step copies the window to an atlas": {"window": "atlas"},
+    "default: the step's own pass copies it to a band area": {},
     "default, divergence by discard + occlusion query": {"divergence": "discard"},
 }
 #: step variants (body, edges, sponge) whose cost per node the variants run measures
