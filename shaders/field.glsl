@@ -3,20 +3,16 @@
 // (moments of f*, as Solver.macroscopic, Guo's F/2 removed; vorticity duy/dx - dux/dy by central differences,
 // one-sided at the domain edges). Runs only when the app asks for it.
 // @LATTICE
+// @INCLUDE paired_layout.glsl
 
-uniform sampler2D G0;
-uniform sampler2D G1;
-uniform sampler2D G2;
 uniform ivec2 N;
 uniform vec2 body_force;  // Guo: the step's velocity is (sum c f* - F/2) / rho
 
 out vec4 field;
 
 vec3 moments(ivec2 p) {  // (rho, ux, uy) at node p
-    vec4 a = texelFetch(G0, p, 0);
-    vec4 b = texelFetch(G1, p, 0);
-    vec4 c = texelFetch(G2, p, 0);
-    float g[9] = float[9](a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x);
+    float g[9];
+    load_node(p, g);
     float rho = RHO0;
     vec2 j = vec2(0.0);
     for (int i = 0; i < Q; ++i) {

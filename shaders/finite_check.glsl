@@ -1,13 +1,14 @@
 #version 330 core
-// Cheap divergence check: each output texel sums the stored g_0..g_3 over a BLOCK_X x BLOCK_Y
-// tile of nodes; a NaN or Inf anywhere makes its tile's sum non-finite (NaN spreads to every
-// population of the neighbours within a step, so one texture suffices). The sums of step k go
+// Cheap divergence check: each output texel sums texture G0 (g1 and g3 of two nodes,
+// shaders/paired_layout.glsl) over a BLOCK_X x BLOCK_Y tile of texels; a NaN or Inf anywhere
+// makes its tile's sum non-finite (NaN spreads to every population of the neighbours within a
+// step, so one texture suffices). The sums of step k go
 // to a band of an atlas whose lower-left texel is `band`; the tiles are shaped so that a band
 // is at least 128 texels wide (two of llvmpipe's 64 x 64 bins: both threads share the work).
 // @LATTICE
 
 uniform sampler2D G0;
-uniform ivec2 N;
+uniform ivec2 N;       // the lattice's texels (ceil(nx / 2), ny)
 uniform ivec2 band;
 
 out vec4 tile_sum;

@@ -1,35 +1,29 @@
 #version 330 core
 // One lattice Boltzmann step t -> t+1, collide and stream fused (pull form), exactly as
-// docs/algorithm.md states it. Populations are stored shifted, g_i = f*_i - w_i RHO0, in three
-// RGBA32F textures: G0 = (g0, g1, g2, g3), G1 = (g4, g5, g6, g7), G2 = (g8, -, -, -).
+// docs/algorithm.md states it. Populations are stored shifted, g_i = f*_i - w_i RHO0, two nodes
+// per texel in five RGBA32F textures (shaders/paired_layout.glsl, solver/gl_layout.py); each
+// fragment updates the two nodes a = (2k, y) and b = (2k + 1, y) of its texel k.
 // References: Bouzidi, Firdaouss & Lallemand (2001); Lallemand & Luo (2003); Ginzburg (2008);
 // Guo, Zheng & Shi (2002).
 //
 // Compile-time variants (defines injected by solver/gl_programs.py). llvmpipe executes both
 // sides of a divergent branch, so each region of the grid is drawn by the variant it needs:
 //   BODY  1: rule 1a (Bouzidi links with the moving-wall term) and solid nodes (body window);
-//   EDGES 1: rules 1b-1e (walls, inlet, pressure outlet, periodic wrap) (edge strips);
-//   both 0: the fast path, plain streaming (rule 1f) for the interior.
+//   EDGES 1: rules 1b-1e (walls, inlet, pressure outlet, periodic wrap) (edge strips); streams
+//     node by node through texelFetch with an explicit wrap;
+//   both 0: the fast path, plain streaming (rule 1f) for the interior: both nodes streamed by
+//     stream_pair, whose fetches the directions with the same row offset share (12 for two
+//     nodes, 9 per node before), through textureOffset() at normalized coordinates and REPEAT
+//     samplers (a fully periodic grid of even width wraps for free).
 //   TRT, GUO_FORCE, SPONGE: collision operator, Guo body force, outlet sponge (per-column rates).
 //   X_PERIODIC 0/1; Y_MODE 0 no_slip, 1 free_slip, 2 periodic.
-//   FETCH_NORMALIZED 1: streaming reads with texture() at normalized coordinates through
-//     REPEAT samplers (the wrap comes free); 2: the same through textureOffset();
-//     0: texelFetch() (docs/performance.md compares them).
 //   DIVERGENCE_DISCARD 1: a node with a non-finite density discards its fragment (an
 //     occlusion-query divergence check; measured slower than the tile check, not the default).
-//   PAIRED 1: a layout probe, not used by the solver (solver/gl_layout_probe.py,
-//     docs/performance.md): two nodes per fragment, a = (2k, y) and b = (2k+1, y), in five
-//     RGBA32F textures of width nx/2, fully periodic fast path only:
-//     G0 (g1a g1b g3a g3b), G1 (g5a g5b g6a g6b), G2 (g7a g7b g8a g8b), G3 (g2a g2b g4a g4b),
-//     G4 (g0a g0b - -). Directions sharing a row offset share texels: 12 fetches per 2 nodes
-//     instead of 18, 5 writes instead of 6.
 // @LATTICE
+// @INCLUDE paired_layout.glsl
 
-uniform sampler2D G0;
-uniform sampler2D G1;
-uniform sampler2D G2;
-uniform ivec2 N;               // (nx, ny)
-uniform vec2 inv_n;            // (1/nx, 1/ny)
+uniform ivec2 N;               // (nx, ny) in nodes
+uniform vec2 inv_n;            // 1 / (texture width, height) in texels
 uniform float omega_plus;      // 1 / tau
 uniform float omega_minus;     // TRT odd rate from the magic number
 uniform vec2 body_force;       // Guo force density F
@@ -37,8 +31,8 @@ uniform vec2 body_force;       // Guo force density F
 uniform sampler2D OMEGA;       // (omega+, omega-) of column ix in texel (ix, 0): the outlet sponge
 #endif
 #if BODY
-uniform usampler2D MASK;       // bit 0 solid; bit i (1..8) q[OPP[i], x] > 0; bit 8+i: that
-                               // link takes the two-node interpolation (q < 1/2, x + c_i fluid)
+uniform usampler2D MASK;       // per node: bit 0 solid; bit i (1..8) q[OPP[i], x] > 0; bit 8+i:
+                               // that link takes the two-node interpolation (q < 1/2, x + c_i fluid)
 uniform sampler2D QA;          // q[1..4, x]
 uniform sampler2D QB;          // q[5..8, x]
 uniform vec2 body_velocity;    // V
@@ -53,50 +47,41 @@ uniform float inflow_ramp;     // ramp(t): u_in(iy, t) = ramp(t) profile(iy)
 layout(location = 0) out vec4 out0;
 layout(location = 1) out vec4 out1;
 layout(location = 2) out vec4 out2;
-#if PAIRED
-uniform sampler2D G3;
-uniform sampler2D G4;
 layout(location = 3) out vec4 out3;
 layout(location = 4) out vec4 out4;
-#endif
 
-float pop(int j, ivec2 p) {  // stored g_j at node p (inside the grid)
-    if (j < 4) return texelFetch(G0, p, 0)[j];
-    if (j < 8) return texelFetch(G1, p, 0)[j - 4];
-    return texelFetch(G2, p, 0).x;
-}
-
-ivec2 wrap(ivec2 p) {
+ivec2 wrap(ivec2 p) {  // node p, periodic wrap
     return ivec2((p.x + N.x) % N.x, (p.y + N.y) % N.y);
 }
 
-// g_i(x - c_i): plain streaming, periodic wrap at the edges (rules 1e, 1f).
-float streamed(int i, ivec2 x) {
-#if FETCH_NORMALIZED
-    vec2 p = (gl_FragCoord.xy - vec2(C[i])) * inv_n;
-    if (i < 4) return texture(G0, p)[i];
-    if (i < 8) return texture(G1, p)[i - 4];
-    return texture(G2, p).x;
-#elif EDGES
-    return pop(i, wrap(x - C[i]));
-#else
-    return pop(i, x - C[i]);
-#endif
+// both nodes of this fragment's texel, plain streaming g_i(x - c_i) (rule 1f), the fetches
+// shared between directions with the same row offset (texel offsets -1, 0, +1 in x)
+void stream_pair(out float a[9], out float b[9]) {
+    vec2 p = gl_FragCoord.xy * inv_n;
+    vec4 z = texture(G4, p);
+    a[0] = z.x; b[0] = z.y;
+    vec4 l = textureOffset(G0, p, ivec2(-1, 0));  // row y: g1 (+1, 0), g3 (-1, 0)
+    vec4 m = texture(G0, p);
+    vec4 r = textureOffset(G0, p, ivec2(1, 0));
+    a[1] = l.y; b[1] = m.x; a[3] = m.w; b[3] = r.z;
+    l = textureOffset(G1, p, ivec2(-1, -1));      // row y - 1: g5 (+1, +1), g6 (-1, +1)
+    m = textureOffset(G1, p, ivec2(0, -1));
+    r = textureOffset(G1, p, ivec2(1, -1));
+    a[5] = l.y; b[5] = m.x; a[6] = m.w; b[6] = r.z;
+    l = textureOffset(G2, p, ivec2(-1, 1));       // row y + 1: g7 (-1, -1), g8 (+1, -1)
+    m = textureOffset(G2, p, ivec2(0, 1));
+    r = textureOffset(G2, p, ivec2(1, 1));
+    a[7] = m.y; b[7] = r.x; a[8] = l.w; b[8] = m.z;
+    vec4 s = textureOffset(G3, p, ivec2(0, -1));  // g2 (0, +1) from row y - 1
+    vec4 n = textureOffset(G3, p, ivec2(0, 1));   // g4 (0, -1) from row y + 1
+    a[2] = s.x; b[2] = s.y; a[4] = n.z; b[4] = n.w;
 }
 
-#if FETCH_NORMALIZED == 2
-// the nine streaming reads through textureOffset(): one coordinate, constant texel offsets
-void stream_all(out float gin[9]) {
-    vec2 p = gl_FragCoord.xy * inv_n;
-    gin[0] = texture(G0, p).x;
-    gin[1] = textureOffset(G0, p, -C[1]).y;
-    gin[2] = textureOffset(G0, p, -C[2]).z;
-    gin[3] = textureOffset(G0, p, -C[3]).w;
-    gin[4] = textureOffset(G1, p, -C[4]).x;
-    gin[5] = textureOffset(G1, p, -C[5]).y;
-    gin[6] = textureOffset(G1, p, -C[6]).z;
-    gin[7] = textureOffset(G1, p, -C[7]).w;
-    gin[8] = textureOffset(G2, p, -C[8]).x;
+#if EDGES
+// node x, plain streaming with the periodic wrap (rules 1e, 1f); what the wrap brings in across
+// a non-periodic edge is replaced by rules b-d
+void stream_node(ivec2 x, out float g[9]) {
+    for (int i = 0; i < Q; ++i) g[i] = pop(i, wrap(x - C[i]));
 }
 #endif
 
@@ -107,10 +92,12 @@ float feq_shifted(int i, float drho, float rho, vec2 u) {
     return W[i] * (drho + rho * (cu + 0.5 * cu * cu - usq));
 }
 
-void store(float g[9]) {
-    out0 = vec4(g[0], g[1], g[2], g[3]);
-    out1 = vec4(g[4], g[5], g[6], g[7]);
-    out2 = vec4(g[8], 0.0, 0.0, 0.0);
+void store_pair(float a[9], float b[9]) {
+    out0 = vec4(a[1], b[1], a[3], b[3]);
+    out1 = vec4(a[5], b[5], a[6], b[6]);
+    out2 = vec4(a[7], b[7], a[8], b[8]);
+    out3 = vec4(a[2], b[2], a[4], b[4]);
+    out4 = vec4(a[0], b[0], 0.0, 0.0);
 }
 
 // Collision (algorithm.md steps 2-4) of the incoming shifted populations f at node x, in place,
@@ -214,53 +201,16 @@ int reflect_y(int i) {  // j with C[j] = (C[i].x, -C[i].y)
 }
 #endif
 
-#if PAIRED
-void main() {  // the layout probe (see the header): pull both nodes, collide each, store
-    ivec2 x = ivec2(gl_FragCoord.xy);
-    vec2 p = gl_FragCoord.xy * inv_n;
-    float a[9];
-    float b[9];
-    vec4 z = texture(G4, p);
-    a[0] = z.x; b[0] = z.y;
-    vec4 l = textureOffset(G0, p, ivec2(-1, 0));  // row y: g1 (+1, 0), g3 (-1, 0)
-    vec4 m = texture(G0, p);
-    vec4 r = textureOffset(G0, p, ivec2(1, 0));
-    a[1] = l.y; b[1] = m.x; a[3] = m.w; b[3] = r.z;
-    l = textureOffset(G1, p, ivec2(-1, -1));      // row y - 1: g5 (+1, +1), g6 (-1, +1)
-    m = textureOffset(G1, p, ivec2(0, -1));
-    r = textureOffset(G1, p, ivec2(1, -1));
-    a[5] = l.y; b[5] = m.x; a[6] = m.w; b[6] = r.z;
-    l = textureOffset(G2, p, ivec2(-1, 1));       // row y + 1: g7 (-1, -1), g8 (+1, -1)
-    m = textureOffset(G2, p, ivec2(0, 1));
-    r = textureOffset(G2, p, ivec2(1, 1));
-    a[7] = m.y; b[7] = r.x; a[8] = l.w; b[8] = m.z;
-    vec4 s = textureOffset(G3, p, ivec2(0, -1));  // g2 (0, +1) from row y - 1
-    vec4 n = textureOffset(G3, p, ivec2(0, 1));   // g4 (0, -1) from row y + 1
-    a[2] = s.x; b[2] = s.y; a[4] = n.z; b[4] = n.w;
-    collide(a, ivec2(2 * x.x, x.y));
-    collide(b, ivec2(2 * x.x + 1, x.y));
-    out0 = vec4(a[1], b[1], a[3], b[3]);
-    out1 = vec4(a[5], b[5], a[6], b[6]);
-    out2 = vec4(a[7], b[7], a[8], b[8]);
-    out3 = vec4(a[2], b[2], a[4], b[4]);
-    out4 = vec4(a[0], b[0], 0.0, 0.0);
-}
-#else
-void main() {
-    ivec2 x = ivec2(gl_FragCoord.xy);
-    float gin[9];
-#if FETCH_NORMALIZED == 2
-    stream_all(gin);
-#else
-    for (int i = 0; i < Q; ++i) gin[i] = streamed(i, x);
-#endif
+#if BODY || EDGES
+// Rules a-f and the collision at node x (variants BODY, EDGES): gin holds g_i(x - c_i) as
+// streamed and becomes the post-collision populations; own = g*(x); west = g*(x - 1, y), for
+// the pressure outlet.
+void node_update(ivec2 x, inout float gin[9], float own[9], float west[9]) {
 #if BODY
     uint m = texelFetch(MASK, x, 0).r;
     if ((m & 1u) != 0u) {  // solid node: equilibrium at the body velocity, density RHO0
         vec2 ub = wall_velocity(vec2(x));
-        float g[9];
-        for (int i = 0; i < Q; ++i) g[i] = feq_shifted(i, 0.0, RHO0, ub);
-        store(g);
+        for (int i = 0; i < Q; ++i) gin[i] = feq_shifted(i, 0.0, RHO0, ub);
         return;
     }
     vec4 qa = texelFetch(QA, x, 0);
@@ -268,11 +218,6 @@ void main() {
     float qs[9] = float[9](0.0, qa.x, qa.y, qa.z, qa.w, qb.x, qb.y, qb.z, qb.w);
     float plain[9] = gin;  // plain[ib] = g_ib(x + c_i): the second node of the interpolation
 #endif
-#if BODY || EDGES
-    vec4 a = texelFetch(G0, x, 0);
-    vec4 b = texelFetch(G1, x, 0);
-    vec4 c = texelFetch(G2, x, 0);
-    float own[9] = float[9](a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x);
 #if EDGES
     float uin = X_PERIODIC == 0 ? inflow_ramp * texelFetch(INFLOW, ivec2(x.y, 0), 0).r : 0.0;
     // outlet velocity u_b = u(x) + (u(x) - u(x - 1)) / 2 of the stored populations
@@ -280,11 +225,6 @@ void main() {
     vec2 u_out = vec2(0.0);
     float usq_out = 0.0;
     if (X_PERIODIC == 0) {
-        ivec2 xw = wrap(x - ivec2(1, 0));
-        vec4 aw = texelFetch(G0, xw, 0);
-        vec4 bw = texelFetch(G1, xw, 0);
-        vec4 cw = texelFetch(G2, xw, 0);
-        float west[9] = float[9](aw.x, aw.y, aw.z, aw.w, bw.x, bw.y, bw.z, bw.w, cw.x);
         u_out = 1.5 * stored_velocity(own) - 0.5 * stored_velocity(west);
         usq_out = dot(u_out, u_out);
     }
@@ -325,8 +265,41 @@ void main() {
         }  // else rules e, f: gin[i] as streamed (wrapped)
 #endif
     }
-#endif
     collide(gin, x);
-    store(gin);
 }
 #endif
+
+void main() {
+    ivec2 k = ivec2(gl_FragCoord.xy);  // texel
+    ivec2 xa = ivec2(2 * k.x, k.y);
+    ivec2 xb = xa + ivec2(1, 0);
+    float a[9];
+    float b[9];
+#if EDGES
+    stream_node(xa, a);
+    stream_node(xb, b);
+#else
+    stream_pair(a, b);
+#endif
+#if BODY || EDGES
+    float own_a[9];
+    float own_b[9];
+    load_pair(k, own_a, own_b);
+    float west_a[9];
+#if EDGES
+    load_node(wrap(xa - ivec2(1, 0)), west_a);
+#else
+    west_a = own_a;  // not used without EDGES
+#endif
+    node_update(xa, a, own_a, west_a);
+    node_update(xb, b, own_b, own_a);
+#if EDGES
+    if (xb.x >= N.x)  // the column past the last node of an odd nx: kept at rest
+        for (int i = 0; i < Q; ++i) b[i] = 0.0;
+#endif
+#else
+    collide(a, xa);
+    collide(b, xb);
+#endif
+    store_pair(a, b);
+}

@@ -5,9 +5,10 @@ methods as the numpy reference (`add_force_model`, `body_window`). It never
 creates a GL context: the CLI and the tests hand it an EGL standalone one, the window Qt's.
 Arithmetic is float32 whatever `config.dtype` says.
 
-State on the GPU: the shifted post-collision populations g_i = f*_i - w_i RHO0 in three RGBA32F
-textures per side (three sides: see 'Steps run in blocks' below) (G0 = g0..g3, G1 = g4..g7, G2 = g8), written by one fused
-collide+stream pass through three colour attachments (MRT). llvmpipe executes both sides of a
+State on the GPU: the shifted post-collision populations g_i = f*_i - w_i RHO0, two nodes per
+texel in five RGBA32F textures per side (solver/gl_layout.py; three sides: see 'Steps run in
+blocks' below), written by one fused collide+stream pass through five colour attachments (MRT),
+each fragment updating the two nodes of its texel. llvmpipe executes both sides of a
 divergent branch, so the step is drawn as rectangles, each with the variant of
 `shaders/lbm_step.glsl` it needs: the interior (plain streaming, the fast path), the edge rows
 and columns (walls, inlet, outlet, wrap), and the body window (Bouzidi links, solid nodes).
@@ -26,7 +27,7 @@ API for the app (a QOpenGLWidget sharing this context):
 - `grid_size` -> (nx, ny); `renderer` -> the GL renderer string; `finish()` waits for the GPU.
 - Every pass sets the state it needs: `ctx.enable_only(moderngl.NOTHING)` (Qt enters paintGL
   with blending on), no scissor, its own framebuffer and viewport, and binds every texture unit
-  it samples (units 0..7) right before drawing. Nothing is restored: after `step()` or
+  it samples (units 0..9) right before drawing. Nothing is restored: after `step()` or
   `field_texture()` the bound framebuffer is the solver's, so a paintGL must re-bind its own
   (`ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`) and its own textures.
 - Steps run in blocks of up to CHECK_EVERY (32) steps with nothing read back inside a block
@@ -55,20 +56,23 @@ from solver.body import (BodyState, expand_box, make_body_state, move_body, shif
                          window_margin)
 from solver.forces import create_model
 from solver.forces.base import BodyWindow
+from solver.gl_layout import TEXTURES, pack, texel_box, texels, unpack
 from solver.gl_programs import create_program
 from solver.inflow import profile, ramp
 from solver.lattice import C, OPP, Q, RHO0, equilibrium
 from solver.numpy_backend import relaxation_rates
 
 #: texture units (fixed; every pass binds all it samples)
-UNIT_G = (0, 1, 2)
-UNIT_MASK, UNIT_QA, UNIT_QB, UNIT_INFLOW, UNIT_OMEGA = 3, 4, 5, 6, 7
+UNIT_G = tuple(range(TEXTURES))
+UNIT_MASK, UNIT_QA, UNIT_QB, UNIT_INFLOW, UNIT_OMEGA = 5, 6, 7, 8, 9
+#: sampler uniforms of the population textures
+G_NAMES = tuple(f"G{t}" for t in range(TEXTURES))
 #: region rectangles are aligned to llvmpipe's 4x4 shading blocks
 ALIGN = 4
 #: steps whose divergence checks and force windows are read back together (one GPU sync)
 CHECK_EVERY = 32
-#: width of the band area right of the lattice in each state texture (tuning window="state"):
-#: each step's draw copies the body window of its source state into a slot there
+#: width in nodes of the band area right of the lattice in each state texture (tuning
+#: window="state"): each step's draw copies the body window of its source state into a slot there
 BAND_WIDTH = 128
 _Y_MODE = {"no_slip": 0, "free_slip": 1, "periodic": 2}
 
@@ -131,8 +135,7 @@ class GLSolver(Solver):
 
     name = "gl"
     #: default tuning (docs/performance.md measures each choice)
-    TUNING = {"split": True, "fetch_normalized": 2, "divergence": "tiles", "check_every": CHECK_EVERY,
-              "window": "state"}
+    TUNING = {"split": True, "divergence": "tiles", "check_every": CHECK_EVERY, "window": "state"}
 
     def __init__(self, config, ctx=None, tuning: dict | None = None):
         super().__init__(config)
@@ -150,20 +153,21 @@ class GLSolver(Solver):
             "GUO_FORCE": any(c != 0.0 for c in cfg.body_force),
             "X_PERIODIC": cfg.x_boundary == "periodic",
             "Y_MODE": _Y_MODE[cfg.y_boundary],
-            "FETCH_NORMALIZED": int(self.tuning["fetch_normalized"]),
             "DIVERGENCE_DISCARD": self.tuning["divergence"] == "discard",
         }
         self._defines = defines
         self._sponge = sponge
         self._programs = {}
         op, om = relaxation_rates(cfg)
-        # tunnels keep a band area right of the lattice in every state texture (window="state");
-        # an x-periodic grid needs the texture to be exactly nx wide (REPEAT wraps it)
-        self._band_w = min(nx, BAND_WIDTH) if self.tuning["window"] == "state" and cfg.x_boundary != "periodic" else 0
-        self._tex_size = (nx + self._band_w, ny)
+        # texels: the lattice's ceil(nx / 2) columns, then (tunnels, window="state") the band
+        # area; an x-periodic grid's texture is exactly the lattice (REPEAT wraps it)
+        self._kx = texels(nx)
+        self._band_w = (texels(min(nx, BAND_WIDTH)) if self.tuning["window"] == "state"
+                        and cfg.x_boundary != "periodic" else 0)
+        self._tex_size = (self._kx + self._band_w, ny)
         tex_w = float(self._tex_size[0])
         self._uniform_values = dict(
-            G0=UNIT_G[0], G1=UNIT_G[1], G2=UNIT_G[2], MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
+            **dict(zip(G_NAMES, UNIT_G)), MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
             INFLOW=UNIT_INFLOW, OMEGA=UNIT_OMEGA, N=(nx, ny), grid_size=(tex_w, float(ny)),
             inv_n=(1.0 / tex_w, 1.0 / ny), body_force=tuple(float(v) for v in cfg.body_force),
             omega_plus=float(np.ravel(op)[0]), omega_minus=float(np.ravel(om)[0]))  # column 0: no sponge
@@ -178,7 +182,7 @@ class GLSolver(Solver):
 
         # three sides: two ping-pong within a block of steps, the third keeps the block's start
         # state, from which a block whose final state is not finite is replayed step by step
-        self._g = [[tex(self._tex_size, 4, repeat=True) for _ in range(3)] for _ in range(3)]
+        self._g = [[tex(self._tex_size, 4, repeat=True) for _ in range(TEXTURES)] for _ in range(3)]
         self._fbo = [ctx.framebuffer(color_attachments=side) for side in self._g]
         self._objects += self._fbo
         self._cur = 0  # the side holding f*(t)
@@ -196,8 +200,8 @@ class GLSolver(Solver):
         self._field = None
         self._discard = self.tuning["divergence"] == "discard"
         # divergence checks and force windows of up to CHECK_EVERY steps, read back at once
-        self._tile_block = _tile_block(nx)
-        self._tile_grid = (-(-nx // self._tile_block[0]), -(-ny // self._tile_block[1]))
+        self._tile_block = _tile_block(self._kx)
+        self._tile_grid = (-(-self._kx // self._tile_block[0]), -(-ny // self._tile_block[1]))
         self._atlas, self._check_progs = None, None
         self._check_every = max(1, min(CHECK_EVERY, int(self.tuning["check_every"])))
         self._window_mode = self.tuning["window"]
@@ -239,7 +243,9 @@ class GLSolver(Solver):
         Rectangles are aligned to llvmpipe's 4x4 pixel blocks (a partly covered block runs the
         whole shader), so the edge strips are ALIGN wide and the body window is grown to them.
         """
-        nx, ny, a = self.nx, self.ny, ALIGN
+        nx, ny, a = self._kx, self.ny, ALIGN  # texel columns
+        if window is not None:
+            window = texel_box(window)
         sp = int(self._sponge)
         x1, y1 = (nx - 1) // a * a, (ny - 1) // a * a
         if not self.tuning["split"] or x1 <= a or y1 <= a:
@@ -262,7 +268,7 @@ class GLSolver(Solver):
             inside = w[0] >= a and w[1] >= a and w[2] <= x1 and w[3] <= y1
             parts[(1, 0, sp) if inside else (1, 1, sp)] = [w]
         if sp:  # the sponge columns (aligned down) get the variant with per-column rates
-            xs = (nx - self.config.sponge_cells) // a * a
+            xs = (self.nx - self.config.sponge_cells) // 2 // a * a
             plain, sponge = [], []
             for r in parts[(0, 0, 0)]:
                 if r[0] < xs:
@@ -273,9 +279,10 @@ class GLSolver(Solver):
         return {k: v for k, v in parts.items() if v}
 
     def _wraps_free(self) -> bool:
-        """Both directions periodic and streamed through REPEAT samplers: no edge rules at all."""
+        """Both directions periodic, an even nx (whole texels), streamed through REPEAT
+        samplers: no edge rules at all."""
         d = self._defines
-        return bool(d["X_PERIODIC"] and d["Y_MODE"] == 2 and d["FETCH_NORMALIZED"] and not self._sponge)
+        return bool(d["X_PERIODIC"] and d["Y_MODE"] == 2 and self.nx % 2 == 0 and not self._sponge)
 
     def _set_rects(self, window):
         """Vertex data of every region (see _regions), drawn in this order each step; kept
@@ -352,8 +359,8 @@ class GLSolver(Solver):
                 vao.render(moderngl.TRIANGLES)
         if slot is not None:
             vao, _, (cols, ww, wh) = self._band_copy
-            x0, y0 = self.body.window[:2]
-            vao.program["shift"].value = (x0 - self.nx - (slot % cols) * ww, y0 - (slot // cols) * wh)
+            k0, y0 = texel_box(self.body.window)[:2]
+            vao.program["shift"].value = (k0 - self._kx - (slot % cols) * ww, y0 - (slot // cols) * wh)
             vao.render(moderngl.TRIANGLES, vertices=6, first=6 * slot)
         self._cur = dst
         self.time += 1
@@ -414,8 +421,8 @@ class GLSolver(Solver):
         no band area: the atlas path); builds the copy pass's rectangles for this window size."""
         if not self._band_w:
             return 0
-        x0, y0, x1, y1 = self.body.window
-        ww, wh = x1 - x0, y1 - y0
+        k0, y0, k1, y1 = texel_box(self.body.window)
+        ww, wh = k1 - k0, y1 - y0
         cols, rows = self._band_w // ww, self.ny // wh
         if cols * rows == 0:
             return 0
@@ -423,7 +430,7 @@ class GLSolver(Solver):
         if self._band_copy is None or self._band_copy[2] != layout:
             if self._band_copy is None:
                 prog = create_program(self.ctx, "rect_vertex.glsl", "copy_window.glsl")
-                self._uniforms(prog, G0=UNIT_G[0], G1=UNIT_G[1], G2=UNIT_G[2],
+                self._uniforms(prog, **dict(zip(G_NAMES, UNIT_G)),
                                grid_size=(float(self._tex_size[0]), float(self.ny)))
                 vbo = self.ctx.buffer(reserve=1)
                 self._objects.append(prog)
@@ -431,7 +438,7 @@ class GLSolver(Solver):
                 vao, vbo, _ = self._band_copy
                 prog = vao.program
                 vao.release()
-            rects = [(self.nx + c * ww, r * wh, self.nx + (c + 1) * ww, (r + 1) * wh)
+            rects = [(self._kx + c * ww, r * wh, self._kx + (c + 1) * ww, (r + 1) * wh)
                      for r in range(rows) for c in range(cols)]
             data = _triangles(rects).tobytes()
             vbo.orphan(len(data))
@@ -440,9 +447,11 @@ class GLSolver(Solver):
         return cols * rows
 
     def _band_windows(self, sides, bands: int) -> list[np.ndarray]:
-        """The stored g (9, wh, ww) of each step's body window from the band areas: step b's
+        """The stored g (9, h, w) of each step's body window from the band areas: step b's
         window is slot b // 2 of side sides[b % 2]; each side's used rows are read once."""
         _, _, (cols, ww, wh) = self._band_copy
+        x0, _, x1, _ = self.body.window
+        lo = x0 - 2 * (x0 // 2)  # the window's first node within its first texel
         out = []
         areas = {}
         for b in range(bands):
@@ -450,9 +459,10 @@ class GLSolver(Solver):
             if side not in areas:
                 used = (bands - 1 - b % 2) // 2 + 1  # slots this side holds
                 h = -(-used // cols) * wh
-                areas[side] = self._read_shifted((self.nx, 0, self.nx + cols * ww, h), side)
+                areas[side] = self._read_texels((self._kx, 0, self._kx + cols * ww, h), side)
             c, r = slot % cols, slot // cols
-            out.append(areas[side][:, r * wh:(r + 1) * wh, c * ww:(c + 1) * ww])
+            nodes = areas[side][:, r * wh:(r + 1) * wh, 2 * c * ww:2 * (c + 1) * ww]
+            out.append(nodes[:, :, lo:lo + x1 - x0])
         return out
 
     def _replay(self, start: int, t0: int, k: int):
@@ -473,7 +483,7 @@ class GLSolver(Solver):
         `draws` times (the state is advanced: for docs/performance.md's cost table only)."""
         import time
 
-        vbo = self.ctx.buffer(_triangles([(0, 0, self.nx, self.ny)]).tobytes())
+        vbo = self.ctx.buffer(_triangles([(0, 0, self._kx, self.ny)]).tobytes())
         vao = self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")])
         self._update_inflow(self.time)
         self.finish()
@@ -504,20 +514,20 @@ class GLSolver(Solver):
         vbo = self.ctx.buffer(_triangles([(0, 0, *size)]).tobytes())
         vao = self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
         self._objects += [vao, vbo, fbo, tex, prog]
-        self._uniforms(prog, G0=UNIT_G[0], G1=UNIT_G[1], G2=UNIT_G[2], N=(self.nx, self.ny),
+        self._uniforms(prog, **dict(zip(G_NAMES, UNIT_G)), N=(self.nx, self.ny),
                        grid_size=(float(size[0]), float(size[1])),
                        body_force=tuple(float(v) for v in self.config.body_force))
         return prog, tex, fbo, vao
 
     def _ensure_atlas(self, with_window: bool) -> int:
         """The check atlas: per step one band of tile sums (columns [0, TW)) and, with forces,
-        one band of the body window (columns [TW, TW + w)), 3 RGBA32F attachments. Returns how
+        one band of the body window (columns [TW, TW + w), in texels), 5 RGBA32F attachments. Returns how
         many bands (steps) fit: CHECK_EVERY, fewer for a body window too tall for the texture."""
         tw, th = self._tile_grid
         ww, wh = (0, 0)
         if with_window:
-            x0, y0, x1, y1 = self.body.window
-            ww, wh = x1 - x0, y1 - y0
+            k0, y0, k1, y1 = texel_box(self.body.window)
+            ww, wh = k1 - k0, y1 - y0
         limit = int(self.ctx.info.get("GL_MAX_TEXTURE_SIZE", 16384))
         bands = max(1, min(CHECK_EVERY, limit // max(th, wh)))
         need = (tw + ww, max(th, wh) * bands)
@@ -527,12 +537,13 @@ class GLSolver(Solver):
                     obj.release()
             size = (min(limit, max(need[0], self._atlas["size"][0] if self._atlas else 0)),
                     min(limit, max(need[1], self._atlas["size"][1] if self._atlas else 0)))
-            texs = [self.ctx.texture(size, 4, dtype="f4") for _ in range(3)]
+            texs = [self.ctx.texture(size, 4, dtype="f4") for _ in range(TEXTURES)]
             fbo = self.ctx.framebuffer(color_attachments=texs)
             self._atlas = {"size": size, "fbo": fbo, "objects": [fbo, *texs]}
         if self._check_progs is None:
             tiles = self._aux_program("finite_check.glsl", {"BLOCK_X": self._tile_block[0],
                                                              "BLOCK_Y": self._tile_block[1]})
+            self._uniforms(tiles[0].program, N=(self._kx, self.ny))
             window = self._aux_program("copy_window.glsl")
             self._check_progs = (tiles, window)
         size = self._atlas["size"]
@@ -555,7 +566,7 @@ class GLSolver(Solver):
         vbo = self.ctx.buffer(reserve=2 * CHECK_EVERY * 6 * 8)
         vao = self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
         self._objects += [vao, vbo, prog]
-        self._uniforms(prog, G0=UNIT_G[0], G1=UNIT_G[1], G2=UNIT_G[2], N=(self.nx, self.ny))
+        self._uniforms(prog, **dict(zip(G_NAMES, UNIT_G)), N=(self.nx, self.ny))
         return vao, vbo
 
     def _queue_checks(self, band: int, window_side: int | None, tiles: bool):
@@ -573,8 +584,8 @@ class GLSolver(Solver):
         if window_side is not None:
             for unit, texture in zip(UNIT_G, self._g[window_side]):
                 texture.use(location=unit)
-            x0, y0 = self.body.window[:2]
-            window_vao.program["shift"].value = (x0 - tw, y0 - band * band_h)
+            k0, y0 = texel_box(self.body.window)[:2]
+            window_vao.program["shift"].value = (k0 - tw, y0 - band * band_h)
             window_vao.render(moderngl.TRIANGLES, vertices=6, first=6 * (CHECK_EVERY + band))
 
     def _tiles_finite(self, band: int) -> bool:
@@ -597,7 +608,7 @@ class GLSolver(Solver):
         if self._discard:
             for step, query in self._pending:
                 self._idle_queries.append(query)
-                if query.samples != self.nx * self.ny and not bad:
+                if query.samples != self._kx * self.ny and not bad:
                     bad.append((step, "density is no longer finite"))
             self._pending = []
         elif not self._tiles_finite(0):
@@ -606,12 +617,12 @@ class GLSolver(Solver):
         if impulses and band_sides is not None:
             step_windows = self._band_windows(band_sides, bands)
         elif impulses:
-            g = np.empty((12, height, ww), dtype="f4")
-            for k in range(3):
-                data = self._atlas["fbo"].read(viewport=(tw, 0, ww, height), components=4, attachment=k,
-                                               dtype="f4")
-                g[4 * k:4 * k + 4] = np.moveaxis(np.frombuffer(data, dtype="f4").reshape(height, ww, 4), -1, 0)
-            step_windows = [g[:Q, b * band_h:b * band_h + wh] for b in range(bands)]
+            g = unpack([np.frombuffer(self._atlas["fbo"].read(viewport=(tw, 0, ww, height), components=4,
+                                                              attachment=k, dtype="f4"), dtype="f4")
+                        .reshape(height, ww, 4) for k in range(TEXTURES)])
+            x0, _, x1, _ = self.body.window
+            lo = x0 - 2 * (x0 // 2)
+            step_windows = [g[:, b * band_h:b * band_h + wh, lo:lo + x1 - x0] for b in range(bands)]
         if impulses:
             b_ = self.body
             solid, q = b_.window_arrays()
@@ -701,26 +712,35 @@ class GLSolver(Solver):
                           velocity=b.velocity, omega=b.omega, impulse=impulse, config=self.config, links=b.links)
 
     # --- fields -----------------------------------------------------------------
+    def _read_texels(self, kbox, side=None) -> np.ndarray:
+        """Node populations g (9, h, 2 w) float32 of the texel box kbox (k0, y0, k1, y1) of the
+        current ping-pong side (or `side`)."""
+        k0, y0, k1, y1 = kbox
+        w, h = k1 - k0, y1 - y0
+        fbo = self._fbo[self._cur if side is None else side]
+        return unpack([np.frombuffer(fbo.read(viewport=(k0, y0, w, h), components=4, attachment=t, dtype="f4"),
+                                     dtype="f4").reshape(h, w, 4) for t in range(TEXTURES)])
+
     def _read_shifted(self, box=None, side=None) -> np.ndarray:
         """Stored g (9, h, w) float32 over box (x0, y0, x1, y1), default the whole grid, of the
         current ping-pong side (or `side`)."""
         x0, y0, x1, y1 = box or (0, 0, self.nx, self.ny)
-        w, h = x1 - x0, y1 - y0
-        fbo = self._fbo[self._cur if side is None else side]
-        g = np.empty((12, h, w), dtype="f4")
-        for k in range(3):
-            data = fbo.read(viewport=(x0, y0, w, h), components=4, attachment=k, dtype="f4")
-            g[4 * k:4 * k + 4] = np.moveaxis(np.frombuffer(data, dtype="f4").reshape(h, w, 4), -1, 0)
-        return g[:Q]
+        lo = x0 - 2 * (x0 // 2)
+        return np.ascontiguousarray(self._read_texels(texel_box((x0, y0, x1, y1)), side)[:, :, lo:lo + x1 - x0])
 
     def _write_shifted(self, g: np.ndarray, box=None) -> None:
+        """Store g (9, h, w) over box in the current side; a box that starts or ends inside a
+        texel keeps the other node of that texel (read, merged, written back)."""
         x0, y0, x1, y1 = box or (0, 0, self.nx, self.ny)
-        w, h = x1 - x0, y1 - y0
-        padded = np.zeros((12, h, w), dtype="f4")
-        padded[:Q] = g
-        for k in range(3):
-            data = np.ascontiguousarray(np.moveaxis(padded[4 * k:4 * k + 4], 0, -1))
-            self._g[self._cur][k].write(data.tobytes(), viewport=(x0, y0, w, h))
+        k0, _, k1, _ = kbox = texel_box((x0, y0, x1, y1))
+        lo = x0 - 2 * k0
+        if lo or (x1 - x0 + lo) % 2 and x1 < self.nx:
+            nodes = self._read_texels(kbox)
+        else:
+            nodes = np.zeros((Q, y1 - y0, 2 * (k1 - k0)), np.float32)
+        nodes[:, :, lo:lo + x1 - x0] = g
+        for t, data in enumerate(pack(nodes)):
+            self._g[self._cur][t].write(np.ascontiguousarray(data).tobytes(), viewport=(k0, y0, k1 - k0, y1 - y0))
 
     def shifted_distributions(self) -> np.ndarray:
         return self._read_shifted()

@@ -6,6 +6,11 @@ Every file in `shaders/` is one shader stage whose line 1 is the `#version` dire
 compile-time `#define`s a variant asks for; a `#line` directive after the injected block puts
 the driver's line numbers back on the file's own lines, so a compile error reported by the
 driver as "0:57(3)" is line 57 of the file. `ShaderError` names the file and that line.
+
+A line `// @INCLUDE name.glsl` is replaced by that file of `shaders/` (its `#version` line
+dropped): GLSL code two programs share, e.g. the texture layout of the populations
+(`paired_layout.glsl`). `#line` directives give each included file its own source-string
+number, which `ShaderError` turns back into the included file's name and line.
 """
 from __future__ import annotations
 
@@ -16,18 +21,17 @@ from solver.lattice import glsl_constants
 
 SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
 MARKER = "// @LATTICE"
+INCLUDE = "// @INCLUDE "
 #: what line 1 of every shader must declare after `#version`
 GLSL_VERSION = "330 core"
-_DRIVER_LINE = re.compile(r"^\s*\d+:(\d+)\((\d+)\):\s*(.*)$")
+_DRIVER_LINE = re.compile(r"^\s*(\d+):(\d+)\((\d+)\):\s*(.*)$")
 
 
 class ShaderError(RuntimeError):
     """A shader failed to load or compile; the message starts with `file:line:`."""
 
 
-def shader_source(name: str, defines: dict | None = None, directory: Path = SHADER_DIR) -> str:
-    """The text of `shaders/<name>` with constants and defines injected at the marker."""
-    path = Path(directory) / name
+def _read_lines(path: Path) -> list[str]:
     try:
         text = path.read_text()
     except OSError as exc:
@@ -35,25 +39,44 @@ def shader_source(name: str, defines: dict | None = None, directory: Path = SHAD
     lines = text.splitlines()
     if not lines or lines[0].split(None, 1) != ["#version", GLSL_VERSION]:
         raise ShaderError(f"{path}:1: the first line must be the #version directive for GLSL {GLSL_VERSION}")
+    return lines
+
+
+def shader_source(name: str, defines: dict | None = None, directory: Path = SHADER_DIR,
+                  sources: list | None = None) -> str:
+    """The text of `shaders/<name>` with constants and defines injected at the marker and
+    included files in place; `sources`, when given, receives the file of each source-string
+    number (0: `name` itself)."""
+    path = Path(directory) / name
+    files = [path] if sources is None else sources
+    files[:] = [path]
     out = []
-    for number, line in enumerate(lines, start=1):
+    for number, line in enumerate(_read_lines(path), start=1):
         if line.strip() == MARKER:
             out.extend(f"#define {k} {int(v) if isinstance(v, bool) else v}" for k, v in (defines or {}).items())
             out.append(glsl_constants())
-            out.append(f"#line {number + 1}")
+            out.append(f"#line {number + 1} 0")
+        elif line.startswith(INCLUDE):
+            included = Path(directory) / line[len(INCLUDE):].strip()
+            files.append(included)
+            out.append(f"#line 2 {len(files) - 1}")
+            out.extend(_read_lines(included)[1:])
+            out.append(f"#line {number + 1} 0")
         else:
             out.append(line)
     return "\n".join(out) + "\n"
 
 
-def _explain(path: Path, log: str) -> str:
-    """Turn the driver's log into 'file:line:col: message' lines."""
+def _explain(files: list, log: str) -> str:
+    """Turn the driver's log into 'file:line:col: message' lines (files: by source number)."""
     messages = []
     for raw in log.splitlines():
         m = _DRIVER_LINE.match(raw)
         if m:
-            messages.append(f"{path}:{m.group(1)}:{m.group(2)}: {m.group(3)}")
-    return "\n".join(messages) if messages else f"{path}: {log.strip()}"
+            k = int(m.group(1))
+            where = files[k] if k < len(files) else files[0]
+            messages.append(f"{where}:{m.group(2)}:{m.group(3)}: {m.group(4)}")
+    return "\n".join(messages) if messages else f"{files[0]}: {log.strip()}"
 
 
 def create_program(ctx, vertex: str, fragment: str, defines: dict | None = None,
@@ -62,14 +85,15 @@ def create_program(ctx, vertex: str, fragment: str, defines: dict | None = None,
 
     Raises ShaderError whose first line is `<file>:<line>:<col>: <driver message>`.
     """
-    vs = shader_source(vertex, defines, directory)
-    fs = shader_source(fragment, defines, directory)
+    vs_files, fs_files = [], []
+    vs = shader_source(vertex, defines, directory, vs_files)
+    fs = shader_source(fragment, defines, directory, fs_files)
     try:
         return ctx.program(vertex_shader=vs, fragment_shader=fs)
     except Exception as exc:  # moderngl raises a plain Error with the driver's log
         log = str(exc)
-        stage = fragment
+        files = fs_files
         if "vertex_shader\n" in log and "fragment_shader\n" not in log:
-            stage = vertex
+            files = vs_files
         body = log.split("===============", 1)[-1]
-        raise ShaderError(_explain(Path(directory) / stage, body)) from None
+        raise ShaderError(_explain(files, body)) from None

@@ -10,8 +10,8 @@ written per second) and reports each MLUPS as a fraction of the D2Q9 bound, 72 b
 and step (9 float32 read + 9 written). GPU work is timed up to `glFinish`.
 
 `--variants` instead compares the gl backend's tuning choices on the moving-cylinder tunnel,
-interleaved in the same run, with the periodic box and a two-nodes-per-fragment layout probe
-(solver/gl_layout_probe.py), and llvmpipe's thread count and SIMD width in subprocesses
+interleaved in the same run, with the periodic box, and llvmpipe's thread count and SIMD width in
+subprocesses
 (docs/performance.md). Figures from a shared machine are indicative.
 """
 from __future__ import annotations
@@ -184,10 +184,8 @@ def _format_row(r) -> str:
 
 # --- tuning variants (docs/performance.md) ---------------------------------------------------
 VARIANTS = {
-    "one program, texelFetch (no regions)": {"split": False, "fetch_normalized": 0},
-    "regions, texelFetch": {"split": True, "fetch_normalized": 0},
-    "regions, texture() + REPEAT": {"split": True, "fetch_normalized": 1},
-    "regions, textureOffset() + REPEAT, read back every step": {"check_every": 1, "window": "read"},
+    "one program for every node (no regions)": {"split": False},
+    "regions, read back every step": {"check_every": 1, "window": "read"},
     "default, force window read right after each step": {"window": "read"},
     "blocks of 32, a pass per step copies the window to an atlas": {"window": "atlas"},
     "default: the step's own pass copies it to a band area": {},
@@ -209,7 +207,6 @@ def run_variants(quick: bool, seconds: float | None):
     and llvmpipe's thread count and vector width (subprocesses)."""
     from shapes import Cylinder
     from solver.gl_backend import GLSolver
-    from solver.gl_layout_probe import PairedLayoutProbe
 
     seconds = seconds if seconds is not None else (0.3 if quick else 1.0)
     rounds = 2 if quick else 5
@@ -224,8 +221,6 @@ def run_variants(quick: bool, seconds: float | None):
     no_force.solver.enable_force_models([])
     runs["default, no force model (no window readback)"] = no_force
     runs["empty periodic box (default)"] = SceneRun("box", GLSolver(scene_config("box", nx, ny), ctx=ctx))
-    runs["empty periodic box, layout probe: two nodes per fragment"] = SceneRun(
-        "box", PairedLayoutProbe(scene_config("box", nx, ny), ctx))
     wall = {name: [] for name in runs}
     per_cpu = {name: [] for name in runs}
     for run in runs.values():
