@@ -9,8 +9,9 @@ driver as "0:57(3)" is line 57 of the file. `ShaderError` names the file and tha
 
 A line `// @INCLUDE name.glsl` is replaced by that file of `shaders/` (its `#version` line
 dropped): GLSL code two programs share, e.g. the texture layout of the populations
-(`paired_layout.glsl`). `#line` directives give each included file its own source-string
-number, which `ShaderError` turns back into the included file's name and line.
+(`paired_layout.glsl`). The k-th included file's lines are numbered from k * INCLUDE_LINES
+by `#line` (Mesa attributes some errors to the wrong source-string number, never to the wrong
+line), which `ShaderError` turns back into the included file's name and line.
 """
 from __future__ import annotations
 
@@ -22,6 +23,8 @@ from solver.lattice import glsl_constants
 SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
 MARKER = "// @LATTICE"
 INCLUDE = "// @INCLUDE "
+#: line-number offset of each included file (file k starts at k * INCLUDE_LINES + 1)
+INCLUDE_LINES = 100000
 #: what line 1 of every shader must declare after `#version`
 GLSL_VERSION = "330 core"
 _DRIVER_LINE = re.compile(r"^\s*(\d+):(\d+)\((\d+)\):\s*(.*)$")
@@ -45,8 +48,8 @@ def _read_lines(path: Path) -> list[str]:
 def shader_source(name: str, defines: dict | None = None, directory: Path = SHADER_DIR,
                   sources: list | None = None) -> str:
     """The text of `shaders/<name>` with constants and defines injected at the marker and
-    included files in place; `sources`, when given, receives the file of each source-string
-    number (0: `name` itself)."""
+    included files in place; `sources`, when given, receives the files: index k is the file
+    whose lines are numbered from k * INCLUDE_LINES (0: `name` itself)."""
     path = Path(directory) / name
     files = [path] if sources is None else sources
     files[:] = [path]
@@ -55,27 +58,27 @@ def shader_source(name: str, defines: dict | None = None, directory: Path = SHAD
         if line.strip() == MARKER:
             out.extend(f"#define {k} {int(v) if isinstance(v, bool) else v}" for k, v in (defines or {}).items())
             out.append(glsl_constants())
-            out.append(f"#line {number + 1} 0")
+            out.append(f"#line {number + 1}")
         elif line.startswith(INCLUDE):
             included = Path(directory) / line[len(INCLUDE):].strip()
             files.append(included)
-            out.append(f"#line 2 {len(files) - 1}")
+            out.append(f"#line {(len(files) - 1) * INCLUDE_LINES + 2}")
             out.extend(_read_lines(included)[1:])
-            out.append(f"#line {number + 1} 0")
+            out.append(f"#line {number + 1}")
         else:
             out.append(line)
     return "\n".join(out) + "\n"
 
 
 def _explain(files: list, log: str) -> str:
-    """Turn the driver's log into 'file:line:col: message' lines (files: by source number)."""
+    """Turn the driver's log into 'file:line:col: message' lines (files: see shader_source)."""
     messages = []
     for raw in log.splitlines():
         m = _DRIVER_LINE.match(raw)
         if m:
-            k = int(m.group(1))
+            k, line = divmod(int(m.group(2)), INCLUDE_LINES)
             where = files[k] if k < len(files) else files[0]
-            messages.append(f"{where}:{m.group(2)}:{m.group(3)}: {m.group(4)}")
+            messages.append(f"{where}:{line}:{m.group(3)}: {m.group(4)}")
     return "\n".join(messages) if messages else f"{files[0]}: {log.strip()}"
 
 

@@ -56,3 +56,19 @@ def test_every_step_variant_compiles(gl_context):
                     defines = dict(BODY=body, EDGES=edges, TRT=1, GUO_FORCE=1, SPONGE=1, X_PERIODIC=y_mode == 2,
                                    Y_MODE=y_mode, DIVERGENCE_DISCARD=discard)
                     create_program(gl_context, "rect_vertex.glsl", "lbm_step.glsl", defines).release()
+
+
+def test_compile_error_in_an_included_file_names_that_file(gl_context, tmp_path):
+    """`// @INCLUDE name.glsl` (solver/gl_programs.py): a driver error inside the included file
+    is reported with that file's name and its own line number."""
+    (tmp_path / "rect_vertex.glsl").write_text((SHADER_DIR / "rect_vertex.glsl").read_text())
+    (tmp_path / "part.glsl").write_text("#version 330 core\n// shared part\nfloat helper() {\n"
+                                        "    return undeclared_in_part;\n}\n")
+    (tmp_path / "main.glsl").write_text("#version 330 core\n// @LATTICE\n// @INCLUDE part.glsl\n"
+                                        "out vec4 colour;\nvoid main() { colour = vec4(helper()); }\n")
+    with pytest.raises(ShaderError) as err:
+        create_program(gl_context, "rect_vertex.glsl", "main.glsl", directory=tmp_path)
+    first = str(err.value).splitlines()[0]
+    m = re.match(r"^(.*part\.glsl):(\d+):(\d+): (.*)$", first)
+    assert m, first
+    assert int(m.group(2)) == 4 and "undeclared_in_part" in m.group(4)
