@@ -10,13 +10,15 @@
 // sides of a divergent branch, so each region of the grid is drawn by the variant it needs:
 //   BODY  1: rule 1a (Bouzidi links with the moving-wall term) and solid nodes (body window);
 //   EDGES 1: rules 1b-1e (walls, inlet, pressure outlet, periodic wrap) (edge strips); streams
-//     node by node through texelFetch with an explicit wrap;
+//     like the fast path where the REPEAT samplers wrap right (a tunnel: what crosses the inlet
+//     or outlet is replaced by rules c, d; or an even nx), else node by node with an explicit
+//     wrap (x-periodic with an odd nx);
 //   both 0: the fast path, plain streaming (rule 1f) for the interior: both nodes streamed by
 //     stream_pair, whose fetches the directions with the same row offset share (12 for two
 //     nodes, 9 per node before), through textureOffset() at normalized coordinates and REPEAT
 //     samplers (a fully periodic grid of even width wraps for free).
 //   TRT, GUO_FORCE, SPONGE: collision operator, Guo body force, outlet sponge (per-column rates).
-//   X_PERIODIC 0/1; Y_MODE 0 no_slip, 1 free_slip, 2 periodic.
+//   X_PERIODIC 0/1; Y_MODE 0 no_slip, 1 free_slip, 2 periodic; NX_ODD: nx is odd.
 //   DIVERGENCE_DISCARD 1: a node with a non-finite density discards its fragment (an
 //     occlusion-query divergence check; measured slower than the tile check, not the default).
 // @LATTICE
@@ -77,7 +79,7 @@ void stream_pair(out float a[9], out float b[9]) {
     a[2] = s.x; b[2] = s.y; a[4] = n.z; b[4] = n.w;
 }
 
-#if EDGES
+#if EDGES && X_PERIODIC && NX_ODD
 // node x, plain streaming with the periodic wrap (rules 1e, 1f); what the wrap brings in across
 // a non-periodic edge is replaced by rules b-d
 void stream_node(ivec2 x, out float g[9]) {
@@ -275,7 +277,7 @@ void main() {
     ivec2 xb = xa + ivec2(1, 0);
     float a[9];
     float b[9];
-#if EDGES
+#if EDGES && X_PERIODIC && NX_ODD
     stream_node(xa, a);
     stream_node(xb, b);
 #else
@@ -286,10 +288,10 @@ void main() {
     float own_b[9];
     load_pair(k, own_a, own_b);
     float west_a[9];
-#if EDGES
-    load_node(wrap(xa - ivec2(1, 0)), west_a);
+#if EDGES && !X_PERIODIC && NX_ODD
+    load_node(wrap(xa - ivec2(1, 0)), west_a);  // the outlet node nx - 1 is an a node
 #else
-    west_a = own_a;  // not used without EDGES
+    west_a = own_a;  // not used: without EDGES, x-periodic, or the outlet node is a b node
 #endif
     node_update(xa, a, own_a, west_a);
     node_update(xb, b, own_b, own_a);

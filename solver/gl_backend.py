@@ -135,7 +135,8 @@ class GLSolver(Solver):
 
     name = "gl"
     #: default tuning (docs/performance.md measures each choice)
-    TUNING = {"split": True, "divergence": "tiles", "check_every": CHECK_EVERY, "window": "state"}
+    TUNING = {"split": True, "divergence": "tiles", "check_every": CHECK_EVERY, "window": "state",
+              "draw": "scissor"}
 
     def __init__(self, config, ctx=None, tuning: dict | None = None):
         super().__init__(config)
@@ -153,6 +154,7 @@ class GLSolver(Solver):
             "GUO_FORCE": any(c != 0.0 for c in cfg.body_force),
             "X_PERIODIC": cfg.x_boundary == "periodic",
             "Y_MODE": _Y_MODE[cfg.y_boundary],
+            "NX_ODD": nx % 2 == 1,
             "DIVERGENCE_DISCARD": self.tuning["divergence"] == "discard",
         }
         self._defines = defines
@@ -285,20 +287,39 @@ class GLSolver(Solver):
         return bool(d["X_PERIODIC"] and d["Y_MODE"] == 2 and self.nx % 2 == 0 and not self._sponge)
 
     def _set_rects(self, window):
-        """Vertex data of every region (see _regions), drawn in this order each step; kept
-        when the (block-aligned) regions did not change."""
+        """Draws of every region (see _regions), in this order each step; kept when the
+        (block-aligned) regions did not change. Default (tuning draw="scissor"): per rectangle,
+        one triangle covering the texture, clipped by the scissor box to the rectangle, so every
+        4x4 block inside is fully covered; drawn as two triangles (draw="triangles"), the 4x4
+        blocks along the diagonal are shaded twice, once per triangle, which doubles the cost
+        of the 4-texel edge strips (docs/performance.md)."""
         regions = sorted(self._regions(window).items())
         if regions == self._draw_regions:
             return
         self._draw_regions = regions
-        for vao, vbo in self._draws:
+        for vao, vbo, _ in self._draws:
             vao.release()
             vbo.release()
         self._draws = []
+        w, h = self._tex_size
         for key, rects in regions:
-            vbo = self.ctx.buffer(_triangles(rects).tobytes())
+            if self.tuning["draw"] == "scissor":
+                data, scissors = _triangles([(0, 0, 2 * w, 2 * h)])[[0, 1, 5]], rects
+            else:
+                data, scissors = _triangles(rects), None
+            vbo = self.ctx.buffer(data.tobytes())
             vao = self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")])
-            self._draws.append((vao, vbo))
+            self._draws.append((vao, vbo, scissors))
+
+    def _render_regions(self):
+        for vao, _, scissors in self._draws:
+            if scissors is None:
+                vao.render(moderngl.TRIANGLES)
+                continue
+            for x0, y0, x1, y1 in scissors:
+                self.ctx.scissor = (x0, y0, x1 - x0, y1 - y0)
+                vao.render(moderngl.TRIANGLES, vertices=3)
+        self.ctx.scissor = None
 
     def _upload_body_uniforms(self):
         b = self.body
@@ -352,11 +373,9 @@ class GLSolver(Solver):
         if self._discard:
             query = self._idle_queries.pop() if self._idle_queries else self.ctx.query(samples=True)
             with query:
-                for vao, _ in self._draws:
-                    vao.render(moderngl.TRIANGLES)
+                self._render_regions()
         else:
-            for vao, _ in self._draws:
-                vao.render(moderngl.TRIANGLES)
+            self._render_regions()
         if slot is not None:
             vao, _, (cols, ww, wh) = self._band_copy
             k0, y0 = texel_box(self.body.window)[:2]
@@ -767,7 +786,7 @@ class GLSolver(Solver):
         return tex
 
     def close(self) -> None:
-        for obj in [*(o for d in self._draws for o in d), *self._objects, *self._programs.values()]:
+        for obj in [*(o for d in self._draws for o in d[:2]), *self._objects, *self._programs.values()]:
             obj.release()
         self._draws, self._objects, self._programs = [], [], {}
         self._field = None

@@ -189,6 +189,7 @@ VARIANTS = {
     "default, force window read right after each step": {"window": "read"},
     "blocks of 32, a pass per step copies the window to an atlas": {"window": "atlas"},
     "default: the step's own pass copies it to a band area": {},
+    "default, regions as two triangles each, not scissored": {"draw": "triangles"},
     "default, divergence by discard + occlusion query": {"divergence": "discard"},
 }
 #: step variants (body, edges, sponge) whose cost per node the variants run measures
