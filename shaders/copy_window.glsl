@@ -4,12 +4,7 @@
 // attachments, as the state), one per step, so that the windows of a whole `step(n)` are read
 // back at once instead of once per step (a read stalls llvmpipe's queue).
 // @LATTICE
-
-uniform sampler2D G0;
-uniform sampler2D G1;
-uniform sampler2D G2;
-uniform sampler2D G3;
-uniform sampler2D G4;
+// @INCLUDE paired_layout.glsl
 uniform ivec2 shift;   // state texel = target texel + shift
 
 layout(location = 0) out vec4 out0;
