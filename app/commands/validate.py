@@ -95,7 +95,7 @@ def run_case(name: str, factory, resolution, quick: bool, backend: str):
 def main(args) -> int:
     from app.commands.run import positive_int_option
     from app.headless import make_solver
-    from solver.validation import CASES
+    from solver.validation import CASES, case_module
 
     names = args.case or list(CASES)
     for name in names:
@@ -120,6 +120,10 @@ def main(args) -> int:
     machine = machine_description()
     print(f"\nFeelFlow validation, backend {args.backend}, on {machine}\n")
     print(format_table(results))
+    for r in results:   # a case may add its own tables (e.g. the stability map)
+        details = getattr(case_module(r.name), "format_details", None)
+        if details is not None and details(r):
+            print("\n" + details(r))
     failed = [r.name for r in results if not r.passed]
     print(f"\n{len(results) - len(failed)} of {len(results)} cases meet their targets"
           + (f"; not met: {', '.join(failed)}" if failed else ""))

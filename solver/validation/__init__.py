@@ -15,6 +15,7 @@ CASES: dict[str, str] = {
     "schaefer-turek-2d2": "solver.validation.schaefer_turek_2d2",
     "galilean": "solver.validation.galilean",
     "mass": "solver.validation.mass",
+    "stability": "solver.validation.stability",
 }
 
 

@@ -48,6 +48,7 @@ class CaseResult:
     node_updates: int = 0
     wall_seconds: float = 0.0
     notes: str = ""
+    details: dict = field(default_factory=dict)   # case-specific extra data for the JSON (maps, series)
 
     @property
     def mlups(self) -> float:
@@ -71,6 +72,7 @@ class CaseResult:
                                      "met": self.check_results()[c.quantity]} for c in self.checks},
             "passed": self.passed, "steps": self.steps, "wall_seconds": round(self.wall_seconds, 3),
             "mlups": clean(round(self.mlups, 3)), "notes": self.notes,
+            **({"details": self.details} if self.details else {}),
         }
 
 

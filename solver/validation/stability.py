@@ -1,0 +1,304 @@
+"""Where the scheme stays stable on the hard cases a classroom produces: a scan of viscosity nu
+against wind speed U, per hard scene and collision operator, on the window's grid.
+
+Scenes (grid 192 x 96, the window's tunnel: velocity inlet, pressure outlet with its 32-cell
+sponge, no-slip walls, float32; the body of size `d` at the window's start point (0.3 nx, ny/2)):
+  plate45            - a flat plate d long and 0.5 cells thick (thinner than a cell) at 45 deg,
+                       fixed, the wind blowing everywhere from the first step (the window's start);
+  cylinder_impulsive - a cylinder, fluid at rest, the inflow switched on at full speed (no ramp);
+  cylinder_shaken    - a cylinder moved back and forth along the stream over one diameter and
+                       spun, its fastest surface point at the Mach cap `FlowConfig.max_speed`
+                       (what a student's fast drag and wheel do), in the running wind;
+  wedge_upstream     - the 60-degree wedge pointing upstream, fixed, wind everywhere.
+
+A point (scene, collision, U, nu) is *stable* when the run lasts `CONVECTIVE_TIMES` d / U steps
+without `SolverDiverged` and with max |u| below `U_BOUND` (a bounded flow: twice the largest
+wind); else it is *diverged* (the solver's check) or *unbounded*. Stability falls as nu falls,
+so each (scene, collision, U) bisects the ordered viscosities for the smallest stable one
+(points not run are inferred from that order and marked so in the map).
+
+The limit is reported as a grid Reynolds number Re_cell = U / nu: the lowest Re_cell at which a
+run failed and the highest at which all runs at that speed were stable. Whether Re_cell or
+Re_D = U d / nu describes it is measured too: the full scan repeats the most restrictive
+fixed-body scene with d = 10 and 40 (`size_check`); if the failing Re_cell stays put while d
+changes four-fold, the limit is a cell (grid) Reynolds number, not a body one.
+
+Background: BGK loses stability as tau -> 1/2 at finite Mach number (Krueger et al. 2017,
+sec. 4.5 and 10.7: the lattice Reynolds number U dx / nu bounds the resolvable flow);
+TRT (Ginzburg 2008) relaxes the odd moments separately and stays stable further.
+
+`feelflow validate --case stability [--backend gl] [--json PATH]` runs the full scan;
+`--quick` runs `QUICK_POINTS` (the default test suite's): one point per hard case inside the
+window's guarded region (must stay finite and bounded) and one far outside (must diverge).
+The constants the window uses live in `solver/stability_limit.py`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from solver.backend import SolverDiverged
+from solver.config import FlowConfig
+from solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
+
+NAME = "stability"
+DEFAULT_RESOLUTION = 20   # body size d in cells (the window's default)
+QUICK_RESOLUTION = 20
+GRID = (192, 96)
+SPONGE_CELLS = 32
+SCENES = ("plate45", "cylinder_impulsive", "cylinder_shaken", "wedge_upstream")
+COLLISIONS = ("bgk", "trt")
+VISCOSITIES = (0.002, 0.003, 0.004, 0.006, 0.008, 0.012, 0.018, 0.027, 0.04)
+SPEEDS = (0.02, 0.035, 0.05, 0.07, 0.09)
+SIZE_CHECK = (10, 40)
+CONVECTIVE_TIMES = 6.0
+U_BOUND = 0.35          # 0.6 c_s: far beyond any physical speed here (wind + body <= 0.19); a runaway
+CHECK_EVERY = 100        # steps between the max |u| checks
+PLATE_THICKNESS = 0.5
+PLATE_ANGLE_DEG = 45.0
+WEDGE_APEX_DEG = 60.0
+
+
+@dataclass
+class Point:
+    scene: str
+    collision: str
+    speed: float
+    nu: float
+    size: int
+    state: str = ""            # stable | diverged | unbounded (measured) or inferred-stable/-unstable
+    steps: int = 0             # steps run (up to the failure)
+    max_u: float = float("nan")
+
+    @property
+    def re_cell(self) -> float:
+        return self.speed / self.nu
+
+    @property
+    def stable(self) -> bool:
+        return self.state in ("stable", "inferred-stable")
+
+    def to_dict(self) -> dict:
+        return {"scene": self.scene, "collision": self.collision, "u": self.speed, "nu": self.nu,
+                "size": self.size, "re_cell": round(self.re_cell, 4), "state": self.state, "steps": self.steps,
+                "max_u": None if not math.isfinite(self.max_u) else round(self.max_u, 5)}
+
+
+def scene_config(scene: str, collision: str, speed: float, nu: float, grid=GRID) -> FlowConfig:
+    nx, ny = grid
+    start = (0.0, 0.0) if scene == "cylinder_impulsive" else (speed, 0.0)
+    return FlowConfig(nx=nx, ny=ny, nu=nu, collision=collision, dtype="float32", x_boundary="tunnel",
+                      y_boundary="no_slip", inflow_speed=speed, inflow_ramp_steps=0, initial_velocity=start,
+                      sponge_cells=min(SPONGE_CELLS, nx // 4)).validate()
+
+
+def scene_body(scene: str, size: float, grid=GRID):
+    from shapes import Cylinder, FlatPlate, Wedge
+
+    x, y = 0.3 * grid[0], 0.5 * grid[1]
+    if scene == "plate45":
+        return FlatPlate(size, PLATE_THICKNESS, x, y, math.radians(PLATE_ANGLE_DEG))
+    if scene == "wedge_upstream":
+        return Wedge(size, math.radians(WEDGE_APEX_DEG), "upstream", x, y)
+    if scene in ("cylinder_impulsive", "cylinder_shaken"):
+        return Cylinder(size, x, y)
+    raise ValueError(f"unknown stability scene {scene!r}; choose from {', '.join(SCENES)}")
+
+
+def _max_speed(solver) -> float:
+    _, ux, uy = solver.macroscopic()
+    s = np.hypot(ux, uy)
+    return float(np.nanmax(s)) if np.isfinite(s).all() else float("inf")
+
+
+def run_point(make_solver: SolverFactory, scene: str, collision: str, speed: float, nu: float,
+              size: int = DEFAULT_RESOLUTION, watch: Stopwatch | None = None,
+              convective_times: float = CONVECTIVE_TIMES, grid=GRID, u_bound: float = U_BOUND) -> Point:
+    """Run one point; its state is stable, diverged (SolverDiverged) or unbounded (max |u| above
+    `u_bound`; pass math.inf to count only the solver's own divergence check)."""
+    config = scene_config(scene, collision, speed, nu, grid)
+    body = scene_body(scene, size, grid)
+    watch = watch or Stopwatch()
+    steps = int(math.ceil(convective_times * size / speed))
+    point = Point(scene, collision, speed, nu, size)
+    solver = make_solver(config)
+    try:
+        if scene == "cylinder_shaken":
+            _shake(solver, body, steps, point, watch, u_bound)
+        else:
+            solver.set_body(body)
+            _run(solver, steps, point, watch, lambda n: watch.step(solver, n), u_bound)
+    finally:
+        solver.close()
+    return point
+
+
+def _run(solver, steps, point, watch, advance, u_bound):
+    done = 0
+    point.max_u = 0.0
+    try:
+        while done < steps:
+            n = min(CHECK_EVERY, steps - done)
+            advance(n)
+            done += n
+            point.max_u = max(point.max_u, _max_speed(solver))
+            if point.max_u > u_bound:
+                point.state, point.steps = "unbounded", done
+                return
+    except SolverDiverged as exc:
+        point.state, point.steps, point.max_u = "diverged", exc.step + 1, float("inf")
+        return
+    point.state, point.steps = "stable", done
+
+
+def _shake(solver, body, steps, point, watch, u_bound):
+    """Back and forth along the stream over one diameter (centred on the start), spinning with
+    the direction of travel, at the Mach cap: asks for the cap in translation and in rotation;
+    `set_body` scales both so that the fastest surface point moves at exactly max_speed
+    (docs/algorithm.md 'Speed limit'), so each keeps half of it."""
+    cap = solver.config.max_speed
+    x0, y0, x1, y1 = body.bounding_box()
+    radius = math.hypot(0.5 * (x1 - x0), 0.5 * (y1 - y0))   # the cap's R: centre to a box corner
+    v = 0.5 * cap                                         # the capped translation speed
+    sweep = max(2, int(round(body.diameter / v)))          # steps per sweep of one diameter
+    state = {"x": body.x, "t": 0}
+
+    def advance(n):
+        for _ in range(n):
+            t = state["t"]
+            direction = -1.0 if ((t + sweep // 2) // sweep) % 2 == 0 else 1.0   # first against the stream
+            solver.set_body(body.moved(x=state["x"], y=body.y), velocity=(direction * cap, 0.0),
+                            omega=direction * cap / radius)
+            watch.step(solver, 1)
+            state["x"] += direction * v
+            state["t"] = t + 1
+
+    _run(solver, steps, point, watch, advance, u_bound)
+
+
+# --- the scan ---------------------------------------------------------------------------------
+def scan(make_solver: SolverFactory, scenes=SCENES, collisions=COLLISIONS, speeds=SPEEDS,
+         viscosities=VISCOSITIES, size: int = DEFAULT_RESOLUTION, watch: Stopwatch | None = None,
+         progress=None) -> list[Point]:
+    """Every (scene, collision, U, nu) point, run (no point is inferred)."""
+    points = []
+    for scene in scenes:
+        for collision in collisions:
+            for speed in speeds:
+                for nu in viscosities:
+                    p = run_point(make_solver, scene, collision, speed, nu, size, watch)
+                    points.append(p)
+                    if progress:
+                        progress(p)
+    return points
+
+
+def limits(points) -> dict:
+    """Per (scene, collision, size): the lowest Re_cell = U / nu at which a run failed, the
+    highest Re_cell below which every run was stable, and per speed the bracket of nu."""
+    out = {}
+    keys = sorted({(p.scene, p.collision, p.size) for p in points}, key=lambda k: (SCENES.index(k[0]), k[1], k[2]))
+    for key in keys:
+        group = [p for p in points if (p.scene, p.collision, p.size) == key]
+        failed = [p.re_cell for p in group if not p.stable]
+        fail = min(failed) if failed else math.inf
+        stable_below = max((p.re_cell for p in group if p.stable and p.re_cell < fail), default=0.0)
+        per_speed = {}
+        for u in sorted({p.speed for p in group}):
+            row = sorted((p for p in group if p.speed == u), key=lambda p: p.nu)
+            bad = [p.nu for p in row if not p.stable]
+            good = [p.nu for p in row if p.stable and (not bad or p.nu > max(bad))]
+            per_speed[u] = {"largest_failed_nu": max(bad) if bad else None,
+                            "smallest_stable_nu": min(good) if good else None,
+                            "monotone": all(p.stable for p in row if bad and p.nu > max(bad))
+                            and not any(p.stable for p in row if bad and p.nu < max(bad))}
+        out[key] = {"re_cell_failed": fail, "re_cell_stable": stable_below,
+                    "re_d_failed": fail * key[2], "per_speed": per_speed}
+    return out
+
+
+def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool = False,
+        backend: str = "numpy", progress=None) -> CaseResult:
+    from solver.stability_limit import MAX_CELL_REYNOLDS, SAFETY_MARGIN, min_stable_viscosity
+
+    size = resolution or DEFAULT_RESOLUTION
+    watch = Stopwatch()
+    if quick:
+        points = [run_point(make_solver, *qp, size=size, watch=watch) for qp in quick_points()]
+    else:
+        points = scan(make_solver, size=size, watch=watch, progress=progress)
+        worst = min(SCENES, key=lambda s: limits([p for p in points if p.scene == s and p.collision == "trt"])
+                    [(s, "trt", size)]["re_cell_failed"])
+        for d in SIZE_CHECK:   # does the limit move with the body size? (Re_cell or Re_D)
+            points += scan(make_solver, scenes=(worst,), collisions=("trt",), size=d, watch=watch,
+                           progress=progress)
+    result = CaseResult(NAME, backend, size)
+    guarded = []
+    for key, lim in limits(points).items():
+        tag = f"{key[0]}_{key[1]}" + ("" if key[2] == size else f"_d{key[2]}")
+        result.quantities[f"re_cell_failed_{tag}"] = lim["re_cell_failed"]
+        result.quantities[f"re_cell_stable_{tag}"] = lim["re_cell_stable"]
+    for p in points:   # every point the window would allow must have been stable
+        if p.nu >= min_stable_viscosity(p.speed, p.collision) - 1e-12:
+            guarded.append(p)
+    result.quantities["guarded_points"] = float(len(guarded))
+    result.quantities["guarded_points_stable"] = float(sum(p.stable for p in guarded))
+    result.quantities["guarded_all_stable"] = float(all(p.stable for p in guarded))
+    result.checks.append(Check("guarded_all_stable", 1.0, 1.0,
+                               "every point the window allows (U / nu <= margin x limit) stays stable"))
+    if quick:
+        outside = [p for p in points if p.nu < min_stable_viscosity(p.speed, p.collision)]
+        result.quantities["outside_points_failed"] = float(sum(not p.stable for p in outside))
+        result.quantities["outside_all_failed"] = float(all(not p.stable for p in outside))
+        result.checks.append(Check("outside_all_failed", 1.0, 1.0, "the far-outside points must diverge"))
+    result.details = {"points": [p.to_dict() for p in points],
+                      "limits": [{"scene": k[0], "collision": k[1], "size": k[2],
+                                  **{n: v for n, v in lim.items() if n != "per_speed"},
+                                  "per_speed": [{"u": u, **b} for u, b in lim["per_speed"].items()]}
+                                 for k, lim in limits(points).items()]}
+    result.notes = (f"{GRID[0]} x {GRID[1]} tunnel, float32, body size {size} cells, {CONVECTIVE_TIMES:g} d / U "
+                    f"steps per point; window limit Re_cell <= {SAFETY_MARGIN} x {MAX_CELL_REYNOLDS}")
+    return watch.fill(result)
+
+
+def quick_points():
+    """(scene, collision, U, nu) for the default test suite: per hard case, the window's own
+    corner (the highest wind at the lowest viscosity the guard allows, TRT as in the window)
+    and the panel's extreme corner (U = 0.09, nu = 0.002), far outside the measured region."""
+    from solver.stability_limit import min_stable_viscosity
+
+    u = max(SPEEDS)
+    out = []
+    for scene in SCENES:
+        out.append((scene, "trt", u, min_stable_viscosity(u, "trt")))
+        out.append((scene, "trt", u, min(VISCOSITIES)))
+    return out
+
+
+def format_details(result: CaseResult) -> str:
+    """The stable / failed map per scene and collision (rows U, columns nu) and the limits."""
+    points = [Point(d["scene"], d["collision"], d["u"], d["nu"], d["size"], d["state"], d["steps"])
+              for d in result.details.get("points", [])]
+    if not points:
+        return ""
+    mark = {"stable": "s", "diverged": "**D**", "unbounded": "**U**"}
+    lines = ["Stability map (s stable, **D** diverged, **U** unbounded max |u| > "
+             f"{U_BOUND}); cell Reynolds number Re_cell = U / nu:", ""]
+    nus = sorted({p.nu for p in points})
+    lines.append("| scene | collision | d | U \\ nu | " + " | ".join(f"{n:g}" for n in nus) + " |")
+    lines.append("| --- | --- | --- | --- | " + " | ".join("---" for _ in nus) + " |")
+    lim = limits(points)
+    for key in lim:
+        group = [p for p in points if (p.scene, p.collision, p.size) == key]
+        for u in sorted({p.speed for p in group}):
+            cells = {p.nu: mark.get(p.state, p.state) for p in group if p.speed == u}
+            lines.append(f"| {key[0]} | {key[1]} | {key[2]} | {u:g} | "
+                         + " | ".join(cells.get(n, "") for n in nus) + " |")
+    lines += ["", "| scene | collision | d | lowest failing Re_cell | highest all-stable Re_cell | "
+              "lowest failing Re_D |", "| --- | --- | --- | --- | --- | --- |"]
+    for key, v in lim.items():
+        lines.append(f"| {key[0]} | {key[1]} | {key[2]} | {v['re_cell_failed']:.3g} | {v['re_cell_stable']:.3g} | "
+                     f"{v['re_d_failed']:.4g} |")
+    return "\n".join(lines)
