@@ -199,6 +199,7 @@ class MainWindow(QMainWindow):
         self.status["renderer"].setToolTip(self.viewport.renderer())
         self._upload_field()
         self.refresh_devices()
+        self._say_guard()
         self.timer.start()
         self.slow_timer.start()
         self.refresh_readouts()
@@ -485,6 +486,8 @@ class MainWindow(QMainWindow):
             self._refuse("This shape cannot be used", exc)
             return False
         self.panel.show_params(self.sim.params, self.display_mode)
+        if self._say_guard():
+            self._after_rebuild()
         self.viewport.update()
         return True
 
@@ -516,7 +519,16 @@ class MainWindow(QMainWindow):
         except ConfigError as exc:
             self._refuse("This flow setting cannot be used", exc)
             return
+        if self._say_guard():
+            self.panel.show_params(self.sim.params, self.display_mode)
         self._after_rebuild()
+
+    def _say_guard(self) -> bool:
+        """Show in the status bar what the stability guard changed (app.simulation.stable_params)."""
+        note = self.sim.guard_note if self.sim is not None else None
+        if note:
+            self.statusBar().showMessage(note, 10000)
+        return bool(note)
 
     def set_grid(self, grid):
         if self.sim is None or self._refuse_in_replay("the grid is the recording's"):
@@ -937,7 +949,8 @@ class MainWindow(QMainWindow):
         if sim is None:
             return
         p = sim.params
-        if sim is self.sim and abs(self.panel.wind.value() - p.wind) > 5e-4:   # a sweep or a lesson changed it
+        if sim is self.sim and (abs(self.panel.wind.value() - p.wind) > 5e-4   # a sweep, a lesson or the guard
+                                or abs(self.panel.viscosity.value() - p.nu) > 5e-5):
             self.panel.show_params(p, self.display_mode)
         self.panel.show_numbers(sim.reynolds(), sim.mach(), sim.config.mach_limit)
         t, drag, lift = sim.history.drag_lift(p.force_model)

@@ -35,7 +35,7 @@ PRESETS = {
     "lift": Lesson("Lift on the half airfoil", "lift.toml", display="pressure",
                    note="Flat side down: the blue lift arrow points up."),
     "vortex_street": Lesson("Vortex street behind a cylinder", "vortex_street.toml", display="vorticity",
-                            note="Re 200: the wake starts to swing after a few thousand steps."),
+                            note="Re 90 (the most this grid keeps stable here): the wake starts to swing after several thousand steps."),
     "seed_protocol": Lesson("The seed's experiment: stopped, with, against the stream", "seed_protocol.toml",
                             hold_still=False,
                             note="Four phases of 2500 steps: stopped, with the stream, stopped, against it."),

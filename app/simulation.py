@@ -15,6 +15,7 @@ from app.session import SessionSolver
 from solver.backend import create_solver
 from solver.config import FlowConfig
 from solver.motion import MotionRunner
+from solver.stability_limit import inside, min_stable_viscosity
 
 #: grid presets offered in the side panel: label -> (nx, ny)
 GRID_PRESETS = {
@@ -130,8 +131,24 @@ def phase_name(velocity, wind: float) -> str:
     return f"moving at ({vx:.3f}, {vy:.3f})"
 
 
+def stable_params(params: Params, collision: str) -> tuple[Params, str | None]:
+    """`params` kept inside the measured stable region (solver/stability_limit.py): where the
+    wind and body size over the viscosity, U sqrt(d) / nu, exceed what the scheme survives, the viscosity
+    is raised to the limit (the wind is what the student sees and feels, and what the lessons
+    step through; viscosity is the scheme's stability lever). Returns (params, plain sentence
+    for the status bar, or None when nothing changed)."""
+    if inside(params.wind, params.nu, collision, params.size):
+        return params, None
+    nu = math.ceil(min_stable_viscosity(params.wind, collision, params.size) * 1e4 - 1e-6) / 1e4   # 4 decimals
+    return replace(params, nu=nu), (f"Viscosity raised to {nu:.4f}: at wind {params.wind:.3f} past a "
+                                    f"{params.size:g}-cell body a thinner fluid makes this grid unstable "
+                                    f"(lower the wind or the size to go thinner).")
+
+
 class Simulation:
-    """Owns the solver and the body; `advance(n)` runs n steps and records one force sample."""
+    """Owns the solver and the body; `advance(n)` runs n steps and records one force sample.
+    The wind and viscosity it is given stay inside the measured stable region (`stable_params`);
+    `guard_note` says what the last change had to adjust (None when nothing)."""
 
     def __init__(self, params: Params | None = None, backend: str = "numpy", ctx=None, shape_factory=None,
                  base_config: FlowConfig | None = None):
@@ -149,6 +166,7 @@ class Simulation:
         self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
         self.base_config = base_config or default_base_config(self.params.grid)
         self._wind_starts_everywhere = base_config is None   # default tunnel: no ramp, see below
+        self.params, self.guard_note = stable_params(self.params, self.base_config.collision)
         self.sweep = None            # (wind speeds, steps each, first step): a wind-speed sweep
         self.capped = False          # the Mach cap limited the body's speed in the last frame
         self.solver = None
@@ -205,10 +223,15 @@ class Simulation:
         self.angle = self.angle_target = angle
         self._clamp_pose()
         self.solver.set_body(self.shape, self.vel, 0.0)
+        guarded, note = stable_params(self.params, self.base_config.collision)
+        if note:   # a larger body needs a thicker fluid at this wind
+            self.set_flow(nu=guarded.nu)
+        self.guard_note = note
 
     def set_flow(self, wind=None, nu=None, wall=None):
         """Change inflow speed, viscosity or walls, keeping the flow as it is (raises ConfigError)."""
         params = replace(self.params, **{k: v for k, v in (("wind", wind), ("nu", nu), ("wall", wall)) if v is not None})
+        params, self.guard_note = stable_params(params, self.base_config.collision)
         self.flow_config(params)  # validate first: a bad value leaves everything as it was
         only_wind = (params.nu, params.wall) == (self.params.nu, self.params.wall)
         self.params = params
@@ -277,6 +300,7 @@ class Simulation:
         self.params = replace(self.params, grid=(cfg.nx, cfg.ny), shape=kind, size=size or self.params.size,
                               angle_deg=math.degrees(scene.body.angle), wind=cfg.inflow_speed, nu=cfg.nu,
                               wall=cfg.y_boundary, force_model=models[0], compare_all=len(models) > 1)
+        self.params, self.guard_note = stable_params(self.params, cfg.collision)
         self.polygon = verts
         self.runner = None
         self.sweep = None

@@ -61,6 +61,7 @@ def main(args) -> int:
     from app.scene import load_scene
 
     scene = load_scene(args.scene)
+    warn_outside_stable_region(scene, args.scene)
     backend = args.backend if args.backend is not None else scene.backend
     steps = positive_int_option("--steps", args.steps) if args.steps is not None else scene.steps
     out = Path(args.out)
@@ -102,6 +103,28 @@ def main(args) -> int:
           f"Re {scene.reynolds:.4g} with L = {scene.reference_length:g} cells, U = {scene.reference_speed:g}, "
           f"Ma {scene.mach:.3f}); {wall:.1f} s, {mlups:.1f} MLUPS")
     return 0
+
+
+def warn_outside_stable_region(scene, name) -> bool:
+    """One line on stderr when the scene lies outside the measured stable region,
+    U sqrt(d) / nu <= K (solver/stability_limit.py); the scene is run as written (the window, by
+    contrast, raises the viscosity). U is the scene's reference speed (the inflow, or the fastest
+    motion phase in fluid at rest), d the body's larger bounding-box side (the scan's d: cylinder
+    diameter, plate or wedge length)."""
+    from solver.stability_limit import measured_cell_reynolds
+
+    cfg = scene.config
+    speed = abs(scene.reference_speed)
+    x0, y0, x1, y1 = scene.body.bounding_box()
+    size = max(x1 - x0, y1 - y0)
+    limit = measured_cell_reynolds(cfg.collision, size)
+    if speed / cfg.nu <= limit:
+        return False
+    print(f"feelflow: warning: {name}: U / nu = {speed / cfg.nu:.3g} is above {limit:.3g}, the measured stable "
+          f"cell Reynolds number for a {size:.3g}-cell body ({cfg.collision}, "
+          f"solver/stability_limit.py); the run may diverge (nu >= {speed / limit:.4g} keeps it inside)",
+          file=sys.stderr)
+    return True
 
 
 def run_scene(scene, solver, steps: int):

@@ -17,15 +17,18 @@ wind); else it is *diverged* (the solver's check) or *unbounded*. Stability fall
 so each (scene, collision, U) bisects the ordered viscosities for the smallest stable one
 (points not run are inferred from that order and marked so in the map).
 
-The limit is reported as a grid Reynolds number Re_cell = U / nu: the lowest Re_cell at which a
-run failed and the highest at which all runs at that speed were stable. Whether Re_cell or
-Re_D = U d / nu describes it is measured too: the full scan repeats the most restrictive
-fixed-body scene with d = 10 and 40 (`size_check`); if the failing Re_cell stays put while d
-changes four-fold, the limit is a cell (grid) Reynolds number, not a body one.
+The limit is reported per (scene, collision, d) as a grid Reynolds number Re_cell = U / nu:
+the lowest Re_cell at which a run failed and the highest below which every run was stable.
+Whether Re_cell or Re_D = U d / nu describes it is measured: the full scan repeats the most
+restrictive TRT scene with d = 10 and 40 (`SIZE_CHECK`). Measured (README, Validation): neither
+is constant; Re_cell sqrt(d) is, to 1 %, so solver/stability_limit.py states the limit as
+U sqrt(d) / nu <= K (`k_measured_<collision>` in the results).
 
-Background: BGK loses stability as tau -> 1/2 at finite Mach number (Krueger et al. 2017,
-sec. 4.5 and 10.7: the lattice Reynolds number U dx / nu bounds the resolvable flow);
-TRT (Ginzburg 2008) relaxes the odd moments separately and stays stable further.
+Background: LBM loses stability as tau -> 1/2 at finite Mach number (Krueger et al. 2017,
+sec. 4.5 and 10.7: the grid Reynolds number U dx / nu bounds the resolvable flow). TRT
+(Ginzburg 2008) with a fixed magic number Lambda = 3/16 sets tau- = 1/2 + Lambda / (tau+ - 1/2),
+which grows without bound as tau+ -> 1/2 (tau- = 32 at nu = 0.002): the odd (flux) moments are
+barely relaxed there, and on this scan TRT fails where BGK does not.
 
 `feelflow validate --case stability [--backend gl] [--json PATH]` runs the full scan;
 `--quick` runs `QUICK_POINTS` (the default test suite's): one point per hard case inside the
@@ -221,7 +224,7 @@ def limits(points) -> dict:
 
 def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool = False,
         backend: str = "numpy", progress=None) -> CaseResult:
-    from solver.stability_limit import MAX_CELL_REYNOLDS, SAFETY_MARGIN, min_stable_viscosity
+    from solver.stability_limit import SAFETY_MARGIN, STABLE_U_SQRT_D_OVER_NU, min_stable_viscosity
 
     size = resolution or DEFAULT_RESOLUTION
     watch = Stopwatch()
@@ -240,16 +243,19 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
         tag = f"{key[0]}_{key[1]}" + ("" if key[2] == size else f"_d{key[2]}")
         result.quantities[f"re_cell_failed_{tag}"] = lim["re_cell_failed"]
         result.quantities[f"re_cell_stable_{tag}"] = lim["re_cell_stable"]
+    for collision in sorted({p.collision for p in points}):   # the constant K of solver/stability_limit.py
+        result.quantities[f"k_measured_{collision}"] = min(
+            lim["re_cell_stable"] * math.sqrt(k[2]) for k, lim in limits(points).items() if k[1] == collision)
     for p in points:   # every point the window would allow must have been stable
-        if p.nu >= min_stable_viscosity(p.speed, p.collision) - 1e-12:
+        if p.nu >= min_stable_viscosity(p.speed, p.collision, p.size) - 1e-12:
             guarded.append(p)
     result.quantities["guarded_points"] = float(len(guarded))
     result.quantities["guarded_points_stable"] = float(sum(p.stable for p in guarded))
     result.quantities["guarded_all_stable"] = float(all(p.stable for p in guarded))
     result.checks.append(Check("guarded_all_stable", 1.0, 1.0,
-                               "every point the window allows (U / nu <= margin x limit) stays stable"))
+                               "every point the window allows (U sqrt(d) / nu <= margin x K) stays stable"))
     if quick:
-        outside = [p for p in points if p.nu < min_stable_viscosity(p.speed, p.collision)]
+        outside = [p for p in points if p.nu < min_stable_viscosity(p.speed, p.collision, p.size)]
         result.quantities["outside_points_failed"] = float(sum(not p.stable for p in outside))
         result.quantities["outside_all_failed"] = float(all(not p.stable for p in outside))
         result.checks.append(Check("outside_all_failed", 1.0, 1.0, "the far-outside points must diverge"))
@@ -259,7 +265,7 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
                                   "per_speed": [{"u": u, **b} for u, b in lim["per_speed"].items()]}
                                  for k, lim in limits(points).items()]}
     result.notes = (f"{GRID[0]} x {GRID[1]} tunnel, float32, body size {size} cells, {CONVECTIVE_TIMES:g} d / U "
-                    f"steps per point; window limit Re_cell <= {SAFETY_MARGIN} x {MAX_CELL_REYNOLDS}")
+                    f"steps per point; window limit U sqrt(d) / nu <= {SAFETY_MARGIN} x {STABLE_U_SQRT_D_OVER_NU}")
     return watch.fill(result)
 
 
@@ -272,7 +278,7 @@ def quick_points():
     u = max(SPEEDS)
     out = []
     for scene in SCENES:
-        out.append((scene, "trt", u, min_stable_viscosity(u, "trt")))
+        out.append((scene, "trt", u, min_stable_viscosity(u, "trt", DEFAULT_RESOLUTION)))
         out.append((scene, "trt", u, min(VISCOSITIES)))
     return out
 
@@ -297,8 +303,8 @@ def format_details(result: CaseResult) -> str:
             lines.append(f"| {key[0]} | {key[1]} | {key[2]} | {u:g} | "
                          + " | ".join(cells.get(n, "") for n in nus) + " |")
     lines += ["", "| scene | collision | d | lowest failing Re_cell | highest all-stable Re_cell | "
-              "lowest failing Re_D |", "| --- | --- | --- | --- | --- | --- |"]
+              "lowest failing Re_D | all-stable Re_cell sqrt(d) |", "| --- | --- | --- | --- | --- | --- | --- |"]
     for key, v in lim.items():
         lines.append(f"| {key[0]} | {key[1]} | {key[2]} | {v['re_cell_failed']:.3g} | {v['re_cell_stable']:.3g} | "
-                     f"{v['re_d_failed']:.4g} |")
+                     f"{v['re_d_failed']:.4g} | {v['re_cell_stable'] * math.sqrt(key[2]):.4g} |")
     return "\n".join(lines)
