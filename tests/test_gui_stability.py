@@ -24,8 +24,8 @@ def test_lowest_viscosity_at_highest_wind_runs_finite_and_says_so(window, qtbot)
     u = panel.wind.maximum()
     assert sim.params.wind == pytest.approx(u)          # the wind the student chose stays
     nu = sim.params.nu
-    assert nu > panel.viscosity.minimum() and inside(u, nu, sim.config.collision)
-    assert nu == pytest.approx(min_stable_viscosity(u, sim.config.collision), abs=1e-4)
+    assert nu > panel.viscosity.minimum() and inside(u, nu, sim.config.collision, sim.params.size)
+    assert nu == pytest.approx(min_stable_viscosity(u, sim.config.collision, sim.params.size), abs=1e-4)
     assert sim.config.nu == nu and panel.viscosity.value() == pytest.approx(nu)   # the panel shows it
     message = window.statusBar().currentMessage()
     assert message.startswith(f"Viscosity raised to {nu:.4f}") and message.count(". ") == 0, message
