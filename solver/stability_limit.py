@@ -13,10 +13,11 @@ size in cells):
   Re_cell sqrt(d) is (27.7 / 27.95 / 27.7). The fixed-body cases (plate, wedge, impulsive start)
   stay stable up to Re_cell = 10 at d = 20 (sqrt(d) Re_cell = 44.7) and fail from 11.25.
 * BGK: no point of the scan failed within 6 d / U (up to Re_cell = 45 at d = 20, the panel's
-  extreme corner), but runs of 30 d / U at that corner (U = 0.09, nu = 0.002) do fail: the thin
-  plate runs away after 2400 steps (10.8 d / U), the shaken cylinder diverges at step 3189. Its
-  limit is therefore not measured; BGK gets TRT's K, at which all four BGK cases ran 30 d / U
-  stably (U = 0.09, d = 20).
+  extreme corner), but runs of 30 d / U at that corner do fail (`python -m
+  solver.validation.stability --u 0.09 --nu 0.002 --collision bgk --convective-times 30`: the
+  thin plate runs away after 2400 steps, 10.8 d / U, the shaken cylinder diverges at step 3189).
+  Its limit is therefore not measured; BGK gets TRT's K, at which all four cases ran 30 d / U
+  stably with both operators (`... --u 0.09 --k 27.67 --collision bgk|trt --convective-times 30`).
 
 So the limit is `U sqrt(d) / nu <= K` with K per collision operator (the smallest measured
 Re_cell sqrt(d) below which every run was stable); below d = 10 (the smallest size scanned) the

@@ -127,7 +127,10 @@ def test_divergence_is_one_line_and_exit_1(tmp_path):
         "inflow_speed = 0.04", "inflow_speed = 0.095").replace("inflow_ramp_steps = 20", "inflow_ramp_steps = 0")
     scene = write(tmp_path, text.replace("[output]", "[run]\nsteps = 3000\n\n[output]"))
     result = feelflow("run", scene, "--out", tmp_path / "f.csv")
-    assert_one_line_error(result, "diverged", code=1)
+    # far outside the measured stable region: run warns first (one line), then the error (one line)
+    warning, error = result.stderr.strip("\n").split("\n")
+    assert warning.startswith("feelflow: warning:") and "stable" in warning
+    assert result.returncode == 1 and "diverged" in error and "Traceback" not in result.stderr
 
 
 def test_validate_prints_a_table_and_writes_json(tmp_path):

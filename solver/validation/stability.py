@@ -308,3 +308,35 @@ def format_details(result: CaseResult) -> str:
         lines.append(f"| {key[0]} | {key[1]} | {key[2]} | {v['re_cell_failed']:.3g} | {v['re_cell_stable']:.3g} | "
                      f"{v['re_d_failed']:.4g} | {v['re_cell_stable'] * math.sqrt(key[2]):.4g} |")
     return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    """`python -m solver.validation.stability --u 0.09 --nu 0.002 --collision bgk --convective-times 30`:
+    the four hard cases at one point for longer than the scan (numpy), one line each."""
+    import argparse
+    import warnings
+
+    from solver.backend import create_solver
+
+    parser = argparse.ArgumentParser(prog="python -m solver.validation.stability", description=main.__doc__)
+    parser.add_argument("--u", type=float, required=True, help="wind speed (cells per step)")
+    parser.add_argument("--nu", type=float, default=None, help="viscosity (default: --k gives it)")
+    parser.add_argument("--k", type=float, default=None, help="instead of --nu: nu = U sqrt(d) / K")
+    parser.add_argument("--collision", default="trt", choices=COLLISIONS)
+    parser.add_argument("--size", type=int, default=DEFAULT_RESOLUTION)
+    parser.add_argument("--convective-times", type=float, default=CONVECTIVE_TIMES)
+    args = parser.parse_args(argv)
+    if (args.nu is None) == (args.k is None):
+        parser.error("give --nu or --k")
+    nu = args.nu if args.nu is not None else args.u * math.sqrt(args.size) / args.k
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        warnings.simplefilter("ignore", RuntimeWarning)
+        for scene in SCENES:
+            p = run_point(lambda c: create_solver("numpy", c), scene, args.collision, args.u, nu, args.size,
+                          convective_times=args.convective_times)
+            print(p.to_dict(), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
