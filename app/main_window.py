@@ -27,8 +27,9 @@ from app.presets import PRESETS
 from app.bodies import default_polygon
 from app.shape_editor import SetPolygon
 from app.side_panel import SidePanel
-from app.simulation import Params, Simulation
-from app.viewport import DISPLAY_MODES, Viewport
+from app.simulation import Params, Simulation, wrap_degrees
+from app.turn_handle import TurnBody
+from app.viewport import DISPLAY_MODES, MOUSE_HINT, Viewport
 from shapes.base import ShapeError
 from solver.backend import SolverDiverged  # noqa: E402
 from solver.config import ConfigError
@@ -94,6 +95,9 @@ class MainWindow(QMainWindow):
         self.startup_error = None
         self.viewport.polygonEdited.connect(self.edit_polygon)
         self.viewport.inputRefused.connect(lambda: self._refuse_in_replay("the mouse does not move the body"))
+        self.viewport.turnRequested.connect(self.turn_body)
+        self.viewport.turnFinished.connect(self._turn_done)
+        self.viewport.turnRefused.connect(self._turn_refused)
         geometry = self.settings.value("geometry")
         if geometry is not None:
             self.restoreGeometry(geometry)
@@ -203,6 +207,8 @@ class MainWindow(QMainWindow):
         self.timer.start()
         self.slow_timer.start()
         self.refresh_readouts()
+        if not self.statusBar().currentMessage():   # a note about ignored settings comes first
+            self.statusBar().showMessage(MOUSE_HINT, 20000)
         self.simulationReady.emit()
 
     # --- menus and keys ---------------------------------------------------------------------
@@ -556,6 +562,37 @@ class MainWindow(QMainWindow):
             self.sim.hold_still = bool(on)
         self.panel.hold_still.setChecked(bool(on))
 
+    # --- turning the body (the viewport's rotation handle) ----------------------------------------
+    def turn_body(self, degrees: float) -> bool:
+        """Turn the body to `degrees` (any number of turns). While the flow runs it swings there
+        through the angle spring, as with the wheel; paused or held still it turns at once, as
+        with the panel's angle box. The panel shows the angle asked for."""
+        sim = self.sim
+        if sim is None or self._refuse_in_replay("the body follows the recording"):
+            return False
+        if self.paused or sim.hold_still:
+            if sim.angle != math.radians(wrap_degrees(degrees)):
+                self._make_current()
+                try:
+                    sim.set_shape(angle_deg=wrap_degrees(degrees))
+                except (ShapeError, ConfigError, ValueError) as exc:   # no dialog in the middle of a drag
+                    self.statusBar().showMessage(f"The body cannot turn there: {exc}", 4000)
+                    return False
+        else:
+            sim.turn_to(degrees)
+        self.panel.show_angle(sim.params.angle_deg)
+        self.viewport.update()
+        return True
+
+    def _turn_done(self, before: float, after: float):
+        """One drag of the handle: one undo step (pushing it applies `after`, where the body is)."""
+        if self.sim is not None and self.replay is None:
+            self.undo.push(TurnBody(self.turn_body, before, after))
+
+    def _turn_refused(self, driver: str):
+        how = "choose Mouse under Input" if self.input_device is not None else "wait for it to end or reset the flow (R)"
+        self.statusBar().showMessage(f"{driver} drives the body: the handle cannot rotate it now ({how}).", 6000)
+
     def set_display_mode(self, mode):
         self.display_mode = mode
         self.viewport.mode = mode
@@ -753,6 +790,7 @@ class MainWindow(QMainWindow):
             self._back_to_mouse("")
             return
         self.input_device.disconnected.connect(self._device_lost)
+        self.viewport.driver = "The haptic device"
         self.set_hold_still(False)
         self.panel.input_note.setText("The device moves the body; you feel the selected force model.")
 
@@ -779,6 +817,7 @@ class MainWindow(QMainWindow):
 
     def _close_device(self):
         device, self.input_device = self.input_device, None
+        self.viewport.driver = None
         if device is not None:
             device.close()
 
@@ -952,6 +991,8 @@ class MainWindow(QMainWindow):
         if sim is self.sim and (abs(self.panel.wind.value() - p.wind) > 5e-4   # a sweep, a lesson or the guard
                                 or abs(self.panel.viscosity.value() - p.nu) > 5e-5):
             self.panel.show_params(p, self.display_mode)
+        elif sim is self.sim and not self.panel.angle.hasFocus():   # the wheel or the handle turned the body
+            self.panel.show_angle(p.angle_deg)
         self.panel.show_numbers(sim.reynolds(), sim.mach(), sim.config.mach_limit)
         t, drag, lift = sim.history.drag_lift(p.force_model)
         if len(t) and p.force_model in sim.history.forces:

@@ -14,12 +14,14 @@ from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import QApplication
 
 
-def send_mouse(widget, kind, pos: QPointF, button=Qt.LeftButton):
-    """Deliver a synthetic mouse event to `widget` (what a real press/move/release does)."""
-    types = {"press": QEvent.MouseButtonPress, "move": QEvent.MouseMove, "release": QEvent.MouseButtonRelease}
-    buttons = Qt.NoButton if kind == "release" else button
-    ev = QMouseEvent(types[kind], pos, widget.mapToGlobal(pos), Qt.NoButton if kind == "move" else button,
-                     buttons, Qt.NoModifier)
+def send_mouse(widget, kind, pos: QPointF, button=Qt.LeftButton, modifiers=Qt.NoModifier):
+    """Deliver a synthetic mouse event to `widget` (what a real press/move/release does);
+    "hover" is a move with no button held."""
+    types = {"press": QEvent.MouseButtonPress, "move": QEvent.MouseMove, "hover": QEvent.MouseMove,
+             "release": QEvent.MouseButtonRelease}
+    buttons = Qt.NoButton if kind in ("release", "hover") else button
+    ev = QMouseEvent(types[kind], pos, widget.mapToGlobal(pos), Qt.NoButton if kind in ("move", "hover") else button,
+                     buttons, modifiers)
     QApplication.sendEvent(widget, ev)
 
 

@@ -60,6 +60,8 @@ class SidePanel(QScrollArea):
         self.size = QDoubleSpinBox(decimals=0, minimum=6, maximum=80, singleStep=2, suffix=" cells")
         self.angle = QDoubleSpinBox(decimals=0, minimum=-180, maximum=180, singleStep=5, suffix="\u00b0")
         self.angle.setWrapping(True)
+        self.angle.setToolTip("The body's angle; on the view, drag the round handle beside the body "
+                              "or turn the mouse wheel over it")
         self.hold_still = QCheckBox("Hold still")
         self.edit = QPushButton("Edit vertices")
         self.edit.setCheckable(True)
@@ -176,6 +178,12 @@ class SidePanel(QScrollArea):
                 w.blockSignals(False)
         self.edit.setEnabled(params.shape == "polygon")
         self.save_shape.setEnabled(True)
+
+    def show_angle(self, degrees: float):
+        """Show the body's angle without emitting angleChanged (the wheel or the handle turned it)."""
+        self.angle.blockSignals(True)
+        self.angle.setValue(degrees)
+        self.angle.blockSignals(False)
 
     def show_numbers(self, reynolds: float, mach: float, mach_limit: float):
         self.reynolds.setText(f"Re = {reynolds:.0f}")

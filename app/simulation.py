@@ -121,6 +121,11 @@ def drag_direction(wind):
     return out
 
 
+def wrap_degrees(degrees: float) -> float:
+    """An angle in [-180, 180): what the panel's angle box shows for any number of turns."""
+    return (degrees + 180.0) % 360.0 - 180.0
+
+
 def phase_name(velocity, wind: float) -> str:
     """Plain words for a scripted phase (SEED-NOTES 'Experiments')."""
     vx, vy = velocity
@@ -320,7 +325,14 @@ class Simulation:
         return bool(np.any(self.shape.contains(px, py)))
 
     def rotate_by(self, degrees: float):
-        self.angle_target += math.radians(degrees)
+        self.turn_to(math.degrees(self.angle_target) + degrees)
+
+    def turn_to(self, degrees: float):
+        """Ask for the angle `degrees` (any turn count: 190 turns 20 from 170, not 340 back):
+        the body swings there through the angle spring (rate capped below the Mach limit), and
+        the panel's angle (params.angle_deg, wrapped to [-180, 180)) says where it is going."""
+        self.angle_target = math.radians(degrees)
+        self.params = replace(self.params, angle_deg=wrap_degrees(degrees))
 
     # --- running --------------------------------------------------------------------------
     def relative_wind(self):

@@ -1,6 +1,7 @@
 """The wind tunnel view: a QOpenGLWidget whose moderngl context colours the flow field
 (shaders/display*.glsl, colormaps from pyqtgraph), with the body, its force arrows, tracers,
-the colour bar and the polygon editor's handles painted on top with QPainter.
+the colour bar, the polygon editor's handles and the rotation handle (app/turn_handle.py)
+painted on top with QPainter.
 
 GL pitfalls handled here (shared/notes/gl-qt-on-this-machine.md): detect_framebuffer in every
 paintGL, enable_only(NOTHING) before any pass, every texture bound before every draw.
@@ -14,10 +15,12 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import QPointF, QRectF, Qt, Signal
+from PySide6.QtCore import QEvent, QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QBrush, QColor, QFont, QLinearGradient, QPainter, QPen, QPolygonF
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
+from PySide6.QtWidgets import QToolTip
 
+from app import turn_handle
 from solver import units
 from solver.lattice import glsl_constants
 
@@ -45,6 +48,9 @@ BODY_EDGE = QColor(20, 20, 20)
 DRAG_COLOUR = QColor(230, 40, 40)
 LIFT_COLOUR = QColor(40, 120, 255)
 COLOUR_BAR_MARGIN = 132  # pixels on the right kept for the colour bar
+MOUSE_HINT = ("Drag the body to move it; drag its round handle or turn the mouse wheel to rotate it "
+              "(hold Shift for 15\u00b0 steps).")
+HANDLE_HINT = "Drag to rotate the body about its reference point (Shift: 15\u00b0 steps); the mouse wheel rotates it too."
 
 
 def load_shader(name: str) -> str:
@@ -59,6 +65,9 @@ class Viewport(QOpenGLWidget):
     bodyGrabbed = Signal(bool)
     polygonEdited = Signal(object)  # new vertex list (body frame) from the editor handles
     inputRefused = Signal()         # a press or wheel turn while `locked` (a replay shows)
+    turnRequested = Signal(float)   # the rotation handle asks for this body angle (degrees, any turns)
+    turnFinished = Signal(float, float)   # one drag of the handle: angle before and after (degrees)
+    turnRefused = Signal(str)       # the handle was pressed while this (a device, a script) drives the body
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -77,8 +86,11 @@ class Viewport(QOpenGLWidget):
         self._grab = None              # offset from body centre to the pressed point
         self._edit_vertex = None       # index of the vertex being dragged
         self._edit_preview = None
+        self.driver = None             # what else drives the body ("The haptic device"), set by the window
+        self._turn = None              # the handle's drag in progress (turn_handle.Turn)
+        self._hover = None             # "handle", "body" or "near" (the handle shows), or None
         self.setMinimumSize(480, 260)
-        self.setMouseTracking(False)
+        self.setMouseTracking(True)    # the handle appears when the pointer comes near the body
         self.setFocusPolicy(Qt.StrongFocus)
 
     # --- GL ---------------------------------------------------------------------------------
@@ -214,6 +226,7 @@ class Viewport(QOpenGLWidget):
         if self.mode == "tracers" and self.tracers is not None:
             self._paint_tracers(p)
         self._paint_body(p)
+        self._paint_turn_handle(p)
         if self.show_arrows and self.arrow_forces and self.sim.shape is not None:
             self._paint_arrows(p)
         self._paint_colour_bar(p)
@@ -377,6 +390,101 @@ class Viewport(QOpenGLWidget):
         p.drawLines(lines)
         p.setRenderHint(QPainter.Antialiasing, True)
 
+    # --- rotation handle ------------------------------------------------------------------------
+    def turn_blocker(self):
+        """What drives the body instead of the mouse (a haptic device, a motion script), or None."""
+        if self.driver:
+            return self.driver
+        if getattr(self.sim, "runner", None) is not None:
+            return "A motion script"
+        return None
+
+    def handle_geometry(self):
+        """(reference point, knob centre, stalk length) in widget pixels, or None without a body."""
+        sim = self.sim
+        if sim is None or sim.shape is None:
+            return None
+        centre = self.to_widget(*sim.pos)
+        reach = turn_handle.handle_reach(centre, self.body_outline_points())
+        return centre, turn_handle.knob_position(centre, reach, sim.angle), reach
+
+    def handle_shown(self) -> bool:
+        """The handle shows while the pointer is near the body or turns it; never during a replay,
+        a drag of the body or while the polygon editor drags a vertex."""
+        if self.locked or self.sim is None or self.sim.shape is None:
+            return False
+        if self._grab is not None or self._edit_vertex is not None:
+            return False
+        return self._turn is not None or self._hover is not None
+
+    def _hover_at(self, pos: QPointF):
+        """What the pointer is over: the knob, the body, near the body (within the handle's reach)."""
+        geometry = self.handle_geometry() if not self.locked else None
+        if geometry is None:
+            return None
+        centre, knob, reach = geometry
+        if math.hypot(pos.x() - knob.x(), pos.y() - knob.y()) <= turn_handle.KNOB_REACH:
+            return "handle"
+        if self.sim.hit(*self.to_lattice(pos)):
+            return "body"
+        if math.hypot(pos.x() - centre.x(), pos.y() - centre.y()) <= reach + turn_handle.NEAR:
+            return "near"
+        return None
+
+    def _set_hover(self, hover):
+        if hover != self._hover:
+            self._hover = hover
+            self.update()
+        if self._turn is not None:
+            self.setCursor(turn_handle.rotate_cursor())
+        elif self._grab is not None:
+            self.setCursor(Qt.ClosedHandCursor)
+        elif hover == "handle":
+            self.setCursor(Qt.ForbiddenCursor if self.turn_blocker() else turn_handle.rotate_cursor())
+        elif hover == "body" and not self.editing:
+            self.setCursor(Qt.OpenHandCursor)
+        else:
+            self.unsetCursor()
+
+    def _pointer_degrees(self, pos: QPointF) -> float:
+        return turn_handle.pointer_degrees(self.sim.pos, self.to_lattice(pos))
+
+    def _paint_turn_handle(self, p: QPainter):
+        if not self.handle_shown():
+            return
+        centre, knob, reach = self.handle_geometry()
+        turn = self._turn
+        if turn is not None and abs(math.radians(turn.target) - self.sim.angle) > 1e-3:
+            target = turn_handle.knob_position(centre, reach, math.radians(turn.target))
+            turn_handle.paint_turn_target(p, centre, target)
+        state = "refused" if self.turn_blocker() else "active" if turn is not None or self._hover == "handle" else "idle"
+        turn_handle.paint_handle(p, centre, knob, state)
+        if turn is not None:
+            shown = (turn.target + 180.0) % 360.0 - 180.0
+            ux, uy = (knob.x() - centre.x()) / reach, (knob.y() - centre.y()) / reach
+            at = QPointF(knob.x() + 16 * ux - (38 if ux < -0.3 else 0 if ux > 0.3 else 18), knob.y() + 16 * uy + 6)
+            self._label(p, at, f"{shown:.0f}\u00b0".replace("-", "\u2212"))   # beyond the knob, off the stalk
+
+    def leaveEvent(self, ev):
+        if self._turn is None:
+            self._set_hover(None)
+        super().leaveEvent(ev)
+
+    def event(self, ev):
+        """Tooltips where they help: over the handle, over the body."""
+        if ev.type() == QEvent.ToolTip and self.sim is not None and not self.locked:
+            hover = self._hover_at(QPointF(ev.pos()))
+            text = {"handle": HANDLE_HINT, "body": MOUSE_HINT}.get(hover)
+            blocker = self.turn_blocker() if hover == "handle" else None
+            if blocker:
+                text = f"{blocker} drives the body: the handle cannot rotate it now."
+            if text:
+                QToolTip.showText(ev.globalPos(), text, self)
+            else:
+                QToolTip.hideText()
+            return True
+        return super().event(ev)
+
     # --- editor geometry ------------------------------------------------------------------------
     def body_to_world(self, verts):
         sim = self.sim
@@ -418,30 +526,55 @@ class Viewport(QOpenGLWidget):
                 self._edit_vertex = i
                 self._edit_preview = [tuple(v) for v in self.sim.polygon]
                 return
+        hover = self._hover_at(pos)
+        if ev.button() == Qt.LeftButton and hover == "handle":
+            blocker = self.turn_blocker()
+            if blocker:
+                self.turnRefused.emit(blocker)
+                return
+            self._turn = turn_handle.Turn(self._pointer_degrees(pos), math.degrees(self.sim.angle_target))
+            self._set_hover(hover)
+            return
         if ev.button() == Qt.LeftButton and self.sim.hit(x, y):
             self._grab = (self.sim.pos[0] - x, self.sim.pos[1] - y)
             self.sim.target = (x + self._grab[0], y + self._grab[1])
             self.bodyGrabbed.emit(True)
+            self._set_hover(hover)
             self.update()
 
     def mouseMoveEvent(self, ev):
         if self.sim is None:
             return
         x, y = self.to_lattice(ev.position())
-        if self._edit_vertex is not None:
+        if self._turn is not None:
+            before = self._turn.target
+            target = self._turn.follow(self._pointer_degrees(ev.position()), bool(ev.modifiers() & Qt.ShiftModifier))
+            if target != before:
+                self.turnRequested.emit(target)
+            self.update()
+        elif self._edit_vertex is not None:
             self._edit_preview[self._edit_vertex] = self.world_to_body(x, y)
             self.update()
         elif self._grab is not None:
             self.sim.target = (x + self._grab[0], y + self._grab[1])
+        elif not ev.buttons():
+            self._set_hover(self._hover_at(ev.position()))
 
     def mouseReleaseEvent(self, ev):
-        if self._edit_vertex is not None:
+        if self._turn is not None:
+            turn, self._turn = self._turn, None
+            if turn.target != turn.before:
+                self.turnFinished.emit(turn.before, turn.target)
+            self._set_hover(self._hover_at(ev.position()) if self.sim is not None else None)
+            self.update()
+        elif self._edit_vertex is not None:
             verts, self._edit_vertex, self._edit_preview = self._edit_preview, None, None
             self.polygonEdited.emit(verts)
         elif self._grab is not None:
             self._grab = None
             self.sim.target = None
             self.bodyGrabbed.emit(False)
+            self._set_hover(self._hover_at(ev.position()))
 
     def mouseDoubleClickEvent(self, ev):
         """Editor: a double click adds a vertex on the nearest edge."""

@@ -52,3 +52,18 @@ def test_history_drag_and_lift_are_along_and_across_the_relative_wind():
     h.add(2, (0.0, -0.05), (0.0, 0.05), {"m": (2.0, 1.0)})    # wind from below: drag along +y
     _, drag, lift = h.drag_lift("m")
     assert drag.tolist() == [2.0, 1.0] and lift.tolist() == [1.0, -2.0]
+
+
+def test_a_turn_follows_the_pointer_across_180_degrees_and_snaps():
+    from app.simulation import wrap_degrees
+    from app.turn_handle import Turn, pointer_degrees
+
+    assert pointer_degrees((10.0, 10.0), (10.0, 15.0)) == pytest.approx(90.0)   # y up: counter-clockwise
+    turn = Turn(pointer_deg=170.0, body_deg=30.0)
+    assert turn.follow(-170.0, snapped=False) == pytest.approx(50.0)   # 20 degrees on, not 340 back
+    assert turn.follow(-100.0, snapped=False) == pytest.approx(120.0)
+    assert turn.follow(-100.0, snapped=True) == 120.0
+    assert turn.follow(-93.0, snapped=True) == 120.0                   # 127 -> the nearest 15-degree step
+    assert turn.follow(-87.0, snapped=True) == 135.0
+    assert turn.before == 30.0 and turn.target == 135.0
+    assert [wrap_degrees(a) for a in (190.0, -190.0, 180.0, 725.0)] == [-170.0, 170.0, -180.0, 5.0]

@@ -1,0 +1,157 @@
+"""The rotation handle on the body, in the real window (Xvfb, numpy solver, small grid): it shows
+when the pointer comes near the body, dragging its knob turns the body by the pointer's angle
+(the solid mask follows), Shift snaps to 15 degrees, one drag is one undo step, and it is refused
+while a replay shows or a motion script or a haptic device drives the body."""
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+import pytest
+
+pytestmark = [pytest.mark.gui,
+              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+
+if os.environ.get("DISPLAY"):
+    from test_gui_window import solid_mask, window  # noqa: F401,F811  (the window fixture; Qt is set up there)
+
+
+def knob_after_hover(window):
+    """Bring the pointer over the body (the handle appears), then onto the knob; the knob's
+    centre and the reference point, widget pixels."""
+    from app.selftest import send_mouse
+
+    vp, sim = window.viewport, window.sim
+    send_mouse(vp, "hover", vp.to_widget(*sim.pos))
+    assert vp.handle_shown()
+    centre, knob, _ = vp.handle_geometry()
+    send_mouse(vp, "hover", knob)
+    return centre, knob
+
+
+def drag_handle(window, degrees: float, moves: int = 12, modifiers=None):
+    """Press on the knob and carry it `degrees` counter-clockwise about the reference point."""
+    from PySide6.QtCore import QPointF, Qt
+
+    from app.selftest import send_mouse
+
+    vp = window.viewport
+    modifiers = Qt.NoModifier if modifiers is None else modifiers
+    centre, knob = knob_after_hover(window)
+    r = math.hypot(knob.x() - centre.x(), knob.y() - centre.y())
+    a0 = math.atan2(centre.y() - knob.y(), knob.x() - centre.x())   # widget y is down
+    send_mouse(vp, "press", knob)
+    assert vp._turn is not None, "the press did not take the handle"
+    at = knob
+    for k in range(1, moves + 1):
+        a = a0 + math.radians(degrees) * k / moves
+        at = QPointF(centre.x() + r * math.cos(a), centre.y() - r * math.sin(a))
+        send_mouse(vp, "move", at, modifiers=modifiers)
+    send_mouse(vp, "release", at, modifiers=modifiers)
+
+
+def plate(window):
+    panel = window.panel
+    panel.shape.setCurrentIndex(panel.shape.findData("plate"))
+    assert window.sim.shape.kind == "plate" and window.sim.angle == 0.0
+    return window.sim
+
+
+def test_dragging_the_handle_turns_the_body_and_one_undo_turns_it_back(window, qtbot):
+    sim = plate(window)
+    upright, steps = solid_mask(sim), window.undo.count()
+    drag_handle(window, 90)
+    assert math.degrees(sim.angle_target) == pytest.approx(90, abs=0.5)
+    assert window.undo.count() == steps + 1                        # twelve moves, one undo step
+    assert window.panel.angle.value() == 90
+    qtbot.waitUntil(lambda: sim.angle == sim.angle_target, timeout=30000)   # it swings there, like the wheel
+    lying = solid_mask(sim)
+    ys, xs = np.nonzero(lying)
+    uy, ux = np.nonzero(upright)
+    assert np.ptp(xs) > np.ptp(ux) and np.ptp(ys) < np.ptp(uy)      # along the flow now
+    window.undo.undo()
+    assert sim.angle_target == pytest.approx(0.0, abs=1e-9) and window.panel.angle.value() == 0
+    qtbot.waitUntil(lambda: sim.angle == sim.angle_target, timeout=30000)
+    np.testing.assert_array_equal(solid_mask(sim), upright)
+
+
+def test_shift_snaps_to_15_degrees_and_paused_turns_at_once(window):
+    from PySide6.QtCore import Qt
+
+    sim = plate(window)
+    window.set_paused(True)
+    upright, steps = solid_mask(sim), window.undo.count()
+    drag_handle(window, 50, modifiers=Qt.ShiftModifier)
+    assert sim.angle == pytest.approx(math.radians(45), abs=1e-12)    # 50 snaps to 45, at once while paused
+    assert window.panel.angle.value() == 45 and sim.params.angle_deg == 45
+    assert not np.array_equal(solid_mask(sim), upright)
+    drag_handle(window, 50)                                        # without Shift: where the pointer is
+    assert math.degrees(sim.angle) == pytest.approx(95, abs=0.5)
+    assert window.undo.count() == steps + 2
+    window.undo.undo()
+    assert sim.angle == pytest.approx(math.radians(45), abs=1e-12)
+    window.undo.undo()
+    assert sim.angle == 0.0 and window.panel.angle.value() == 0
+    np.testing.assert_array_equal(solid_mask(sim), upright)
+    window.undo.redo()
+    assert sim.angle == pytest.approx(math.radians(45), abs=1e-12)
+
+
+def test_the_handle_is_refused_while_a_replay_shows(window, qtbot, tmp_path, monkeypatch):
+    from PySide6.QtCore import QPointF
+    from test_gui_replay import record_in_window
+
+    from app.selftest import send_mouse
+
+    path = tmp_path / "turn.ffsession"
+    record_in_window(window, qtbot, path, monkeypatch)
+    live, vp = window.sim, window.viewport
+    angle, steps = live.angle_target, window.undo.count()
+    assert window.start_replay(str(path))
+    replay = window.replay
+    send_mouse(vp, "hover", vp.to_widget(*replay.pos))
+    assert not vp.handle_shown()                                   # no handle on a replayed body
+    centre, knob, _ = vp.handle_geometry()
+    replay_angle = replay.angle
+    send_mouse(vp, "press", knob)
+    quarter = QPointF(centre.x() - (knob.y() - centre.y()), centre.y() + (knob.x() - centre.x()))
+    send_mouse(vp, "move", quarter)
+    send_mouse(vp, "release", knob)
+    assert vp._turn is None
+    assert "the mouse does not move the body" in window.statusBar().currentMessage()
+    assert not window.turn_body(45.0)
+    assert live.angle_target == angle and window.undo.count() == steps
+    assert replay.angle == replay_angle
+
+
+def test_the_handle_is_refused_while_a_script_or_a_device_drives_the_body(window, qtbot):
+    from app.selftest import send_mouse
+
+    vp = window.viewport
+    assert window.apply_preset("seed_protocol")
+    sim = window.sim
+    assert sim.runner is not None
+    angle = sim.angle_target
+    _, knob = knob_after_hover(window)
+    send_mouse(vp, "press", knob)
+    send_mouse(vp, "release", knob)
+    assert vp._turn is None and sim.angle_target == angle
+    assert "A motion script drives the body" in window.statusBar().currentMessage()
+
+    window.reset_flow()                                            # the script ends: the mouse turns it again
+    panel = window.panel
+    panel.input.setCurrentIndex(panel.input.findData("sim://diyhid"))
+    assert window.input_device is not None
+    _, knob = knob_after_hover(window)
+    send_mouse(vp, "press", knob)
+    send_mouse(vp, "release", knob)
+    assert vp._turn is None and sim.angle_target == angle
+    assert "The haptic device drives the body" in window.statusBar().currentMessage()
+
+    panel.input.setCurrentIndex(panel.input.findData("mouse"))
+    assert window.input_device is None and vp.turn_blocker() is None
+    _, knob = knob_after_hover(window)
+    send_mouse(vp, "press", knob)
+    assert vp._turn is not None
+    send_mouse(vp, "release", knob)
