@@ -15,7 +15,8 @@ size in cells):
 * BGK: no point of the scan failed within 6 d / U (up to Re_cell = 45 at d = 20, the panel's
   extreme corner), but runs of 30 d / U at that corner do fail (`python -m
   solver.validation.stability --u 0.09 --nu 0.002 --collision bgk --convective-times 30`: the
-  thin plate runs away after 2400 steps, 10.8 d / U, the shaken cylinder diverges at step 3189).
+  thin plate runs away after 2400 steps, 10.8 d / U, the shaken cylinder and the wedge diverge at
+  steps 3189 and 5398).
   Its limit is therefore not measured; BGK gets TRT's K, at which all four cases ran 30 d / U
   stably with both operators (`... --u 0.09 --k 27.67 --collision bgk|trt --convective-times 30`).
 
