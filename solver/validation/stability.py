@@ -31,7 +31,7 @@ which grows without bound as tau+ -> 1/2 (tau- = 32 at nu = 0.002): the odd (flu
 barely relaxed there, and on this scan TRT fails where BGK does not.
 
 `feelflow validate --case stability [--backend gl] [--json PATH]` runs the full scan;
-`--quick` runs `QUICK_POINTS` (the default test suite's): one point per hard case inside the
+`--quick` runs `quick_points()` (as the default test suite does): one point per hard case inside the
 window's guarded region (must stay finite and bounded) and one far outside (must diverge).
 The constants the window uses live in `solver/stability_limit.py`.
 """
