@@ -340,10 +340,12 @@ class GLSolver(Solver):
         if self._inflow_key != self.inflow_speed:
             self._inflow_key = self.inflow_speed
             self._inflow_tex.write(profile(cfg.ny, self.inflow_speed, cfg.inflow_profile).astype("f4").tobytes())
-        r = ramp(t, cfg.inflow_ramp_steps)
-        for key, prog in self._programs.items():
-            if key[1]:
-                self._uniforms(prog, inflow_ramp=r)
+        r = float(ramp(t, cfg.inflow_ramp_steps))
+        if self._uniform_values.get("inflow_ramp") != r:  # constant once the ramp is over
+            self._uniform_values["inflow_ramp"] = r  # also for edge programs compiled later
+            for key, prog in self._programs.items():
+                if key[1]:
+                    self._uniforms(prog, inflow_ramp=r)
 
     def _begin_pass(self, fbo, size):
         """The state every pass needs, whatever the host (Qt) left: see the module docstring."""
@@ -664,15 +666,17 @@ class GLSolver(Solver):
         new = self._body_state(shape, velocity, omega, raster)
         read = {}
 
-        def read_window(x0, y0, x1, y1):  # the refill box, read back once
-            read["g"] = self._read_shifted((x0, y0, x1, y1))
-            return unshifted(read["g"])
+        def read_window(x0, y0, x1, y1):  # the refill box's texels, read back once
+            read["kbox"] = kbox = texel_box((x0, y0, x1, y1))
+            read["texels"] = self._read_texels(kbox)
+            read["lo"] = lo = x0 - 2 * kbox[0]
+            return unshifted(read["texels"][:, :, lo:lo + x1 - x0])
 
-        def write_nodes(x0, y0, f, changed):  # rewrite the box, changed nodes from the refill
-            g = read["g"]
-            g[:, changed] = shifted(f[:, changed]).astype("f4")
+        def write_nodes(x0, y0, f, changed):  # the changed nodes merged into the texels read
             h, w = changed.shape
-            self._write_shifted(g, (x0, y0, x0 + w, y0 + h))
+            g = read["texels"][:, :, read["lo"]:read["lo"] + w]
+            g[:, changed] = shifted(f[:, changed]).astype("f4")
+            self._write_texels(read["texels"], read["kbox"])
 
         jx, jy = move_body(old, new, cfg, read_window, write_nodes)
         self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
@@ -758,6 +762,11 @@ class GLSolver(Solver):
         else:
             nodes = np.zeros((Q, y1 - y0, 2 * (k1 - k0)), np.float32)
         nodes[:, :, lo:lo + x1 - x0] = g
+        self._write_texels(nodes, kbox)
+
+    def _write_texels(self, nodes: np.ndarray, kbox) -> None:
+        """Store node populations (9, h, 2 w) into the texel box kbox of the current side."""
+        k0, y0, k1, y1 = kbox
         for t, data in enumerate(pack(nodes)):
             self._g[self._cur][t].write(np.ascontiguousarray(data).tobytes(), viewport=(k0, y0, k1 - k0, y1 - y0))
 
