@@ -45,6 +45,9 @@ class Solver(ABC):
         self.config = config.validate()
         self.time = 0  # steps done
         self.inflow_speed = float(self.config.inflow_speed)  # U of the tunnel inlet, in use
+        self.body = None      # solver.body.BodyState of the body, or None
+        self._models = {}     # enabled force models by name
+        self._forces: dict[str, tuple[float, float]] = {}  # their means over the last step(n)
 
     # --- inflow ---------------------------------------------------------------
     def set_inflow_speed(self, speed: float) -> None:
@@ -54,8 +57,7 @@ class Solver(ABC):
 
         u, _, capped = cap_speed(float(speed), 0.0, self.config.max_speed)
         self.inflow_speed, self.inflow_capped = u, capped
-        body = getattr(self, "body", None)
-        self.speed_capped = capped or bool(body is not None and body.capped)
+        self.speed_capped = capped or bool(self.body is not None and self.body.capped)
 
     # --- body -----------------------------------------------------------------
     @abstractmethod
@@ -71,7 +73,7 @@ class Solver(ABC):
         from solver.body import make_body_state, window_margin
 
         return make_body_state(shape, velocity, omega, self.config,
-                               window_margin(getattr(self, "_models", {}).values()), raster)
+                               window_margin(self._models.values()), raster)
 
     # --- stepping -------------------------------------------------------------
     @abstractmethod
@@ -79,13 +81,31 @@ class Solver(ABC):
         """Advance n steps; evaluate the enabled force models on each."""
 
     # --- forces ---------------------------------------------------------------
-    @abstractmethod
     def enable_force_models(self, names) -> None:
         """Compute only these models (names from `solver.forces.MODELS`)."""
+        from solver.forces import create_model
 
-    @abstractmethod
+        self._models = {name: create_model(name) for name in names}
+        self._forces = {}
+        self._rebuild_body_window()
+
+    def add_force_model(self, model) -> None:
+        """Enable an already-built model instance (e.g. with options), keyed by its name."""
+        self._models[model.name] = model
+        self._rebuild_body_window()
+
+    def _rebuild_body_window(self) -> None:
+        """The body's force window for the margin the enabled models need (solver/body.py)."""
+        b = self.body
+        if b is not None:
+            from solver.body import make_body_state, window_margin
+
+            self.body = make_body_state(b.shape, b.velocity, b.omega, self.config,
+                                        window_margin(self._models.values()), b.raster)
+
     def forces(self) -> dict[str, tuple[float, float]]:
         """Mean force per model over the last `step(n)` call, lattice units."""
+        return dict(self._forces)
 
     # --- fields ---------------------------------------------------------------
     @abstractmethod

@@ -52,9 +52,7 @@ import moderngl
 import numpy as np
 
 from solver.backend import BackendError, Solver, SolverDiverged
-from solver.body import (BodyState, expand_box, make_body_state, move_body, shifted, union_box, unshifted,
-                         window_margin)
-from solver.forces import create_model
+from solver.body import expand_box, move_body, shifted, union_box, unshifted
 from solver.forces.base import BodyWindow
 from solver.gl_layout import TEXTURES, pack, texel_box, texels, unpack
 from solver.gl_programs import create_program
@@ -210,10 +208,7 @@ class GLSolver(Solver):
         self._band_copy = None  # (vao, vbo, slot layout) of the window copy into the band area
         self._pending, self._idle_queries = [], []  # divergence="discard": (step, query)
 
-        self.body: BodyState | None = None
         self._impulse = (0.0, 0.0)
-        self._models = {}
-        self._forces: dict[str, tuple[float, float]] = {}
         self._set_rects(None)
         self._upload_body_uniforms()
         ux0, uy0 = cfg.initial_velocity
@@ -704,25 +699,6 @@ class GLSolver(Solver):
         self._qb_tex.write(np.ascontiguousarray(np.moveaxis(q[5:9], 0, -1)).tobytes(), viewport=viewport)
 
     # --- forces -----------------------------------------------------------------
-    def _rebuild_body_window(self):
-        b = self.body
-        if b is not None:
-            self.body = make_body_state(b.shape, b.velocity, b.omega, self.config,
-                                        window_margin(self._models.values()), b.raster)
-
-    def enable_force_models(self, names) -> None:
-        self._models = {name: create_model(name) for name in names}
-        self._forces = {}
-        self._rebuild_body_window()
-
-    def add_force_model(self, model) -> None:
-        """Enable an already-built model instance (e.g. with options), keyed by its name."""
-        self._models[model.name] = model
-        self._rebuild_body_window()
-
-    def forces(self) -> dict[str, tuple[float, float]]:
-        return dict(self._forces)
-
     def body_window(self) -> BodyWindow | None:
         """The body's force window at the current time (full f*, float64): 3 small reads."""
         return None if self.body is None else self._window(self._cur, self._impulse)

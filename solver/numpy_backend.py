@@ -11,13 +11,12 @@ from __future__ import annotations
 import numpy as np
 
 from solver.backend import Solver, SolverDiverged
-from solver.body import BodyState, make_body_state, move_body, shifted, unshifted, window_margin
+from solver.body import move_body, shifted, unshifted
 from solver.bouzidi import incoming
 from solver.collision import Collider
 from solver.config import FlowConfig
-from solver.forces import create_model
 from solver.forces.base import BodyWindow
-from solver.inflow import inflow_velocity, outlet_incoming
+from solver.inflow import OUTLET_DIRECTIONS, inflow_velocity, outlet_incoming
 from solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 
 #: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall
@@ -78,12 +77,9 @@ class NumpySolver(Solver):
             cx, cy = int(C[i, 0]), int(C[i, 1])
             self._roll.append([((yd, xd), (ys, xs))
                                for yd, ys in _roll_segments(cy, ny) for xd, xs in _roll_segments(cx, nx)])
-        self.body: BodyState | None = None
         self._solid_idx = None
         self._solid_g = None
         self._impulse = (0.0, 0.0)
-        self._models = {}
-        self._forces: dict[str, tuple[float, float]] = {}
 
     # --- body -----------------------------------------------------------------
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
@@ -113,25 +109,6 @@ class NumpySolver(Solver):
         sub[:, changed] = shifted(f[:, changed]).astype(self.dtype)
 
     # --- forces ---------------------------------------------------------------
-    def enable_force_models(self, names) -> None:
-        self._models = {name: create_model(name) for name in names}
-        self._forces = {}
-        if self.body is not None:  # the window margin may have changed
-            b = self.body
-            self.body = make_body_state(b.shape, b.velocity, b.omega, self.config,
-                                        window_margin(self._models.values()), b.raster)
-
-    def add_force_model(self, model) -> None:
-        """Enable an already-built model instance (e.g. with options), keyed by its name."""
-        self._models[model.name] = model
-        if self.body is not None:
-            b = self.body
-            self.body = make_body_state(b.shape, b.velocity, b.omega, self.config,
-                                        window_margin(self._models.values()), b.raster)
-
-    def forces(self) -> dict[str, tuple[float, float]]:
-        return dict(self._forces)
-
     def body_window(self) -> BodyWindow | None:
         """The body's force window at the current time (full f*, float64)."""
         b = self.body
@@ -171,7 +148,7 @@ class NumpySolver(Solver):
                 di[yd, xd] = gi[ys, xs]
         if cfg.x_boundary == "tunnel":
             # d: outlet, anti-bounce-back at x = nx - 1/2 with rho = RHO0 (pressure outlet)
-            gin[(3, 6, 7), :, nx - 1] = outlet_incoming(g[:, :, nx - 2:])
+            gin[OUTLET_DIRECTIONS, :, nx - 1] = outlet_incoming(g[:, :, nx - 2:])
             # c: inlet, moving-wall half-way bounce-back at x = -1/2
             u_in = inflow_velocity(cfg, t, self.inflow_speed)
             for i in (1, 5, 8):
