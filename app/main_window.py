@@ -838,6 +838,12 @@ class MainWindow(QMainWindow):
         self.viewport.upload_field(rgba)
         return rgba
 
+    def _field_array(self) -> np.ndarray:
+        """gl backend: the field texture `_upload_field` computed this frame, read back (ny, nx,
+        4) float32, instead of running the field pass again."""
+        tex = self.viewport.field_texture
+        return np.frombuffer(tex.read(), np.float32).reshape(tex.height, tex.width, 4)
+
     def tick(self):
         now = time.perf_counter()
         if self.sim is None:
@@ -926,10 +932,8 @@ class MainWindow(QMainWindow):
     def _free_stream_density(self, rgba) -> float:
         """Median density of the fluid: the reference of the pressure coefficient (the lattice's
         mean density drifts by a fraction of a percent, which alone is Cp ~ 1 at U = 0.05)."""
-        sim = self.shown
         if rgba is None:
-            nx, ny = sim.config.nx, sim.config.ny
-            rgba = np.frombuffer(sim.solver.field_texture().read(), np.float32).reshape(ny, nx, 4)
+            rgba = self._field_array()
         rho = rgba[::2, ::2, 0]
         rho = rho[np.isfinite(rho)]
         return float(np.median(rho)) if rho.size else 1.0
@@ -963,7 +967,7 @@ class MainWindow(QMainWindow):
         sim = self.shown
         nx, ny = sim.config.nx, sim.config.ny
         if rgba is None:
-            rgba = np.frombuffer(sim.solver.field_texture().read(), np.float32).reshape(ny, nx, 4)
+            rgba = self._field_array()
         rng = self.tracer_rng
         if self.viewport.tracers is None or len(self.viewport.tracers[0]) != N_TRACERS:
             pts = np.c_[rng.uniform(0, nx - 1, N_TRACERS), rng.uniform(0, ny - 1, N_TRACERS)]

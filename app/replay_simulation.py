@@ -34,6 +34,7 @@ class ReplaySimulation:
         self.paused = False
         self.last_steps = 0
         self._last_forces: dict = {}
+        self._params_cache = None  # (player.events_done, Params)
 
     # --- what the window draws ----------------------------------------------------------
     @property
@@ -77,7 +78,16 @@ class ReplaySimulation:
 
     @property
     def params(self) -> Params:
-        """The panel's view of the replayed scene now (wind, viscosity, grid, body, models)."""
+        """The panel's view of the replayed scene now (wind, viscosity, grid, body, models);
+        rebuilt only when the player has applied events since (the viewport reads it many
+        times a frame)."""
+        key = self.player.events_done
+        cached = self._params_cache
+        if cached is None or cached[0] != key:
+            self._params_cache = cached = (key, self._build_params())
+        return cached[1]
+
+    def _build_params(self) -> Params:
         from app.bodies import params_for_shape
 
         geometry = self.player.shape or self.player.geometry
