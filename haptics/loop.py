@@ -33,7 +33,7 @@ from haptics.drivers.base import clamp_force
 from haptics.errors import DeviceDisconnected, DeviceError
 from haptics.safety import SafetyConfig, SafetyGate
 from haptics.shaping import ForceInterpolator, ForceScale
-from haptics.timing import Ticker
+from haptics.timing import Ticker, try_realtime
 from haptics.types import BodyTarget, ForceSample, Pose
 
 
@@ -223,11 +223,8 @@ class ForceLoop:
         """Make this (the loop) thread wake on time on a busy machine; returns what worked."""
         if not self.config.realtime:
             return "normal"
-        try:
-            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(10))  # 0 = this thread on Linux
+        if try_realtime(10):
             return "SCHED_FIFO 10"
-        except (OSError, AttributeError):
-            pass
         try:
             os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), -10)
             return "nice -10"

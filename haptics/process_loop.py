@@ -36,6 +36,7 @@ import time
 from haptics.errors import DeviceDisconnected, DeviceError
 from haptics.loop import LoopConfig, LoopStatus
 from haptics.safety import SafetyConfig
+from haptics.timing import try_realtime
 from haptics.types import BodyTarget, Capabilities, ForceSample
 
 _LEN = struct.Struct("<I")
@@ -76,10 +77,11 @@ def _read_msg(stream) -> bytes | None:
 
 
 # --- the child -------------------------------------------------------------------------------------
-def _publish(mm, loop, seq: list, st=None) -> None:
-    """Write the body target (and, when `st` is given, the status) under the seqlock."""
+def _publish(mm, loop, seq: list, vals: list, st=None) -> None:
+    """Write the body target (and, when `st` is given, the status) under the seqlock; `vals`
+    is the publisher's own copy of the block (it is the only writer), so the status fields of
+    the last status publish stay as they were."""
     bt = loop.body_target()
-    vals = list(_ARRAY.unpack(mm[:_ARRAY.size]))
     fields = [("x", bt.x), ("y", bt.y), ("vx", bt.vx), ("vy", bt.vy), ("t", bt.t),
               ("buttons", bt.buttons), ("valid", bt.valid), ("fx", loop._force[0]), ("fy", loop._force[1]),
               ("ticks", loop._ticks), ("gain", loop.gate.gain)]
@@ -93,18 +95,9 @@ def _publish(mm, loop, seq: list, st=None) -> None:
         vals[_IDX[k]] = float(v)
     seq[0] += 1
     mm[0:8] = struct.pack("<d", seq[0])  # odd: being written
-    vals[0] = seq[0] + 1
     mm[8:_ARRAY.size] = _ARRAY.pack(*vals)[8:]
     seq[0] += 1
     mm[0:8] = struct.pack("<d", seq[0])  # even: consistent
-
-
-def _realtime(priority: int) -> None:
-    """Threads of the child that touch the GIL must not be preempted while holding it."""
-    try:
-        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
-    except (OSError, AttributeError):
-        pass
 
 
 def child_main(argv) -> int:
@@ -138,24 +131,25 @@ def child_main(argv) -> int:
                      on_disconnect=lambda reason: send({"disconnected": reason}))
     send({"ready": dataclasses.asdict(dev.capabilities), "driver": dev.driver_name})
     seq = [0.0]
+    vals = list(_ARRAY.unpack(mm[:_ARRAY.size]))
     done = threading.Event()
 
     def publisher():  # body target 500 times a second; the (costlier) status 10 times
-        _realtime(8)
+        try_realtime(8)  # threads of the child that touch the GIL must not be preempted holding it
         last_status = last_counters = 0.0
         while not done.wait(0.002):
             now = time.monotonic()
             st = None
             if now - last_status > 0.1:
                 last_status, st = now, loop.status()
-            _publish(mm, loop, seq, st)
+            _publish(mm, loop, seq, vals, st)
             if st is not None and now - last_counters > 0.25:
                 last_counters = now
                 send({"counters": st.device_counters, "scheduling": st.scheduling})
 
     pub = threading.Thread(target=publisher, daemon=True)
     pub.start()
-    _realtime(8)  # this (the command) thread
+    try_realtime(8)  # this (the command) thread
     try:
         while True:
             data = _read_msg(inp)
@@ -170,11 +164,7 @@ def child_main(argv) -> int:
             if op == "quit":
                 break
             try:
-                if op == "start":
-                    loop.start()
-                elif op == "stop":
-                    loop.stop()
-                elif op in ("pause", "resume", "emergency_stop", "clear_stop"):
+                if op in ("start", "stop", "pause", "resume", "emergency_stop", "clear_stop"):
                     getattr(loop, op)()
                 elif op == "set_tunnel":
                     loop.set_tunnel(cmd["rect"], cmd.get("flip_y"))
@@ -192,7 +182,7 @@ def child_main(argv) -> int:
         dev.close()
         done.set()
         pub.join(1.0)
-        _publish(mm, loop, seq, loop.status())
+        _publish(mm, loop, seq, vals, loop.status())
     return 0
 
 

@@ -49,7 +49,7 @@ class SafetyGate:
         """Advance to time `now`; returns the gain to apply to the force this tick."""
         dt = 0.0 if self._t is None else max(now - self._t, 0.0)
         self._t = now
-        if self.faults & set(HARD):
+        if not self.faults.isdisjoint(HARD):
             self.gain = 0.0
         elif self.faults:
             self.gain = max(0.0, self.gain - dt / self.config.fade_time)

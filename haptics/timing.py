@@ -8,7 +8,18 @@ does not accumulate; after a long stall the schedule restarts instead of burstin
 """
 from __future__ import annotations
 
+import os
 import time
+
+
+def try_realtime(priority: int) -> bool:
+    """Put the calling thread in SCHED_FIFO at `priority` (Linux, with the right to do so), so
+    it wakes on time on a busy machine; False where that is not allowed."""
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))  # 0 = this thread
+        return True
+    except (OSError, AttributeError):
+        return False
 
 
 class Ticker:

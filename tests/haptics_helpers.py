@@ -2,11 +2,12 @@
 from __future__ import annotations
 
 import math
-import os
 import threading
 import time
 
 import numpy as np
+
+from haptics.timing import try_realtime
 
 
 def wait_for(cond, timeout=3.0, step=0.002):
@@ -38,10 +39,7 @@ class Feeder:
         self._thread.start()
 
     def _run(self):
-        try:
-            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(5))
-        except (OSError, AttributeError):
-            pass
+        try_realtime(5)
         next_t = time.monotonic()
         while not self._stop.is_set():
             if self.sending:

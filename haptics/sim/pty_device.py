@@ -7,6 +7,8 @@ import select
 import threading
 import tty
 
+from haptics.timing import try_realtime
+
 
 class PtyDevice:
     """Base: runs `on_bytes(data) -> reply bytes` in a thread on the pty's master side."""
@@ -29,10 +31,7 @@ class PtyDevice:
     def _run(self) -> None:
         # A real board has its own processor; give the simulated one a real-time slot when
         # allowed, so it is not descheduled while holding the GIL the force loop needs.
-        try:
-            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(9))
-        except (OSError, AttributeError):
-            pass
+        try_realtime(9)
         while not self._stop.is_set():
             fd = self._master
             if fd is None:
