@@ -27,7 +27,8 @@ if [ -n "$missing" ]; then
   fi
 fi
 
-if [ ! -x .venv/bin/python ]; then
+if ! .venv/bin/python -m pip --version >/dev/null 2>&1; then
+  rm -rf .venv   # none yet, or a half-made one (python3-venv was missing): make it afresh
   python3 -m venv .venv
 fi
 stamp=.venv/.feelflow-installed

@@ -53,5 +53,5 @@ def pytest_terminal_summary(terminalreporter, config):
     n = getattr(config, "_feelflow_gui_deferred", 0)
     if n:
         terminalreporter.write_line(
-            f"{n} gui tests deferred: they need a process of their own (pytest -m gui); "
-            "installer/run-tests.sh runs them next.")
+            f"{n} gui tests deferred: they need a process of their own; run them with "
+            "`pytest -m gui` (installer/run-tests.sh without arguments runs both).")
