@@ -68,12 +68,17 @@ def scene_config(scene: str, nx: int, ny: int):
 
 
 class SceneRun:
-    """One scene on one solver: `advance(n)` runs n steps the way the window drives them."""
+    """One scene on one solver: `advance(n)` runs n steps the way the window drives them.
 
-    def __init__(self, scene, solver):
+    For the tunnel's cost breakdown (`--variants`), `moves=False` keeps the cylinder where it
+    was placed, and `call_steps` sets how many steps each `step()` call runs (None: all n at
+    once) instead of MOVE_EVERY."""
+
+    def __init__(self, scene, solver, moves: bool = True, call_steps: int | None = MOVE_EVERY):
         from shapes import Cylinder
 
         self.scene, self.solver = scene, solver
+        self.moves, self.call_steps = moves, call_steps
         cfg = solver.config
         self.k = 0
         if scene == "tunnel":
@@ -94,11 +99,11 @@ class SceneRun:
     def advance(self, n: int):
         done = 0
         while done < n:
-            chunk = min(MOVE_EVERY, n - done)
+            chunk = n - done if self.call_steps is None else min(self.call_steps, n - done)
             self.solver.step(chunk)
             self.k += chunk
             done += chunk
-            if self.scene == "tunnel":
+            if self.scene == "tunnel" and self.moves:
                 self._move()
         finish = getattr(self.solver, "finish", None)
         if finish is not None:
@@ -221,6 +226,10 @@ def run_variants(quick: bool, seconds: float | None):
     no_force = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx))
     no_force.solver.enable_force_models([])
     runs["default, no force model (no window readback)"] = no_force
+    runs["default, cylinder not moved, step(10) calls"] = SceneRun(
+        "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False)
+    runs["default, cylinder not moved, one step(n) call a round"] = SceneRun(
+        "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False, call_steps=None)
     runs["empty periodic box (default)"] = SceneRun("box", GLSolver(scene_config("box", nx, ny), ctx=ctx))
     wall = {name: [] for name in runs}
     per_cpu = {name: [] for name in runs}
