@@ -233,8 +233,13 @@ class Viewport(QOpenGLWidget):
         self._paint_notes(p)
 
     def body_outline_points(self, outline=None):
+        """The outline in widget pixels: `to_widget` with the lattice rectangle computed once,
+        not once per point (this runs in every paint)."""
         pts = self.sim.shape.outline() if outline is None else outline
-        return QPolygonF([self.to_widget(x, y) for x, y in pts])
+        r = self.lattice_rect()
+        nx, ny = self.sim.config.nx, self.sim.config.ny
+        left, bottom, w, h = r.left(), r.bottom(), r.width(), r.height()
+        return QPolygonF([QPointF(left + (x + 0.5) / nx * w, bottom - (y + 0.5) / ny * h) for x, y in pts])
 
     def _paint_body(self, p: QPainter):
         sim = self.sim
