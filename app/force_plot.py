@@ -16,6 +16,17 @@ from PySide6.QtWidgets import (QCheckBox, QComboBox, QHBoxLayout, QLabel, QPushB
 
 from app.files import atomic_path, write_text_atomic
 from app.simulation import FORCE_MODELS, drag_direction
+from solver.lattice import CS2
+
+#: the impulsive start's pressure pulse (the flow begins at full speed around a body that was not
+#: there) has passed once it crossed the body twice at the speed of sound: 2 D / c_s steps
+START_PULSE_CROSSINGS = 2.0
+
+
+def start_pulse_steps(size_cells: float) -> float:
+    """Solver steps after the flow (re)starts during which the forces show the start pulse, a
+    spike tens of times the steady drag; the time plot's force range leaves them out."""
+    return START_PULSE_CROSSINGS * size_cells / math.sqrt(CS2)
 
 MODEL_COLOURS = {"momentum_exchange": ((220, 40, 40), (40, 110, 240)),
                  "macroscopic": ((230, 140, 20), (20, 170, 190)),
@@ -89,6 +100,8 @@ class ForcePlot(QWidget):
             f = self.plot.getAxis(ax).label.font()
             f.setPointSize(11)
             self.plot.getAxis(ax).label.setFont(f)
+        self.follow_range = True   # the plot sets its ranges until the user zooms or pans
+        self.plot.getViewBox().sigRangeChangedManually.connect(self._user_moved_range)
         self.curves = {}
         self.scatter = self.fit_line = None
         self.fitted_exponent = None
@@ -111,8 +124,20 @@ class ForcePlot(QWidget):
             self.sim.history.clear()
         self.refresh(force=True)
 
+    def _user_moved_range(self, *_):
+        self.follow_range = False
+
+    def _following(self) -> bool:
+        """Is the plot to set its own ranges? Yes until the user zooms or pans, and again once
+        the user clicks pyqtgraph's auto-range button ("A")."""
+        if any(self.plot.getViewBox().autoRangeEnabled()):
+            self.follow_range = True
+        return self.follow_range
+
     def _switch_view(self):
         self._shown = None
+        self.follow_range = True
+        self.plot.enableAutoRange()
         self.plot.clear()
         self.curves.clear()
         self._reset_legend(1)
@@ -124,6 +149,7 @@ class ForcePlot(QWidget):
                                           name="mean drag at one speed")
             self.fit_line = self.plot.plot([], [], pen=pg.mkPen((40, 40, 40), width=2, style=Qt.DashLine),
                                            name="fit")
+            self._set_speed_ranges(np.array([]), np.array([]))
             self.plot.getAxis("bottom").setLabel("relative speed |U - V| (lattice units)")
             self.plot.getAxis("left").setLabel("drag (lattice units)")
         else:
@@ -190,6 +216,7 @@ class ForcePlot(QWidget):
             self.plot.clear()                  # curves and legend rebuilt for the new set of models
             self.curves.clear()
             self._reset_legend(3 if len(shown) > 1 else 1)
+        values = []
         for model in shown:
             t, drag, lift = sim.history.drag_lift(model)
             first = int(np.argmax(np.isfinite(drag))) if np.isfinite(drag).any() else len(t)
@@ -198,6 +225,24 @@ class ForcePlot(QWidget):
             self._curve((model, "drag"), pg.mkPen(cd, width=2.5), self._name((model, "drag"))).setData(t, drag, connect="finite")
             self._curve((model, "lift"), pg.mkPen(cl, width=2.5, style=Qt.DashLine if len(shown) > 1 else Qt.SolidLine),
                         self._name((model, "lift"))).setData(t, lift, connect="finite")
+            settled = t >= start_pulse_steps(sim.params.size)
+            values.append(np.r_[drag[settled], lift[settled]])
+        self._set_force_range(np.concatenate(values) if values else np.array([]))
+
+    def _set_force_range(self, values):
+        """Force axis of the time view: the settled forces and zero, not the start pulse (whose
+        curve runs off the top, data unchanged); pyqtgraph's own auto-range until there are
+        settled samples."""
+        if not self._following():
+            return
+        values = values[np.isfinite(values)]
+        if values.size == 0:
+            self.plot.enableAutoRange(y=True)
+            return
+        lo, hi = min(0.0, float(values.min())), max(0.0, float(values.max()))
+        if hi - lo < 1e-12:
+            hi = lo + 1e-6
+        self.plot.setYRange(lo, hi, padding=0.08)
 
     def _name(self, key):
         model, what = key
@@ -221,6 +266,18 @@ class ForcePlot(QWidget):
             self.fit_line.setData([], [])
             self.fit_label.setText("fit: needs speeds a factor 1.5 apart")
         self.fitted_exponent = n
+        self._set_speed_ranges(us, fs)
+
+    def _set_speed_ranges(self, us, fs):
+        """Log-log ranges around the points (a factor 1.5 in speed, 2 in drag beyond them): with
+        one point or none, pyqtgraph's auto-range spans 1e-300 to 1e300."""
+        if not self._following():
+            return
+        us, fs = np.asarray(us, float), np.asarray(fs, float)
+        x = (us.min() / 1.5, us.max() * 1.5) if us.size else (0.01, 0.1)
+        y = (fs.min() / 2, fs.max() * 2) if fs.size else (1e-3, 1e-1)
+        self.plot.setXRange(math.log10(x[0]), math.log10(x[1]), padding=0)   # log mode: log10 values
+        self.plot.setYRange(math.log10(y[0]), math.log10(y[1]), padding=0)
 
     # --- export ---------------------------------------------------------------------------
     def csv_text(self) -> str:

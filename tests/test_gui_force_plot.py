@@ -1,0 +1,73 @@
+"""The force plot's ranges in the real window (Xvfb, numpy solver, small grid): the time view's
+force axis shows the settled forces, not the impulsive start's pulse, until the user zooms; the
+log-log view frames its points even when there is only one speed."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+pytestmark = [pytest.mark.gui,
+              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+
+if os.environ.get("DISPLAY"):
+    from test_gui_window import window  # noqa: F401,F811  (the window fixture; Qt is set up there)
+
+
+def test_time_view_force_axis_leaves_out_the_start_pulse(window, qtbot):
+    from app.force_plot import start_pulse_steps
+
+    sim, plot = window.sim, window.plot
+    settle = start_pulse_steps(sim.params.size)
+    qtbot.waitUntil(lambda: sim.solver.time > 4 * settle, timeout=30000)
+    plot.refresh(force=True)
+    t, drag, lift = sim.history.drag_lift(sim.params.force_model)
+    early, late = t < settle, t >= settle
+    assert np.nanmax(np.abs(drag[early])) > 3 * np.nanmax(np.abs(drag[late]))   # there is a pulse to leave out
+    lo, hi = plot.plot.getViewBox().viewRange()[1]
+    for v in (0.0, np.nanmin(drag[late]), np.nanmax(drag[late]), np.nanmin(lift[late]), np.nanmax(lift[late])):
+        assert lo <= v <= hi
+    assert hi < np.nanmax(drag[early])                        # the pulse runs off the top...
+    shown = plot.curves[(sim.params.force_model, "drag")].getData()[1]
+    assert np.nanmax(shown) == pytest.approx(np.nanmax(drag))   # ...but its data is all there
+
+
+def test_the_users_zoom_is_kept_until_auto_range(window, qtbot):
+    from PySide6.QtCore import QPoint, QPointF, Qt
+    from PySide6.QtGui import QWheelEvent
+    from PySide6.QtWidgets import QApplication
+
+    plot = window.plot
+    qtbot.waitUntil(lambda: len(window.sim.history) > 20, timeout=20000)
+    plot.refresh(force=True)
+    view = plot.plot
+    centre = QPointF(view.viewport().width() / 2, view.viewport().height() / 2)
+    ev = QWheelEvent(centre, view.viewport().mapToGlobal(centre), QPoint(), QPoint(0, 120 * 3), Qt.NoButton,
+                     Qt.NoModifier, Qt.NoScrollPhase, False)
+    QApplication.sendEvent(view.viewport(), ev)
+    zoomed = view.getViewBox().viewRange()[1]
+    assert not plot.follow_range
+    plot.refresh(force=True)
+    assert view.getViewBox().viewRange()[1] == pytest.approx(zoomed)
+    view.getViewBox().enableAutoRange()                    # what pyqtgraph's "A" button does
+    plot.refresh(force=True)
+    assert plot.follow_range
+
+
+def test_log_log_view_frames_a_single_speed(window, qtbot):
+    plot, sim = window.plot, window.sim
+    qtbot.waitUntil(lambda: len(sim.history) > 30, timeout=20000)
+    plot.view.setCurrentIndex(plot.view.findData("speed"))      # from the time view, as a lesson does
+    n = len(sim.history)
+    qtbot.waitUntil(lambda: len(sim.history) > n + 5, timeout=20000)
+    plot.refresh(force=True)
+    us, fs = plot.scatter.getData()                            # in log mode: log10 of the data
+    assert len(us) == 1 and plot.fitted_exponent is None       # one wind speed so far: one point
+    (x0, x1), (y0, y1) = plot.plot.getViewBox().viewRange()   # log10 of the axes' ends
+    u, f = us[0], fs[0]
+    assert x0 < u < x1 and x1 - x0 < 2                         # a factor < 100 around it, not 1e-300..1e300
+    assert y0 < f < y1 and y1 - y0 < 2
+    for axis in ("bottom", "left"):                            # the tick labels follow (no 10^-300)
+        a0, a1 = plot.plot.getAxis(axis).range
+        assert a1 - a0 < 2, (axis, a0, a1)
