@@ -326,6 +326,7 @@ class MainWindow(QMainWindow):
         self.pause_action.setChecked(False)
         self.stop_replay_action.setEnabled(True)
         self.replay_toolbar.show()
+        self.statusBar().clearMessage()   # a passing message (the mouse hint) would be drawn over the label
         self.replay_label.show()
         self.timer.setInterval(0)
         self._show_replay_progress()

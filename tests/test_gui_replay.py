@@ -226,3 +226,15 @@ def test_an_impossible_event_mid_replay_is_one_line_and_back_to_live(window, qtb
     assert window.viewport.sim is window.sim and not window.viewport.locked
     t = window.sim.solver.time
     qtbot.waitUntil(lambda: window.sim.solver.time > t + 10, timeout=20000)
+
+
+def test_the_replay_line_is_not_drawn_under_a_passing_message(window, qtbot, tmp_path, monkeypatch):
+    """The startup hint ("Drag the body...") is a passing status message; the replay's progress
+    line must not be shown under it (both were drawn on top of each other)."""
+    path = tmp_path / "lesson.ffsession"
+    record_in_window(window, qtbot, path, monkeypatch)
+    window.statusBar().showMessage("Drag the body to move it.", 20000)
+    assert window.start_replay(str(path))
+    assert window.replay_label.isVisible()
+    assert window.statusBar().currentMessage() == ""
+    window.stop_replay()
