@@ -14,11 +14,15 @@ os.environ.setdefault("XDG_CACHE_HOME", _cache)
 
 @pytest.fixture(scope="session")
 def gl_context():
-    """A standalone EGL OpenGL 3.3 core context (llvmpipe where there is no GPU)."""
-    moderngl = pytest.importorskip("moderngl")
+    """The process's standalone EGL OpenGL 3.3 core context (app.headless.gl_context: llvmpipe
+    where there is no GPU), the one the CLI's gl solvers get too."""
+    pytest.importorskip("moderngl")
+    from app.cli import UserError
+    from app.headless import gl_context as egl_context
+
     try:
-        ctx = moderngl.create_context(standalone=True, backend="egl", require=330)
-    except Exception as exc:  # no EGL on this machine: the gl tier cannot run
+        ctx = egl_context()
+    except UserError as exc:  # no EGL on this machine: the gl tier cannot run
         pytest.fail(f"EGL standalone context unavailable: {exc}")
     yield ctx
     ctx.release()
