@@ -6,6 +6,8 @@ import tempfile
 
 import pytest
 
+pytest_plugins = ["gui_fixtures"]   # the GUI tests' window fixture; imports Qt only in a gui run
+
 # Mesa's shader cache and Qt's caches go to a temp dir, never the user's home (shared/notes).
 _cache = tempfile.mkdtemp(prefix="feelflow-test-cache-")
 os.environ.setdefault("MESA_SHADER_CACHE_DIR", _cache)

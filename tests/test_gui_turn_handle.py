@@ -12,11 +12,10 @@ import os
 import numpy as np
 import pytest
 
+from gui_fixtures import solid_mask, wheel   # the `window` fixture comes from gui_fixtures too (conftest)
+
 pytestmark = [pytest.mark.gui,
               pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
-
-if os.environ.get("DISPLAY"):
-    from test_gui_window import solid_mask, window  # noqa: F401,F811  (the window fixture; Qt is set up there)
 
 
 def knob_after_hover(window):
@@ -157,19 +156,6 @@ def test_the_handle_is_refused_while_a_script_or_a_device_drives_the_body(window
     send_mouse(vp, "press", knob)
     assert vp._turn is not None
     send_mouse(vp, "release", knob)
-
-
-def wheel(window, notches: int):
-    """Turn the mouse wheel over the body by `notches` (positive: counter-clockwise)."""
-    from PySide6.QtCore import QPoint, Qt
-    from PySide6.QtGui import QWheelEvent
-    from PySide6.QtWidgets import QApplication
-
-    vp = window.viewport
-    pos = vp.to_widget(*window.sim.pos)
-    ev = QWheelEvent(pos, vp.mapToGlobal(pos), QPoint(), QPoint(0, 120 * notches), Qt.NoButton, Qt.NoModifier,
-                     Qt.NoScrollPhase, False)
-    QApplication.sendEvent(vp, ev)
 
 
 def at_57_degrees(window):
