@@ -24,6 +24,7 @@ def test_error_falls_with_resolution_and_work_rises():
     assert fine["node_updates"] > 2 * coarse["node_updates"]
     (order,) = bench_accuracy.observed_orders([coarse, fine])
     assert (order["from_d"], order["to_d"]) == (8, 12) and order["order"] > 0
+    assert bench_accuracy.fitted_order([coarse, fine]) == pytest.approx(order["order"], abs=0.01)
 
 
 def test_cli_sweeps_both_numpy_precisions_and_writes_json(tmp_path, monkeypatch, capsys):
