@@ -12,6 +12,8 @@ import time
 from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QCursor, QPainter, QPainterPath, QPen, QPixmap, QPolygonF, QUndoCommand
 
+from app.simulation import wrap_degrees
+
 SNAP_DEG = 15.0
 KNOB_RADIUS = 7.0     # pixels
 KNOB_REACH = 12.0     # a press this close to the knob's centre takes the handle
@@ -145,7 +147,10 @@ class TurnBody(QUndoCommand):
         return self.BURSTS.index(self.burst) + 1 if self.burst is not None else -1
 
     def mergeWith(self, other) -> bool:
-        if other.id() != self.id() or other.at - self.at > BURST_S or other.before != self.after:
+        # the next turn starts where this one ended: the same angle, but paused the body turns
+        # at once and keeps only the wrapped angle (181 comes back as -179)
+        if other.id() != self.id() or other.at - self.at > BURST_S \
+                or wrap_degrees(other.before) != wrap_degrees(self.after):
             return False
         self.after, self.at = other.after, other.at
         self.setObsolete(self.after == self.before)   # turned back to where it began: no undo step

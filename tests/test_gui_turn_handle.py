@@ -206,6 +206,18 @@ def test_a_burst_of_wheel_notches_is_one_undo_step(window, qtbot):
     assert window.undo.count() == steps + 1 and sim.params.angle_deg == 67
 
 
+def test_a_burst_of_wheel_notches_across_180_degrees_is_one_undo_step(window):
+    sim = plate(window)
+    window.set_paused(True)
+    window.panel.angle.setValue(177)
+    steps = window.undo.count()
+    for _ in range(3):
+        wheel(window, 1)                                           # 179, 181 (shown as -179), -177
+    assert sim.params.angle_deg == -177 and window.undo.count() == steps + 1
+    window.undo.undo()
+    assert sim.angle == math.radians(177) and sim.params.angle_deg == 177
+
+
 def test_edits_of_the_angle_box_are_one_undo_step(window, qtbot):
     from PySide6.QtCore import Qt
 
