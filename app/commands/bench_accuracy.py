@@ -127,6 +127,21 @@ def format_row(label: str, r: dict) -> str:
             f"{100 * r['cl_error']:+10.2f} {100 * r['dp_error']:+9.3f}{flag}")
 
 
+def markdown_tables(result) -> str:
+    """The two axes as Markdown tables (what README quotes), rows in the order run."""
+    cols = "| variant | D | U_m | tau | grid | steps | wall s | CPU s | MLUPS | C_D error | C_L error | dp error |"
+    rule = "|" + " --- |" * (cols.count("|") - 1)
+    out = []
+    for axis, title in (("resolution", "resolution (U_m fixed)"), ("speed", "time step (D fixed)")):
+        out += ["", f"Axis: {title}", "", cols, rule]
+        for label, v in result["variants"].items():
+            for r in v.get(axis, []):
+                out.append(f"| {label} | {r['d']} | {r['u_max']} | {r['tau']} | {r['grid']} | {r['steps']} | "
+                           f"{r['wall_s']:.1f} | {r['cpu_s']:.1f} | {r['mlups']:.1f} | {100 * r['cd_error']:+.3f} % | "
+                           f"{100 * r['cl_error']:+.2f} % | {100 * r['dp_error']:+.3f} % |")
+    return "\n".join(out)
+
+
 def main(args) -> int:
     from app.commands.bench_solver import machine
 
@@ -141,6 +156,7 @@ def main(args) -> int:
         if "orders" in v:
             orders = ", ".join(f"{o['from_d']}->{o['to_d']}: {o['order']}" for o in v["orders"])
             print(f"{label}: observed order of the C_D error {orders}; fitted over all D: {v['fitted_order']}")
+    print(markdown_tables(result))
     if getattr(args, "json", None):
         from app.files import write_json_atomic
 
