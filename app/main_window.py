@@ -97,6 +97,7 @@ class MainWindow(QMainWindow):
         self.viewport.inputRefused.connect(lambda: self._refuse_in_replay("the mouse does not move the body"))
         self.viewport.turnRequested.connect(self.turn_body)
         self.viewport.turnFinished.connect(self._turn_done)
+        self.viewport.wheelTurned.connect(self.turn_by_wheel)
         self.viewport.turnRefused.connect(self._turn_refused)
         geometry = self.settings.value("geometry")
         if geometry is not None:
@@ -457,7 +458,7 @@ class MainWindow(QMainWindow):
         p = self.panel
         p.shapeChanged.connect(self.set_shape_kind)
         p.sizeChanged.connect(lambda v: self._apply_shape(size=v))
-        p.angleChanged.connect(lambda v: self._apply_shape(angle_deg=v))
+        p.angleChanged.connect(self.set_angle)
         p.holdStillToggled.connect(self.set_hold_still)
         p.editToggled.connect(self.set_editing)
         p.save_shape.clicked.connect(self.save_shape_dialog)
@@ -586,9 +587,35 @@ class MainWindow(QMainWindow):
         return True
 
     def _turn_done(self, before: float, after: float):
-        """One drag of the handle: one undo step (pushing it applies `after`, where the body is)."""
+        """One drag of the handle: one undo step (the body is already at `after`)."""
         if self.sim is not None and self.replay is None:
             self.undo.push(TurnBody(self.turn_body, before, after))
+
+    def turn_by_wheel(self, degrees: float) -> bool:
+        """The mouse wheel turns the body like the handle does; a burst of notches is one undo step."""
+        sim = self.sim
+        if sim is None:
+            return False
+        before = sim.target_degrees()
+        if not self.turn_body(before + degrees):
+            return False
+        self.undo.push(TurnBody(self.turn_body, before, before + degrees, "turn the body (wheel)", burst="wheel"))
+        return True
+
+    def set_angle(self, degrees: float) -> bool:
+        """The panel's angle box turns the body at once; a burst of edits (typed digits, arrow
+        steps) is one undo step, whose undo puts the body back at once too."""
+        sim = self.sim
+        if sim is None:
+            return False
+        before = sim.target_degrees()
+        if not self._turn_at_once(degrees):
+            return False
+        self.undo.push(TurnBody(self._turn_at_once, before, degrees, "set the angle", burst="angle box"))
+        return True
+
+    def _turn_at_once(self, degrees: float) -> bool:
+        return self._apply_shape(angle_deg=wrap_degrees(degrees))
 
     def _turn_refused(self, driver: str):
         how = "choose Mouse under Input" if self.input_device is not None else "wait for it to end or reset the flow (R)"

@@ -25,6 +25,7 @@ import numpy as np
 
 from app.cli import UserError
 from app.files import write_text_atomic
+from app.machine import cpu_name
 from solver.lattice import CS2
 
 MODELS = ("momentum_exchange", "momentum_exchange_classic", "macroscopic", "pressure")
@@ -191,16 +192,7 @@ def load_parts(folder: Path) -> dict:
 
 
 def machine() -> str:
-    cpu = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
+    return f"{cpu_name()}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
 
 
 # --- measuring -----------------------------------------------------------------------------

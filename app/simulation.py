@@ -168,6 +168,7 @@ class Simulation:
         self.hold_still = False
         self.target = None           # where the mouse pulls the body, or None
         self.angle_target = math.radians(self.params.angle_deg)
+        self._asked = (None, None)   # (degrees, radians) of the last turn_to: see target_degrees
         self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
         self.base_config = base_config or default_base_config(self.params.grid)
         self._wind_starts_everywhere = base_config is None   # default tunnel: no ramp, see below
@@ -324,15 +325,24 @@ class Simulation:
         py = y + np.array([0, 0, 0, -1, 1]) * tolerance
         return bool(np.any(self.shape.contains(px, py)))
 
-    def rotate_by(self, degrees: float):
-        self.turn_to(math.degrees(self.angle_target) + degrees)
-
     def turn_to(self, degrees: float):
         """Ask for the angle `degrees` (any turn count: 190 turns 20 from 170, not 340 back):
         the body swings there through the angle spring (rate capped below the Mach limit), and
         the panel's angle (params.angle_deg, wrapped to [-180, 180)) says where it is going."""
         self.angle_target = math.radians(degrees)
         self.params = replace(self.params, angle_deg=wrap_degrees(degrees))
+        self._asked = (degrees, self.angle_target)
+
+    def target_degrees(self) -> float:
+        """The angle the body is asked to turn to, in degrees (any number of turns), exactly as it
+        was asked (by `turn_to` or the panel) where it was: radians -> degrees -> radians is not
+        exact in floating point, and an undo must give back the very angle it took away."""
+        asked, radians = self._asked
+        if radians == self.angle_target:
+            return asked
+        if math.radians(self.params.angle_deg) == self.angle_target:
+            return self.params.angle_deg
+        return math.degrees(self.angle_target)
 
     # --- running --------------------------------------------------------------------------
     def relative_wind(self):

@@ -7,15 +7,19 @@ that makes one drag of the handle one undo step.
 from __future__ import annotations
 
 import math
+import time
 
 from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QCursor, QPainter, QPainterPath, QPen, QPixmap, QPolygonF, QUndoCommand
+
+from app.simulation import wrap_degrees
 
 SNAP_DEG = 15.0
 KNOB_RADIUS = 7.0     # pixels
 KNOB_REACH = 12.0     # a press this close to the knob's centre takes the handle
 STALK_BEYOND = 22.0   # the knob sits this far past the body's farthest outline point
 NEAR = 18.0           # the handle shows while the pointer is this close to the circle it turns on
+BURST_S = 0.8         # wheel notches (angle box edits) closer than this in time are one undo step
 
 KNOB_FILL = QColor(245, 245, 245)
 KNOB_ACTIVE = QColor(255, 200, 0)        # the polygon editor's handle colour
@@ -122,15 +126,40 @@ def rotate_cursor() -> QCursor:
 
 
 class TurnBody(QUndoCommand):
-    """One drag of the handle: the body's angle before and after (degrees); `apply` is the
-    window's function that turns the body (redo after the drag changes nothing: it is there)."""
+    """One turn of the body: its angle before and after (degrees, any number of turns); `apply`
+    is the window's function that turns the body. The window turns the body first and pushes the
+    command only when that worked, so the push's own redo does nothing (the body is there).
 
-    def __init__(self, apply, before: float, after: float, text="turn the body"):
+    `burst` names a source whose quick successive turns make one undo step ("wheel", "angle
+    box"): a command of the same burst that follows within BURST_S seconds of the last one merges
+    into it (QUndoStack calls mergeWith). A drag of the handle (burst None) never merges."""
+
+    BURSTS = ("wheel", "angle box")
+
+    def __init__(self, apply, before: float, after: float, text="turn the body", burst=None, at=None):
         super().__init__(text)
         self.apply, self.before, self.after = apply, before, after
+        self.burst = burst
+        self._pushed = False
+        self.at = time.monotonic() if at is None else at   # when the last turn of the burst came
+
+    def id(self) -> int:
+        return self.BURSTS.index(self.burst) + 1 if self.burst is not None else -1
+
+    def mergeWith(self, other) -> bool:
+        # the next turn starts where this one ended: the same angle, but paused the body turns
+        # at once and keeps only the wrapped angle (181 comes back as -179)
+        if other.id() != self.id() or other.at - self.at > BURST_S \
+                or wrap_degrees(other.before) != wrap_degrees(self.after):
+            return False
+        self.after, self.at = other.after, other.at
+        self.setObsolete(self.after == self.before)   # turned back to where it began: no undo step
+        return True
 
     def redo(self):
-        self.apply(self.after)
+        if self._pushed:
+            self.apply(self.after)
+        self._pushed = True
 
     def undo(self):
         self.apply(self.before)

@@ -48,6 +48,7 @@ BODY_EDGE = QColor(20, 20, 20)
 DRAG_COLOUR = QColor(230, 40, 40)
 LIFT_COLOUR = QColor(40, 120, 255)
 COLOUR_BAR_MARGIN = 132  # pixels on the right kept for the colour bar
+WHEEL_DEG_PER_NOTCH = 2.0  # one notch of the mouse wheel (120 eighths of a degree) turns the body this far
 MOUSE_HINT = ("Drag the body to move it; drag its round handle or turn the mouse wheel to rotate it "
               "(hold Shift for 15\u00b0 steps).")
 HANDLE_HINT = "Drag to rotate the body about its reference point (Shift: 15\u00b0 steps); the mouse wheel rotates it too."
@@ -67,6 +68,7 @@ class Viewport(QOpenGLWidget):
     inputRefused = Signal()         # a press or wheel turn while `locked` (a replay shows)
     turnRequested = Signal(float)   # the rotation handle asks for this body angle (degrees, any turns)
     turnFinished = Signal(float, float)   # one drag of the handle: angle before and after (degrees)
+    wheelTurned = Signal(float)     # the wheel asks to turn the body by this many degrees
     turnRefused = Signal(str)       # the handle was pressed while this (a device, a script) drives the body
 
     def __init__(self, parent=None):
@@ -537,7 +539,7 @@ class Viewport(QOpenGLWidget):
             if blocker:
                 self.turnRefused.emit(blocker)
                 return
-            self._turn = turn_handle.Turn(self._pointer_degrees(pos), math.degrees(self.sim.angle_target))
+            self._turn = turn_handle.Turn(self._pointer_degrees(pos), self.sim.target_degrees())
             self._set_hover(hover)
             return
         if ev.button() == Qt.LeftButton and self.sim.hit(x, y):
@@ -606,6 +608,5 @@ class Viewport(QOpenGLWidget):
             self.inputRefused.emit()
             ev.accept()
             return
-        steps = ev.angleDelta().y() / 120.0
-        self.sim.rotate_by(2.0 * steps)
+        self.wheelTurned.emit(WHEEL_DEG_PER_NOTCH * ev.angleDelta().y() / 120.0)
         ev.accept()

@@ -85,12 +85,15 @@ def build_links(q: np.ndarray, solid: np.ndarray, x0: int, y0: int, center, velo
                      np.stack([ux, uy], axis=1), a, b, c, d)
 
 
-def incoming(f: np.ndarray, links: BodyLinks) -> np.ndarray:
+def incoming(f: np.ndarray, links: BodyLinks, f_ib: np.ndarray | None = None) -> np.ndarray:
     """f_i^in(x) for every body link, from a window f of post-collision populations (9, h, w).
 
     Evaluated in float64 whatever f's dtype, in the order a f_ib(x) + b f_ib(xf) + c f_i(x) + d.
+    `f_ib`: `outgoing(f, links)` where the caller has it already (the momentum exchange: one
+    gather of f*_ib(x) instead of two).
     """
-    f_ib = f[links.ib, links.iy, links.ix].astype(np.float64)
+    if f_ib is None:
+        f_ib = outgoing(f, links)
     f_ib2 = f[links.ib, links.fy, links.fx].astype(np.float64)
     f_i = f[links.i, links.iy, links.ix].astype(np.float64)
     return links.a * f_ib + links.b * f_ib2 + links.c * f_i + links.d

@@ -16,7 +16,7 @@ from solver.bouzidi import incoming
 from solver.collision import Collider
 from solver.config import FlowConfig
 from solver.forces.base import BodyWindow
-from solver.inflow import OUTLET_DIRECTIONS, inflow_velocity, outlet_incoming
+from solver.inflow import OUTLET_DIRECTIONS, outlet_incoming, profile, ramp
 from solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 
 #: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall
@@ -80,6 +80,7 @@ class NumpySolver(Solver):
         self._solid_idx = None
         self._solid_g = None
         self._impulse = (0.0, 0.0)
+        self._inflow_key = self._inflow_profile = None
 
     # --- body -----------------------------------------------------------------
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
@@ -150,7 +151,7 @@ class NumpySolver(Solver):
             # d: outlet, anti-bounce-back at x = nx - 1/2 with rho = RHO0 (pressure outlet)
             gin[OUTLET_DIRECTIONS, :, nx - 1] = outlet_incoming(g[:, :, nx - 2:])
             # c: inlet, moving-wall half-way bounce-back at x = -1/2
-            u_in = inflow_velocity(cfg, t, self.inflow_speed)
+            u_in = self._inflow_velocity(t)
             for i in (1, 5, 8):
                 gin[i, :, 0] = g[OPP[i], :, 0] + (6.0 * W[i] * RHO0) * u_in
         if cfg.y_boundary != "periodic":
@@ -167,6 +168,16 @@ class NumpySolver(Solver):
         self.time = t + 1
         if not np.isfinite(total):
             raise SolverDiverged(t + 1, "density is no longer finite")
+
+    def _inflow_velocity(self, t: int) -> np.ndarray:
+        """u_in(iy, t) = ramp(t) profile(iy), as solver.inflow.inflow_velocity computes it, with
+        the profile rebuilt only when the speed changes (the config is fixed for a solver's life),
+        as the gl backend does with its profile texture."""
+        cfg = self.config
+        if self._inflow_key != self.inflow_speed:
+            self._inflow_key = self.inflow_speed
+            self._inflow_profile = profile(cfg.ny, self.inflow_speed, cfg.inflow_profile)
+        return ramp(t, cfg.inflow_ramp_steps) * self._inflow_profile
 
     def _walls(self, g, gin) -> None:
         """Rule b: half-way bounce-back (no_slip) or specular reflection (free_slip) at

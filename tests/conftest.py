@@ -6,6 +6,8 @@ import tempfile
 
 import pytest
 
+pytest_plugins = ["gui_fixtures"]   # the GUI tests' window fixture; imports Qt only in a gui run
+
 # Mesa's shader cache and Qt's caches go to a temp dir, never the user's home (shared/notes).
 _cache = tempfile.mkdtemp(prefix="feelflow-test-cache-")
 os.environ.setdefault("MESA_SHADER_CACHE_DIR", _cache)
@@ -14,11 +16,15 @@ os.environ.setdefault("XDG_CACHE_HOME", _cache)
 
 @pytest.fixture(scope="session")
 def gl_context():
-    """A standalone EGL OpenGL 3.3 core context (llvmpipe where there is no GPU)."""
-    moderngl = pytest.importorskip("moderngl")
+    """The process's standalone EGL OpenGL 3.3 core context (app.headless.gl_context: llvmpipe
+    where there is no GPU), the one the CLI's gl solvers get too."""
+    pytest.importorskip("moderngl")
+    from app.cli import UserError
+    from app.headless import gl_context as egl_context
+
     try:
-        ctx = moderngl.create_context(standalone=True, backend="egl", require=330)
-    except Exception as exc:  # no EGL on this machine: the gl tier cannot run
+        ctx = egl_context()
+    except UserError as exc:  # no EGL on this machine: the gl tier cannot run
         pytest.fail(f"EGL standalone context unavailable: {exc}")
     yield ctx
     ctx.release()

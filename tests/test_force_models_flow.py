@@ -15,7 +15,6 @@
 """
 from __future__ import annotations
 
-import functools
 
 import numpy as np
 import pytest
@@ -24,7 +23,6 @@ from solver_backends import BACKENDS
 
 from shapes import Cylinder, HalfAirfoil, rasterise
 from solver.config import FlowConfig
-from solver.forces import create_model
 from solver.forces.base import BodyWindow
 from solver.forces.stress import viscous_force
 from solver.lattice import equilibrium

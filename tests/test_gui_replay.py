@@ -12,9 +12,6 @@ import pytest
 pytestmark = [pytest.mark.gui,
               pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
 
-if os.environ.get("DISPLAY"):
-    from test_gui_window import window  # noqa: F401,F811  (the window fixture; Qt is set up there)
-
 
 def record_in_window(window, qtbot, path, monkeypatch):
     """File > Record session: drag the body, change the wind, stop and save to `path`."""
@@ -154,7 +151,7 @@ def test_gl_window_replays_in_its_own_context(qtbot, tmp_path, monkeypatch):
     from app.main_window import MainWindow
     from app.session import load_session
     from app.simulation import Params
-    from test_gui_window import GRID
+    from gui_fixtures import GRID
 
     w = MainWindow(backend="gl", settings=QSettings(str(tmp_path / "s.ini"), QSettings.IniFormat),
                    params=Params(grid=GRID, size=12))

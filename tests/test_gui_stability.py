@@ -11,9 +11,6 @@ import pytest
 pytestmark = [pytest.mark.gui,
               pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
 
-if os.environ.get("DISPLAY"):
-    from test_gui_window import window  # noqa: F401  (the real-window fixture)
-
 
 def test_lowest_viscosity_at_highest_wind_runs_finite_and_says_so(window, qtbot):
     from solver.stability_limit import inside, min_stable_viscosity

@@ -1,7 +1,9 @@
 """The rotation handle on the body, in the real window (Xvfb, numpy solver, small grid): it shows
 when the pointer comes near the body, dragging its knob turns the body by the pointer's angle
 (the solid mask follows), Shift snaps to 15 degrees, one drag is one undo step, and it is refused
-while a replay shows or a motion script or a haptic device drives the body."""
+while a replay shows or a motion script or a haptic device drives the body. The mouse wheel and
+the panel's angle box turn the body undoably too: a burst of notches or of edits is one undo step,
+and undo gives back the very angle it took away."""
 from __future__ import annotations
 
 import math
@@ -10,11 +12,10 @@ import os
 import numpy as np
 import pytest
 
+from gui_fixtures import solid_mask, wheel   # the `window` fixture comes from gui_fixtures too (conftest)
+
 pytestmark = [pytest.mark.gui,
               pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
-
-if os.environ.get("DISPLAY"):
-    from test_gui_window import solid_mask, window  # noqa: F401,F811  (the window fixture; Qt is set up there)
 
 
 def knob_after_hover(window):
@@ -155,3 +156,102 @@ def test_the_handle_is_refused_while_a_script_or_a_device_drives_the_body(window
     send_mouse(vp, "press", knob)
     assert vp._turn is not None
     send_mouse(vp, "release", knob)
+
+
+def at_57_degrees(window):
+    """A plate set to 57 degrees in the angle box: radians -> degrees -> radians of 57 is not 57's
+    radians in floating point, so an undo that went through degrees would miss it by one ulp."""
+    sim = plate(window)
+    window.panel.angle.setValue(57)
+    assert sim.angle == sim.angle_target == math.radians(57) and sim.params.angle_deg == 57
+    assert math.radians(math.degrees(sim.angle_target)) != sim.angle_target
+    return sim
+
+
+def test_a_wheel_turn_is_one_undo_step_back_to_the_exact_angle(window, qtbot):
+    sim = at_57_degrees(window)
+    mask, steps = solid_mask(sim), window.undo.count()
+    wheel(window, 1)
+    assert math.degrees(sim.angle_target) == pytest.approx(59)
+    assert window.undo.count() == steps + 1 and window.panel.angle.value() == 59
+    qtbot.waitUntil(lambda: sim.angle == sim.angle_target, timeout=30000)   # running: it swings there
+    window.undo.undo()
+    assert sim.angle_target == math.radians(57) and sim.params.angle_deg == 57
+    assert window.panel.angle.value() == 57
+    qtbot.waitUntil(lambda: sim.angle == sim.angle_target, timeout=30000)
+    np.testing.assert_array_equal(solid_mask(sim), mask)
+    window.undo.redo()
+    assert math.degrees(sim.angle_target) == pytest.approx(59)
+
+
+def test_a_burst_of_wheel_notches_is_one_undo_step(window, qtbot):
+    from app.turn_handle import BURST_S
+
+    sim = at_57_degrees(window)
+    window.set_paused(True)                                        # paused: each notch turns it at once
+    mask, steps = solid_mask(sim), window.undo.count()
+    for _ in range(5):
+        wheel(window, 1)
+    assert sim.angle == pytest.approx(math.radians(67), abs=1e-12) and sim.params.angle_deg == 67
+    assert window.undo.count() == steps + 1
+    window.undo.undo()
+    assert sim.angle == sim.angle_target == math.radians(57) and sim.params.angle_deg == 57
+    np.testing.assert_array_equal(solid_mask(sim), mask)
+    window.undo.redo()
+    assert sim.params.angle_deg == 67
+    qtbot.wait(int(BURST_S * 1000) + 300)                           # a pause: the next notch is a new step
+    wheel(window, 1)
+    assert window.undo.count() == steps + 2
+    wheel(window, -1)                                              # back where this burst began: no step
+    assert window.undo.count() == steps + 1 and sim.params.angle_deg == 67
+
+
+def test_a_burst_of_wheel_notches_across_180_degrees_is_one_undo_step(window):
+    sim = plate(window)
+    window.set_paused(True)
+    window.panel.angle.setValue(177)
+    steps = window.undo.count()
+    for _ in range(3):
+        wheel(window, 1)                                           # 179, 181 (shown as -179), -177
+    assert sim.params.angle_deg == -177 and window.undo.count() == steps + 1
+    window.undo.undo()
+    assert sim.angle == math.radians(177) and sim.params.angle_deg == 177
+
+
+def test_edits_of_the_angle_box_are_one_undo_step(window, qtbot):
+    from PySide6.QtCore import Qt
+
+    from app.turn_handle import BURST_S
+
+    sim = at_57_degrees(window)
+    qtbot.wait(int(BURST_S * 1000) + 300)                           # the 57 is a step of its own
+    mask, steps = solid_mask(sim), window.undo.count()
+    box = window.panel.angle
+    for _ in range(3):
+        box.stepBy(1)                                              # the arrows: 5 degrees a step
+    assert sim.angle == math.radians(72) and window.undo.count() == steps + 1
+    box.selectAll()
+    qtbot.keyClicks(box, "-48")                                    # typed: "-", "-4", "-48", each applied
+    qtbot.keyClick(box, Qt.Key_Return)
+    assert sim.angle == math.radians(-48) and sim.params.angle_deg == -48
+    assert window.undo.count() == steps + 1                        # arrows and typing in one burst
+    window.undo.undo()
+    assert sim.angle == sim.angle_target == math.radians(57) and box.value() == 57
+    np.testing.assert_array_equal(solid_mask(sim), mask)
+    window.undo.redo()
+    assert sim.angle == math.radians(-48) and box.value() == -48
+
+
+def test_the_wheel_is_refused_while_a_replay_shows(window, qtbot, tmp_path, monkeypatch):
+    from test_gui_replay import record_in_window
+
+    path = tmp_path / "wheel.ffsession"
+    record_in_window(window, qtbot, path, monkeypatch)
+    live = window.sim
+    angle, steps = live.angle_target, window.undo.count()
+    assert window.start_replay(str(path))
+    replay_angle = window.replay.angle
+    wheel(window, 3)
+    assert "the mouse does not move the body" in window.statusBar().currentMessage()
+    assert live.angle_target == angle and window.undo.count() == steps
+    assert window.replay.angle == replay_angle

@@ -11,40 +11,10 @@ import sys
 import numpy as np
 import pytest
 
+from gui_fixtures import GRID, solid_mask, wheel   # the `window` fixture comes from gui_fixtures too (conftest)
+
 pytestmark = [pytest.mark.gui,
               pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
-
-if os.environ.get("DISPLAY"):
-    from app.commands.gui import set_surface_format
-    from app.qt_runtime import make_none_immortal
-
-    make_none_immortal()
-    set_surface_format()   # before pytest-qt creates the QApplication
-
-GRID = (128, 64)
-
-
-@pytest.fixture
-def window(qtbot, tmp_path):
-    from PySide6.QtCore import QSettings
-
-    from app.main_window import MainWindow
-    from app.simulation import Params
-
-    settings = QSettings(str(tmp_path / "settings.ini"), QSettings.IniFormat)
-    w = MainWindow(backend="numpy", settings=settings, params=Params(grid=GRID, size=12))
-    qtbot.addWidget(w)
-    w.resize(1100, 700)
-    w.show()
-    qtbot.waitUntil(lambda: w.sim is not None, timeout=20000)
-    qtbot.waitUntil(lambda: w.sim.solver.time > 20, timeout=20000)
-    yield w
-    w.timer.stop()
-    w.slow_timer.stop()
-
-
-def solid_mask(sim):
-    return sim.solver.body.solid.copy()
 
 
 def test_window_opens_runs_and_shows_a_live_field(window, qtbot):
@@ -139,15 +109,8 @@ def test_dragging_moves_the_body_and_hold_still_freezes_it(window, qtbot):
 
 
 def test_wheel_rotates_the_body(window, qtbot):
-    from PySide6.QtCore import QPoint, QPointF, Qt
-    from PySide6.QtGui import QWheelEvent
-    from PySide6.QtWidgets import QApplication
-
-    vp, sim = window.viewport, window.sim
-    pos = vp.to_widget(*sim.pos)
-    ev = QWheelEvent(pos, vp.mapToGlobal(pos), QPoint(), QPoint(0, 120 * 5), Qt.NoButton, Qt.NoModifier,
-                     Qt.NoScrollPhase, False)
-    QApplication.sendEvent(vp, ev)
+    sim = window.sim
+    wheel(window, 5)
     assert sim.angle_target == pytest.approx(math.radians(10))
     qtbot.waitUntil(lambda: sim.angle > math.radians(1), timeout=10000)
 

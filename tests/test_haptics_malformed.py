@@ -6,7 +6,6 @@ import pytest
 
 from haptics import ForceLoop, LoopConfig, open_device
 from haptics.protocols import diyhid, hapkit, haply
-from haptics.protocols import spacemouse as sm
 from tests.haptics_helpers import Feeder, wait_for
 
 

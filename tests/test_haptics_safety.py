@@ -10,7 +10,7 @@ import time
 import numpy as np
 import pytest
 
-from haptics import ForceLoop, ForceSample, LoopConfig, SafetyConfig, open_device
+from haptics import ForceLoop, LoopConfig, SafetyConfig, open_device
 from haptics.drivers.base import clamp_force
 from tests.haptics_helpers import Feeder, force, force_after, record, wait_for
 

@@ -1,13 +1,16 @@
-"""`feelflow bench [solver|haptics]`: speed of the solver backends, or of the haptic loop.
+"""`feelflow bench [solver|accuracy|haptics]`: speed of the solver backends, their speed against
+their error, or the haptic loop.
 
-The solver bench lives in `app/commands/bench_solver.py`, the haptic one in
-`app/commands/bench_haptics.py`; this module only dispatches.
+The solver bench lives in `app/commands/bench_solver.py`, speed against error in
+`app/commands/bench_accuracy.py`, the haptic one in `app/commands/bench_haptics.py`; this
+module only dispatches.
 """
 from __future__ import annotations
 
 import importlib
 
-TARGETS = {"solver": "app.commands.bench_solver", "haptics": "app.commands.bench_haptics"}
+TARGETS = {"solver": "app.commands.bench_solver", "accuracy": "app.commands.bench_accuracy",
+           "haptics": "app.commands.bench_haptics"}
 
 
 def add_arguments(parser):
@@ -17,7 +20,9 @@ def add_arguments(parser):
     parser.add_argument("--device", metavar="URL", default="sim://haply2diy",
                         help="haptics: the device to run the loop against (default: a simulator)")
     parser.add_argument("--seconds", type=float, default=None, help="how long to measure")
-    parser.add_argument("--quick", action="store_true", help="solver: fewer steps (smoke test)")
+    parser.add_argument("--quick", action="store_true", help="solver, accuracy: fewer steps or points (smoke test)")
+    parser.add_argument("--backend", action="append", choices=("numpy", "gl"),
+                        help="accuracy: only this backend (repeatable; default: numpy float64, numpy float32, gl)")
     parser.add_argument("--variants", action="store_true",
                         help="solver: compare the gl backend's tuning variants (docs/performance.md)")
 

@@ -25,6 +25,10 @@ import time
 
 import numpy as np
 
+from app.cli import UserError
+from app.headless import gl_context
+from app.machine import cpu_name
+
 GRIDS = ((256, 128), (512, 256), (1024, 512))
 SCENES = ("box", "tunnel")
 BYTES_PER_NODE_STEP = 72
@@ -32,14 +36,7 @@ MOVE_EVERY = 10
 
 
 def machine() -> dict:
-    cpu = platform.processor() or "?"
-    try:
-        with open("/proc/cpuinfo") as fh:
-            names = [line.split(":", 1)[1].strip() for line in fh if line.startswith("model name")]
-        cpu = names[0] if names else cpu
-    except OSError:
-        pass
-    return {"cpu": cpu, "cores": os.cpu_count(), "system": f"{platform.system()} {platform.release()}",
+    return {"cpu": cpu_name(), "cores": os.cpu_count(), "system": f"{platform.system()} {platform.release()}",
             "python": platform.python_version(), "numpy": np.__version__,
             "LP_NUM_THREADS": os.environ.get("LP_NUM_THREADS", "(default)")}
 
@@ -129,12 +126,11 @@ def measure(run: SceneRun, seconds: float, warmup: int = 20) -> dict:
 
 
 def _gl_context():
-    import moderngl
-
+    """(the process's EGL context, None), or (None, why) where there is none: the numpy figures stay."""
     try:
-        return moderngl.create_context(standalone=True, backend="egl", require=330), None
-    except Exception as exc:  # report it, keep the numpy figures
-        return None, f"no EGL OpenGL 3.3 context: {exc}"
+        return gl_context(), None
+    except UserError as exc:
+        return None, str(exc)
 
 
 def run_bench(quick: bool, seconds: float | None):

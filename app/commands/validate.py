@@ -5,10 +5,12 @@ The exit code is 0 when every target is met, 1 otherwise.
 """
 from __future__ import annotations
 
+import os
 import platform
 from pathlib import Path
 
 from app.cli import UserError
+from app.machine import cpu_name
 
 
 def add_arguments(parser):
@@ -25,15 +27,8 @@ def add_arguments(parser):
 
 
 def machine_description() -> str:
-    cpu = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo") as fh:
-            names = [line.split(":", 1)[1].strip() for line in fh if line.startswith("model name")]
-        if names:
-            cpu = f"{names[0]} ({len(names)} logical CPUs)"
-    except OSError:
-        pass
-    return f"{cpu}, {platform.system()} {platform.release()}, Python {platform.python_version()}"
+    return (f"{cpu_name()} ({os.cpu_count()} logical CPUs), {platform.system()} {platform.release()}, "
+            f"Python {platform.python_version()}")
 
 
 def _fmt(v) -> str:

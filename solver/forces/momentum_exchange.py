@@ -33,7 +33,7 @@ class GalileanMomentumExchange(ForceModel):
         if len(links) == 0:
             return float(jx), float(jy)
         f_out = outgoing(window.f, links)      # f*_ib(x), moving along c_ib
-        f_in = incoming(window.f, links)       # f_i^in(x), moving along c_i
+        f_in = incoming(window.f, links, f_out)   # f_i^in(x), moving along c_i
         cx = C[links.i, 0].astype(np.float64)
         cy = C[links.i, 1].astype(np.float64)
         ux, uy = links.uw[:, 0], links.uw[:, 1]
@@ -50,7 +50,8 @@ class ClassicMomentumExchange(ForceModel):
         links = window_links(window)
         if len(links) == 0:
             return 0.0, 0.0
-        s = outgoing(window.f, links) + incoming(window.f, links)
+        f_out = outgoing(window.f, links)
+        s = f_out + incoming(window.f, links, f_out)
         fx = -np.sum(C[links.i, 0] * s)
         fy = -np.sum(C[links.i, 1] * s)
         return float(fx), float(fy)

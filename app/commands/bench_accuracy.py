@@ -1,0 +1,164 @@
+"""`feelflow bench accuracy`: speed against error, on a case with a known answer.
+
+Runs Schaefer-Turek 2D-1 (steady flow past a cylinder at Re = 20, `solver/validation/
+schaefer_turek_2d1.py`, to its convergence criterion) for each backend (numpy float64, numpy
+float32, gl float32) along two axes of what a run costs:
+
+- *resolution*: cells per diameter D at the validation's inflow speed U_m = 0.075: error falls
+  like D^-2 (second-order scheme), work rises like D^3 (nodes D^2, steps to the steady state D);
+- *time step*: the inflow speed U_m in lattice units at a fixed D. At fixed D and Re, a larger
+  U_m means fewer steps per unit of physical time (the same grid, a larger time step) but a
+  larger Mach number, whose compressibility error grows like Ma^2.
+
+Per run it reports the grid, steps, wall and CPU seconds, MLUPS, and the relative errors of
+C_D, C_L and dp against the refined reference values (John 2004,
+/work/shared/reference/benchmarks.md); per backend, the observed order of the C_D error between
+successive resolutions. All rows of one invocation come from one process, so their ratios
+compare; the absolute seconds depend on the machine (printed) and on its load.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+RESOLUTIONS = (8, 12, 16, 24, 32)
+SPEEDS = (0.02, 0.03, 0.05, 0.075, 0.09)  # below the Mach cap (FlowConfig.max_speed, Ma 0.17)
+SPEED_RESOLUTION = 16
+QUICK_RESOLUTIONS = (8, 12)
+QUICK_SPEEDS = (0.05, 0.09)
+QUICK_SPEED_RESOLUTION = 8
+#: (label, backend, dtype)
+VARIANTS = (("numpy float64", "numpy", "float64"), ("numpy float32", "numpy", "float32"),
+            ("gl float32", "gl", "float32"))
+
+
+def _factory(backend: str, dtype: str, ctx):
+    from solver.backend import create_solver
+
+    def make(config):
+        config = dataclasses.replace(config, dtype=dtype)
+        return create_solver(backend, config, **({"ctx": ctx} if backend == "gl" else {}))
+    return make
+
+
+def run_point(make_solver, d: int, u_max: float) -> dict:
+    """One converged 2D-1 run: its cost and its errors (relative, signed)."""
+    from solver.validation import schaefer_turek_2d1 as st
+
+    c0 = time.process_time()
+    r = st.run(make_solver, resolution=d, u_max=u_max)
+    cpu = time.process_time() - c0
+    q = r.quantities
+    geo = st.Geometry(d, st.RE, u_max=u_max)
+    return {"d": d, "u_max": u_max, "mach": round(u_max * math.sqrt(3.0), 4), "grid": f"{geo.nx}x{geo.ny}",
+            "node_updates": r.node_updates,
+            "tau": round(q["tau"], 4), "steps": r.steps, "converged": bool(q["converged"]),
+            "wall_s": round(r.wall_seconds, 2), "cpu_s": round(cpu, 2), "mlups": round(r.mlups, 1),
+            "cd": q["cd"], "cd_error": q["cd_rel_error"], "cl_error": q["cl_rel_error"], "dp_error": q["dp_rel_error"]}
+
+
+def observed_orders(rows) -> list[dict]:
+    """Order of the C_D error between successive resolutions of one backend (same U_m)."""
+    out = []
+    for a, b in zip(rows, rows[1:]):
+        ea, eb = abs(a["cd_error"]), abs(b["cd_error"])
+        order = math.log(ea / eb) / math.log(b["d"] / a["d"]) if ea > 0 and eb > 0 else float("nan")
+        out.append({"from_d": a["d"], "to_d": b["d"], "order": round(order, 2)})
+    return out
+
+
+def fitted_order(rows) -> float:
+    """Least-squares slope of -log|C_D error| against log D over all resolutions: the trend
+    through the scatter that the lattice's alignment with the cylinder and tau (which grows with
+    D at fixed U_m) put on the successive orders."""
+    pts = [(math.log(r["d"]), math.log(abs(r["cd_error"]))) for r in rows if r["cd_error"] != 0]
+    if len(pts) < 2:
+        return float("nan")
+    mx = sum(x for x, _ in pts) / len(pts)
+    my = sum(y for _, y in pts) / len(pts)
+    sxx = sum((x - mx) ** 2 for x, _ in pts)
+    return round(-sum((x - mx) * (y - my) for x, y in pts) / sxx, 2)
+
+
+def run_sweep(quick: bool, backends=None) -> dict:
+    from app.commands.bench_solver import _gl_context, machine
+
+    resolutions = QUICK_RESOLUTIONS if quick else RESOLUTIONS
+    speeds = QUICK_SPEEDS if quick else SPEEDS
+    d_speed = QUICK_SPEED_RESOLUTION if quick else SPEED_RESOLUTION
+    from solver.validation.schaefer_turek import U_MAX
+
+    ctx, gl_error = _gl_context()
+    renderer = ctx.info.get("GL_RENDERER") if ctx else None
+    out = {"machine": machine(), "renderer": renderer, "case": "schaefer-turek-2d1 (Re 20, steady)",
+           "resolution_axis": {"u_max": U_MAX, "d": list(resolutions)},
+           "speed_axis": {"d": d_speed, "u_max": list(speeds)}, "variants": {}}
+    for label, backend, dtype in VARIANTS:
+        if backends and backend not in backends:
+            continue
+        if backend == "gl" and ctx is None:
+            out["variants"][label] = {"error": gl_error}
+            print(f"{label}: skipped ({gl_error})", flush=True)
+            continue
+        make = _factory(backend, dtype, ctx)
+        by_d, by_u = [], []
+        for d in resolutions:
+            by_d.append(run_point(make, d, U_MAX))
+            print(format_row(label, by_d[-1]), flush=True)
+        for u in speeds:
+            row = next((r for r in by_d if r["d"] == d_speed and r["u_max"] == u), None)
+            by_u.append(row or run_point(make, d_speed, u))
+            if row is None:
+                print(format_row(label, by_u[-1]), flush=True)
+        out["variants"][label] = {"backend": backend, "dtype": dtype, "resolution": by_d,
+                                  "orders": observed_orders(by_d), "fitted_order": fitted_order(by_d), "speed": by_u}
+    return out
+
+
+HEADER = (f"{'variant':14s} {'D':>3s} {'U_m':>6s} {'grid':>9s} {'tau':>6s} {'steps':>7s} {'wall s':>7s} "
+          f"{'CPU s':>7s} {'MLUPS':>6s} {'C_D err %':>10s} {'C_L err %':>10s} {'dp err %':>9s}")
+
+
+def format_row(label: str, r: dict) -> str:
+    flag = "" if r["converged"] else "  (not converged)"
+    return (f"{label:14s} {r['d']:3d} {r['u_max']:6.3f} {r['grid']:>9s} {r['tau']:6.3f} {r['steps']:7d} "
+            f"{r['wall_s']:7.1f} {r['cpu_s']:7.1f} {r['mlups']:6.1f} {100 * r['cd_error']:+10.3f} "
+            f"{100 * r['cl_error']:+10.2f} {100 * r['dp_error']:+9.3f}{flag}")
+
+
+def markdown_tables(result) -> str:
+    """The two axes as Markdown tables (what README quotes), rows in the order run."""
+    cols = "| variant | D | U_m | tau | grid | steps | wall s | CPU s | MLUPS | C_D error | C_L error | dp error |"
+    rule = "|" + " --- |" * (cols.count("|") - 1)
+    out = []
+    for axis, title in (("resolution", "resolution (U_m fixed)"), ("speed", "time step (D fixed)")):
+        out += ["", f"Axis: {title}", "", cols, rule]
+        for label, v in result["variants"].items():
+            for r in v.get(axis, []):
+                out.append(f"| {label} | {r['d']} | {r['u_max']} | {r['tau']} | {r['grid']} | {r['steps']} | "
+                           f"{r['wall_s']:.1f} | {r['cpu_s']:.1f} | {r['mlups']:.1f} | {100 * r['cd_error']:+.3f} % | "
+                           f"{100 * r['cl_error']:+.2f} % | {100 * r['dp_error']:+.3f} % |")
+    return "\n".join(out)
+
+
+def main(args) -> int:
+    from app.commands.bench_solver import machine
+
+    m = machine()
+    print(f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}, Python {m['python']}, numpy {m['numpy']}")
+    print("Schaefer-Turek 2D-1 (Re 20) to convergence; errors against John 2004's reference values\n")
+    print(HEADER, flush=True)
+    result = run_sweep(bool(getattr(args, "quick", False)), getattr(args, "backend", None))
+    if result["renderer"]:
+        print(f"renderer: {result['renderer']}")
+    for label, v in result["variants"].items():
+        if "orders" in v:
+            orders = ", ".join(f"{o['from_d']}->{o['to_d']}: {o['order']}" for o in v["orders"])
+            print(f"{label}: observed order of the C_D error {orders}; fitted over all D: {v['fitted_order']}")
+    print(markdown_tables(result))
+    if getattr(args, "json", None):
+        from app.files import write_json_atomic
+
+        write_json_atomic(args.json, result)
+    return 0

@@ -1,0 +1,44 @@
+"""`feelflow bench accuracy`: speed against error on Schaefer-Turek 2D-1 (app/commands/bench_accuracy.py)."""
+import json
+
+import pytest
+
+from app.commands import bench_accuracy
+from app.cli import main as cli_main
+
+
+def _numpy64(config):
+    from solver.backend import create_solver
+
+    return create_solver("numpy", config)
+
+
+def test_error_falls_with_resolution_and_work_rises():
+    """A second-order scheme: the C_D error at 12 cells per diameter is below the one at 8,
+    the run costs more node updates, and the observed order is positive (benchmarks.md values)."""
+    coarse = bench_accuracy.run_point(_numpy64, 8, 0.075)
+    fine = bench_accuracy.run_point(_numpy64, 12, 0.075)
+    assert coarse["converged"] and fine["converged"]
+    assert abs(fine["cd_error"]) < abs(coarse["cd_error"]) < 0.03
+    assert abs(fine["dp_error"]) < abs(coarse["dp_error"])
+    assert fine["node_updates"] > 2 * coarse["node_updates"]
+    (order,) = bench_accuracy.observed_orders([coarse, fine])
+    assert (order["from_d"], order["to_d"]) == (8, 12) and order["order"] > 0
+    assert bench_accuracy.fitted_order([coarse, fine]) == pytest.approx(order["order"], abs=0.01)
+
+
+def test_cli_sweeps_both_numpy_precisions_and_writes_json(tmp_path, monkeypatch, capsys):
+    """One point per axis (monkeypatched axes keep it short): float32 storage of f - w rho0 gives
+    the float64 answer to float32 precision, and the JSON holds the machine and every row."""
+    monkeypatch.setattr(bench_accuracy, "QUICK_RESOLUTIONS", (8,))
+    monkeypatch.setattr(bench_accuracy, "QUICK_SPEEDS", (0.075,))
+    out = tmp_path / "acc.json"
+    assert cli_main(["bench", "accuracy", "--quick", "--backend", "numpy", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["machine"]["cores"] >= 1 and set(data["variants"]) == {"numpy float64", "numpy float32"}
+    r64, r32 = (data["variants"][k]["resolution"][0] for k in ("numpy float64", "numpy float32"))
+    assert r64["grid"] == "176x33" and r64["steps"] > 0 and r64["mlups"] > 0
+    assert r32["cd_error"] == pytest.approx(r64["cd_error"], abs=2e-5)
+    assert data["variants"]["numpy float64"]["speed"][0] == r64  # the shared point is not run twice
+    printed = capsys.readouterr().out
+    assert "C_D err %" in printed and "numpy float32" in printed
