@@ -1,4 +1,8 @@
-"""`feelflow gui` (the default command) and `feelflow --selftest [--screenshot PATH] [--seconds S]`.
+"""`feelflow gui [SESSION]` (the default command) and `feelflow --selftest [--screenshot PATH] [--seconds S]`.
+
+`feelflow gui FILE.ffsession` opens the window and replays that session in it as soon as the live
+tunnel runs (what File > Replay session does); the desktop entry's `Exec=... gui %f` uses it, so
+double-clicking a session file in the file manager replays it.
 
 The OpenGL surface format (3.3 core, no depth buffer, no vsync) is set before the QApplication
 exists (shared/notes/gl-qt-on-this-machine.md). Without a display there is no window: one line
@@ -15,6 +19,8 @@ DEFAULT_BACKEND = "gl"
 
 
 def add_arguments(parser):
+    parser.add_argument("session", nargs="?", default=None, metavar="SESSION",
+                        help="a recorded session file (.ffsession) to replay in the window once it has started")
     parser.add_argument("--backend", choices=("gl", "numpy"), default=None,
                         help=f"solver backend (default {DEFAULT_BACKEND}; numpy uploads the field every frame)")
     parser.add_argument("--fresh", action="store_true", help="ignore remembered settings")
@@ -42,7 +48,19 @@ def set_surface_format():
     QSurfaceFormat.setDefaultFormat(fmt)
 
 
+def replay_when_ready(window, path) -> None:
+    """Replay the session at `path` once, when the window's live simulation first runs
+    (`MainWindow.start_replay` needs it; a bad file is its one-line dialog)."""
+    def start():
+        window.simulationReady.disconnect(start)
+        window.start_replay(path)
+    window.simulationReady.connect(start)
+
+
 def main(args) -> int:
+    session = getattr(args, "session", None)
+    if session is not None and not os.path.isfile(session):
+        raise UserError(f"{session}: no such session file")
     if not has_display():
         raise UserError("no display to open the window on (DISPLAY is not set); "
                         "use 'feelflow run' for a headless run, or run under xvfb-run")
@@ -59,6 +77,7 @@ def main(args) -> int:
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("FeelFlow")
     app.setOrganizationName("FeelFlow")
+    app.setDesktopFileName("feelflow")   # the installed feelflow.desktop: its name and icon (installer/)
     selftest = getattr(args, "selftest", False)
     if selftest or getattr(args, "fresh", False):
         import tempfile
@@ -68,6 +87,8 @@ def main(args) -> int:
     else:
         settings = QSettings()
     window = MainWindow(backend=backend, settings=settings)
+    if session is not None:
+        replay_when_ready(window, session)
     if selftest:
         from app.selftest import SelfTest
 

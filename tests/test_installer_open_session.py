@@ -1,0 +1,71 @@
+"""`feelflow gui SESSION`: what the desktop entry's `Exec=... gui %f` runs when a teacher
+double-clicks a `.ffsession` file. The real command line, the real window (Xvfb, numpy solver):
+the window opens and replays that file; a missing file is one line and exit 2."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_a_missing_session_file_is_one_line_and_exit_2(tmp_path):
+    missing = tmp_path / "gone.ffsession"
+    r = subprocess.run([sys.executable, "-m", "app", "gui", str(missing)], cwd=ROOT,
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2
+    assert r.stderr.strip() == f"feelflow: {missing}: no such session file"
+
+
+@pytest.mark.gui
+@pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")
+def test_gui_with_a_session_file_opens_the_window_replaying_it(qapp, tmp_path):
+    from PySide6.QtCore import QTimer
+    from PySide6.QtWidgets import QApplication
+
+    from app.cli import main
+    from app.main_window import MainWindow
+    from app.session import SessionRecorder, SessionSolver
+    from session_scenes import MODELS, drive_moving_cylinder, small_config, start_body
+    from solver.backend import create_solver
+
+    cfg = small_config()
+    rec = SessionRecorder(cfg, start_body(), MODELS)
+    drive_moving_cylinder(SessionSolver(create_solver("numpy", cfg), rec), steps=25)
+    path = rec.save(tmp_path / "lesson.ffsession")
+
+    seen = {}
+
+    def watch():
+        """Once the window replays, note what it shows and close it (app.exec() then returns)."""
+        for w in QApplication.topLevelWidgets():
+            if isinstance(w, MainWindow) and w.isVisible():
+                if w.replay is not None:
+                    seen.update(label=w.replay_label.text(), shown=w.viewport.sim is w.replay,
+                                live=w.sim is not None)
+                    w.close()
+                elif w.startup_error:
+                    seen["error"] = w.startup_error
+
+    def give_up():
+        seen.setdefault("timeout", True)
+        for w in QApplication.topLevelWidgets():
+            if isinstance(w, MainWindow):
+                w.close()
+
+    poll = QTimer()
+    poll.timeout.connect(watch)
+    poll.start(50)
+    QTimer.singleShot(60000, give_up)
+    try:
+        code = main(["gui", "--backend", "numpy", "--fresh", str(path)])
+    finally:
+        poll.stop()
+    assert "timeout" not in seen and "error" not in seen, seen
+    assert code == 0
+    assert seen["live"] and seen["shown"]
+    assert seen["label"].startswith("Replaying lesson.ffsession: step ")
