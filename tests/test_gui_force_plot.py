@@ -8,11 +8,10 @@ import os
 import numpy as np
 import pytest
 
+# the `window` fixture comes from tests/gui_fixtures.py (conftest)
+
 pytestmark = [pytest.mark.gui,
               pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
-
-if os.environ.get("DISPLAY"):
-    from test_gui_window import window  # noqa: F401,F811  (the window fixture; Qt is set up there)
 
 
 def test_time_view_force_axis_leaves_out_the_start_pulse(window, qtbot):
