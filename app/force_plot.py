@@ -82,11 +82,9 @@ class ForcePlot(QWidget):
         bar = QHBoxLayout()
         for w in (self.view, self.pause_box, self.clear_button, self.csv_button, self.png_button):
             bar.addWidget(w)
-        self.fit_label = QLabel("")
-        self.fit_label.setFont(self.readout.font())
+        # the widest readout keeps its place: the bar does not shift as the signs change
+        self.readout.setMinimumWidth(self.readout.fontMetrics().horizontalAdvance("CD = -00.00   CL = -00.00"))
         bar.addStretch(1)
-        bar.addWidget(self.fit_label)
-        bar.addSpacing(16)
         bar.addWidget(self.readout)
 
         pg.setConfigOptions(antialias=True, background="w", foreground="k")
@@ -153,7 +151,6 @@ class ForcePlot(QWidget):
             self.plot.getAxis("bottom").setLabel("relative speed |U - V| (lattice units)")
             self.plot.getAxis("left").setLabel("drag (lattice units)")
         else:
-            self.fit_label.setText("")
             self.plot.getAxis("bottom").setLabel("time (solver steps)")
             self.plot.getAxis("left").setLabel("force (lattice units)")
         self.refresh(force=True)
@@ -261,12 +258,26 @@ class ForcePlot(QWidget):
             c = np.mean(np.log(fs) - n * np.log(us))
             xs = np.geomspace(us.min(), us.max(), 20)
             self.fit_line.setData(xs, np.exp(c) * xs ** n)
-            self.fit_label.setText(f"fit: drag \u221d U<sup>{n:.2f}</sup>")
+            self._set_fit_text(f"fit: drag \u221d U<sup>{n:.2f}</sup>")
         else:
             self.fit_line.setData([], [])
-            self.fit_label.setText("fit: needs speeds a factor 1.5 apart")
+            self._set_fit_text("fit: needs speeds 1.5\u00d7 apart")
         self.fitted_exponent = n
         self._set_speed_ranges(us, fs)
+
+    def fit_text(self) -> str:
+        """The fit's entry in the legend (the exponent, or what the fit still needs)."""
+        for sample, label in self.legend.items:
+            if sample.item is self.fit_line:
+                return label.text
+        return ""
+
+    def _set_fit_text(self, text):
+        """The fit's result stands in the legend beside its line, not in the bar above the plot
+        (there it made the window at least 1175 pixels wide)."""
+        for sample, label in self.legend.items:
+            if sample.item is self.fit_line and label.text != text:
+                label.setText(text, bold=True, size="11pt")
 
     def _set_speed_ranges(self, us, fs):
         """Log-log ranges around the points (a factor 1.5 in speed, 2 in drag beyond them): with

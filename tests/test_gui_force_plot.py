@@ -70,3 +70,17 @@ def test_log_log_view_frames_a_single_speed(window, qtbot):
     for axis in ("bottom", "left"):                            # the tick labels follow (no 10^-300)
         a0, a1 = plot.plot.getAxis(axis).range
         assert a1 - a0 < 2, (axis, a0, a1)
+
+
+def test_the_window_fits_a_1024_pixel_wide_screen(window, qtbot):
+    """A classroom projector is often 1024 pixels wide: the window, with the log-log view and
+    its fit shown, must fit it without clipping the C_D / C_L readout."""
+    plot = window.plot
+    plot.view.setCurrentIndex(plot.view.findData("speed"))
+    qtbot.waitUntil(lambda: len(window.sim.history) > 30, timeout=20000)
+    plot.refresh(force=True)
+    assert plot.fit_text().startswith("fit")
+    window.resize(1024, 700)
+    qtbot.waitUntil(lambda: window.width() <= 1024, timeout=5000)
+    qtbot.wait(100)
+    assert plot.readout.width() >= plot.readout.sizeHint().width()
