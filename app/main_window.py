@@ -1028,12 +1028,9 @@ class MainWindow(QMainWindow):
         self.panel.show_numbers(sim.reynolds(), sim.mach(), sim.config.mach_limit)
         t, drag, lift = sim.history.drag_lift(p.force_model)
         if len(t) and p.force_model in sim.history.forces:
-            d, l = np.nanmean(drag[-30:]), np.nanmean(lift[-30:])
-            self.panel.drag.setText(f"{d:.4g} (lattice units)")
-            self.panel.lift.setText(f"{l:.4g} (lattice units)")
+            self.panel.show_forces(float(np.nanmean(drag[-30:])), float(np.nanmean(lift[-30:])))
         else:
-            self.panel.drag.setText("\u2013")
-            self.panel.lift.setText("\u2013")
+            self.panel.show_forces(None, None)
         self.plot.refresh()
         r = self.rates
         self.status["steps"].setText(f"{r['steps_per_s']:.0f} steps/s")

@@ -4,6 +4,8 @@ and input (mouse or a haptic device). It only edits values; the window applies t
 """
 from __future__ import annotations
 
+import math
+
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (QCheckBox, QComboBox, QDoubleSpinBox, QFormLayout, QGroupBox, QHBoxLayout, QLabel,
                                QPushButton, QScrollArea, QVBoxLayout, QWidget)
@@ -25,6 +27,41 @@ def select_data(box: QComboBox, data) -> None:
     i = box.findData(data)
     if i >= 0:
         box.setCurrentIndex(i)
+
+
+def force_pair_text(drag: float, lift: float) -> tuple[str, str]:
+    """Drag and lift with the same decimals, four significant digits of the larger: a lift of
+    -5.6e-10 beside a drag of 0.58 reads 0.0000, not -5.563e-10 (noise in scientific notation)."""
+    scale = max(abs(drag), abs(lift))
+    if scale < 1e-9:   # no wind, no force
+        return "0", "0"
+    decimals = max(0, 3 - math.floor(math.log10(scale)))
+
+    def text(v):
+        t = f"{v:.{decimals}f}"
+        return t.lstrip("-") if float(t) == 0 else t
+    return text(drag), text(lift)
+
+
+#: what a first-time user needs to know about each control (shown as tooltips)
+TOOLTIPS = {
+    "shape": "The body in the tunnel; Custom polygon lets you edit its corners",
+    "size": "The body's length across the flow, in grid cells (more cells: finer but slower)",
+    "hold_still": "Keep the body fixed: the flow pushes on it but it does not move",
+    "save_shape": "Save the body's shape to a file",
+    "load_shape": "Load a body's shape from a file",
+    "wind": "Speed of the incoming air, in grid cells per solver step; "
+            "keep the Mach number under its limit for a trustworthy flow",
+    "viscosity": "How thick (syrupy) the fluid is, in cells\u00b2 per step: lower viscosity gives a higher "
+                 "Reynolds number, with eddies and a swinging wake",
+    "grid": "How many cells the tunnel has: a finer grid shows more detail but runs slower",
+    "wall": "What the top and bottom of the tunnel are",
+    "model": "How the force on the body is computed from the flow (docs/force-models.md)",
+    "compare_all": "Compute every force model at once and plot them together (dashed lines are lift)",
+    "display": "What the colours show: speed, vorticity (spin), pressure, or moving tracer particles",
+    "arrows": "Draw the drag (red) and lift (blue) forces on the body",
+    "input": "What moves the body: the mouse, or a haptic device you can feel the force with",
+}
 
 
 class SidePanel(QScrollArea):
@@ -81,7 +118,8 @@ class SidePanel(QScrollArea):
 
         # flow
         self.wind = QDoubleSpinBox(decimals=3, minimum=0.0, maximum=0.09, singleStep=0.005, suffix=" cells/step")
-        self.viscosity = QDoubleSpinBox(decimals=4, minimum=0.002, maximum=0.3, singleStep=0.002)
+        self.viscosity = QDoubleSpinBox(decimals=4, minimum=0.002, maximum=0.3, singleStep=0.002,
+                                        suffix=" cells\u00b2/step")
         self.reynolds = QLabel()
         self.mach = QLabel()
         for label in (self.reynolds, self.mach):
@@ -143,6 +181,8 @@ class SidePanel(QScrollArea):
         self.display.currentIndexChanged.connect(lambda: self.displayModeChanged.emit(self.display.currentData()))
         self.arrows.toggled.connect(self.arrowsToggled)
         self.input.currentIndexChanged.connect(lambda: self.inputChanged.emit(self.input.currentData() or "mouse"))
+        for name, tip in TOOLTIPS.items():
+            getattr(self, name).setToolTip(tip)
         self.setMinimumWidth(inner.sizeHint().width() + 24)
 
     @staticmethod
@@ -184,6 +224,16 @@ class SidePanel(QScrollArea):
         self.angle.blockSignals(True)
         self.angle.setValue(degrees)
         self.angle.blockSignals(False)
+
+    def show_forces(self, drag: float | None, lift: float | None):
+        """The force model's mean drag and lift (None: no data yet)."""
+        if drag is None or lift is None or not (math.isfinite(drag) and math.isfinite(lift)):
+            self.drag.setText("\u2013")
+            self.lift.setText("\u2013")
+            return
+        d, l_ = force_pair_text(drag, lift)
+        self.drag.setText(f"{d} (lattice units)")
+        self.lift.setText(f"{l_} (lattice units)")
 
     def show_numbers(self, reynolds: float, mach: float, mach_limit: float):
         self.reynolds.setText(f"Re = {reynolds:.0f}")
