@@ -14,9 +14,10 @@ import math
 import time
 
 import numpy as np
-from PySide6.QtCore import QPoint, QSettings, Qt, QTimer, Signal
+from PySide6.QtCore import QEvent, QPoint, QSettings, Qt, QTimer, Signal
 from PySide6.QtGui import QAction, QKeySequence, QPainter, QUndoStack
-from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox, QToolBar
+from PySide6.QtWidgets import (QAbstractButton, QApplication, QDockWidget, QFileDialog, QLabel, QMainWindow,
+                               QMessageBox, QToolBar)
 
 from app.qt_runtime import make_none_immortal
 
@@ -66,6 +67,8 @@ class MainWindow(QMainWindow):
         self.setCentralWidget(self.viewport)
         self.panel = SidePanel()
         self.plot = ForcePlot()
+        for button in self.panel.findChildren(QAbstractButton) + self.plot.findChildren(QAbstractButton):
+            button.setFocusPolicy(Qt.TabFocus)   # a click leaves the focus (and Space = pause) where it was
         dock = QDockWidget("Controls", self)
         dock.setWidget(self.panel)
         dock.setFeatures(QDockWidget.DockWidgetMovable)
@@ -153,6 +156,17 @@ class MainWindow(QMainWindow):
 
     def params_now(self) -> Params:
         return self.sim.params if self.sim is not None else self.params
+
+    def event(self, ev):
+        """Space is Pause / run everywhere except on a button or check box reached with Tab:
+        there it presses the button, as on any desktop (the panel's buttons take no focus from
+        a mouse click, so Space still pauses after clicking one)."""
+        if (ev.type() == QEvent.ShortcutOverride and ev.key() == Qt.Key_Space
+                and ev.modifiers() == Qt.NoModifier
+                and isinstance(QApplication.focusWidget(), QAbstractButton)):
+            ev.accept()
+            return True
+        return super().event(ev)
 
     def closeEvent(self, ev):
         self.save_settings()

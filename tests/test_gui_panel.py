@@ -40,3 +40,26 @@ def test_force_readouts_are_plain_decimals(window, qtbot):
         float(number)
     decimals = {len(label.text().split()[0].partition(".")[2]) for label in (panel.drag, panel.lift)}
     assert len(decimals) == 1          # drag and lift to the same precision, side by side
+
+
+def test_space_presses_a_tabbed_to_check_box_and_pauses_after_a_click(window, qtbot):
+    from PySide6.QtCore import QPoint, Qt
+    from PySide6.QtTest import QTest
+    from PySide6.QtWidgets import QApplication
+
+    panel = window.panel
+    window.activateWindow()
+    qtbot.waitUntil(window.isActiveWindow, timeout=5000)
+    panel.hold_still.setFocus(Qt.TabFocusReason)                # reached with Tab
+    assert panel.hold_still.hasFocus()
+    QTest.keyClick(panel.hold_still, Qt.Key_Space)
+    assert panel.hold_still.isChecked() and window.sim.hold_still
+    assert not window.paused
+
+    window.viewport.setFocus(Qt.MouseFocusReason)
+    box = panel.hold_still
+    QTest.mouseClick(box, Qt.LeftButton, pos=QPoint(8, box.height() // 2))   # its box, clicked with the mouse
+    assert not panel.hold_still.isChecked()
+    assert not panel.hold_still.hasFocus()
+    QTest.keyClick(QApplication.focusWidget(), Qt.Key_Space)
+    assert window.paused                                        # Space is Pause / run again
