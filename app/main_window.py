@@ -651,6 +651,10 @@ class MainWindow(QMainWindow):
         self.panel.edit.setChecked(self.viewport.editing)
         if self.viewport.editing:
             self.set_hold_still(True)
+            self.statusBar().showMessage(f"Editing the polygon (the body holds still): {self.panel.edit.toolTip()}; "
+                                         "Ctrl+Z undoes an edit.", 20000)
+        elif on is False and self.statusBar().currentMessage().startswith("Editing the polygon"):
+            self.statusBar().clearMessage()
         self.viewport.update()
 
     def check_polygon(self, verts):

@@ -63,3 +63,13 @@ def test_space_presses_a_tabbed_to_check_box_and_pauses_after_a_click(window, qt
     assert not panel.hold_still.hasFocus()
     QTest.keyClick(QApplication.focusWidget(), Qt.Key_Space)
     assert window.paused                                        # Space is Pause / run again
+
+
+def test_editing_the_polygon_says_how_in_the_status_bar(window):
+    panel = window.panel
+    panel.shape.setCurrentIndex(panel.shape.findData("polygon"))
+    panel.edit.setChecked(True)
+    message = window.statusBar().currentMessage()
+    assert message.startswith("Editing the polygon") and "double-click an edge" in message
+    panel.edit.setChecked(False)
+    assert window.statusBar().currentMessage() == ""
