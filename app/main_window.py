@@ -605,10 +605,19 @@ class MainWindow(QMainWindow):
         if self.sim is not None and self.replay is None:
             self.undo.push(TurnBody(self.turn_body, before, after))
 
+    def _script_refuses_turn(self, how: str) -> bool:
+        """A motion script drives the pose (it ignores the angle until it ends, when the body would
+        swing to the last asked angle): refuse the turn with a status message."""
+        if getattr(self.sim, "runner", None) is None:
+            return False
+        self.statusBar().showMessage(f"A motion script drives the body: {how} cannot rotate it now "
+                                     "(wait for it to end or reset the flow (R)).", 6000)
+        return True
+
     def turn_by_wheel(self, degrees: float) -> bool:
         """The mouse wheel turns the body like the handle does; a burst of notches is one undo step."""
         sim = self.sim
-        if sim is None:
+        if sim is None or self._script_refuses_turn("the mouse wheel"):
             return False
         before = sim.target_degrees()
         if not self.turn_body(before + degrees):
@@ -621,6 +630,9 @@ class MainWindow(QMainWindow):
         steps) is one undo step, whose undo puts the body back at once too."""
         sim = self.sim
         if sim is None:
+            return False
+        if self._script_refuses_turn("the Angle box"):
+            self.panel.show_angle(sim.params.angle_deg)   # the box goes back to the angle the body keeps
             return False
         before = sim.target_degrees()
         if not self._turn_at_once(degrees):

@@ -3,7 +3,8 @@ when the pointer comes near the body, dragging its knob turns the body by the po
 (the solid mask follows), Shift snaps to 15 degrees, one drag is one undo step, and it is refused
 while a replay shows or a motion script or a haptic device drives the body. The mouse wheel and
 the panel's angle box turn the body undoably too: a burst of notches or of edits is one undo step,
-and undo gives back the very angle it took away."""
+and undo gives back the very angle it took away; both are refused while a motion script drives
+the body."""
 from __future__ import annotations
 
 import math
@@ -255,3 +256,21 @@ def test_the_wheel_is_refused_while_a_replay_shows(window, qtbot, tmp_path, monk
     assert "the mouse does not move the body" in window.statusBar().currentMessage()
     assert live.angle_target == angle and window.undo.count() == steps
     assert window.replay.angle == replay_angle
+
+
+def test_the_wheel_and_the_angle_box_are_refused_while_a_script_drives_the_body(window):
+    """A motion script ignores the angle until it ends (then the body would swing to whatever was
+    asked meanwhile): the wheel and the Angle box are refused like the handle, with no undo step."""
+    assert window.apply_preset("seed_protocol")
+    sim = window.sim
+    assert sim.runner is not None
+    angle, steps, shown = sim.angle_target, window.undo.count(), window.panel.angle.value()
+    wheel(window, 3)
+    assert "A motion script drives the body: the mouse wheel" in window.statusBar().currentMessage()
+    window.panel.angle.setValue(shown + 30)
+    assert "the Angle box cannot rotate it" in window.statusBar().currentMessage()
+    assert sim.angle_target == angle and window.undo.count() == steps
+    assert window.panel.angle.value() == shown
+    window.reset_flow()                      # the script ends: the wheel turns the body again
+    wheel(window, 3)
+    assert sim.angle_target != angle and window.undo.count() == steps + 1
