@@ -1,7 +1,9 @@
 """Tunnel ends: inlet velocity (smooth ramp-up times a profile) and the pressure outlet.
 
-docs/algorithm.md, rules c and d and 'Inflow'. One definition for both backends; the gl backend
-feeds `inflow_velocity` into its uniforms and implements `outlet_incoming` in GLSL.
+docs/algorithm.md, rules c and d and 'Inflow'. One definition for both backends: `ramp` and
+`profile` (the numpy backend multiplies them each step with the profile cached, the gl backend
+uploads the profile as a texture and the ramp as a uniform); `inflow_velocity` is their product,
+the definition the tests check; the gl backend implements `outlet_incoming` in GLSL.
 """
 from __future__ import annotations
 

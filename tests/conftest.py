@@ -20,14 +20,14 @@ def gl_context():
     where there is no GPU), the one the CLI's gl solvers get too."""
     pytest.importorskip("moderngl")
     from app.cli import UserError
-    from app.headless import gl_context as egl_context
+    from app.headless import gl_context as egl_context, release_gl_context
 
     try:
         ctx = egl_context()
     except UserError as exc:  # no EGL on this machine: the gl tier cannot run
         pytest.fail(f"EGL standalone context unavailable: {exc}")
     yield ctx
-    ctx.release()
+    release_gl_context()   # released and forgotten: a later gl_context() makes a new one
 
 
 def make_solver(backend: str, config, request=None):

@@ -1,5 +1,6 @@
 """`feelflow bench accuracy`: speed against error on Schaefer-Turek 2D-1 (app/commands/bench_accuracy.py)."""
 import json
+import math
 
 import pytest
 
@@ -14,17 +15,27 @@ def _numpy64(config):
 
 
 def test_error_falls_with_resolution_and_work_rises():
-    """A second-order scheme: the C_D error at 12 cells per diameter is below the one at 8,
-    the run costs more node updates, and the observed order is positive (benchmarks.md values)."""
+    """Against the reference values (benchmarks.md): from 8 to 12 cells per diameter the C_D
+    error falls, and dp converges at about second order (observed 1.95 here; C_D's successive
+    orders scatter on coarse grids, README 'Speed against error'); the finer run costs more."""
     coarse = bench_accuracy.run_point(_numpy64, 8, 0.075)
     fine = bench_accuracy.run_point(_numpy64, 12, 0.075)
     assert coarse["converged"] and fine["converged"]
     assert abs(fine["cd_error"]) < abs(coarse["cd_error"]) < 0.03
-    assert abs(fine["dp_error"]) < abs(coarse["dp_error"])
+    dp_order = math.log(coarse["dp_error"] / fine["dp_error"]) / math.log(12 / 8)
+    assert dp_order > 1.5
     assert fine["node_updates"] > 2 * coarse["node_updates"]
     (order,) = bench_accuracy.observed_orders([coarse, fine])
     assert (order["from_d"], order["to_d"]) == (8, 12) and order["order"] > 0
-    assert bench_accuracy.fitted_order([coarse, fine]) == pytest.approx(order["order"], abs=0.01)
+
+
+def test_the_fitted_order_recovers_a_power_law_through_scatter():
+    """The least-squares order of C_D errors e = a D^-2 (1 +- 30 %, alternating) is 2 within the
+    scatter's pull, and the successive orders show the scatter."""
+    rows = [{"d": d, "cd_error": 0.5 * d ** -2.0 * (1.3 if k % 2 else 0.7)} for k, d in enumerate((8, 12, 16, 24, 32))]
+    assert bench_accuracy.fitted_order(rows) == pytest.approx(2.0, abs=0.35)
+    orders = [o["order"] for o in bench_accuracy.observed_orders(rows)]
+    assert min(orders) < 1.0 < 3.0 < max(orders)
 
 
 def test_cli_sweeps_both_numpy_precisions_and_writes_json(tmp_path, monkeypatch, capsys):

@@ -89,7 +89,12 @@ def run_sweep(quick: bool, backends=None) -> dict:
     d_speed = QUICK_SPEED_RESOLUTION if quick else SPEED_RESOLUTION
     from solver.validation.schaefer_turek import U_MAX
 
-    ctx, gl_error = _gl_context()
+    want_gl = not backends or "gl" in backends
+    ctx, gl_error = _gl_context() if want_gl else (None, None)
+    if backends and "gl" in backends and ctx is None:
+        from app.cli import UserError
+
+        raise UserError(gl_error)
     renderer = ctx.info.get("GL_RENDERER") if ctx else None
     out = {"machine": machine(), "renderer": renderer, "case": "schaefer-turek-2d1 (Re 20, steady)",
            "resolution_axis": {"u_max": U_MAX, "d": list(resolutions)},
