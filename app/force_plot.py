@@ -128,7 +128,7 @@ class ForcePlot(QWidget):
     def _following(self) -> bool:
         """Is the plot to set its own ranges? Yes until the user zooms or pans, and again once
         the user clicks pyqtgraph's auto-range button ("A")."""
-        if any(self.plot.getViewBox().autoRangeEnabled()):
+        if all(self.plot.getViewBox().autoRangeEnabled()):   # "A" turns both on; a zoom of one axis turns that one off
             self.follow_range = True
         return self.follow_range
 

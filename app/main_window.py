@@ -793,8 +793,7 @@ class MainWindow(QMainWindow):
         except (UserError, ConfigError, ShapeError, ValueError) as exc:
             self._refuse("This lesson cannot run here", exc)
             return False
-        if self.sim.params.shape == "polygon":
-            self.undo.clear()
+        self.undo.clear()   # the lesson replaces the body and its pose: earlier edits and turns do not apply
         self.set_hold_still(lesson.hold_still and self.sim.runner is None)
         if lesson.wind_sweep:
             self.sim.start_sweep(lesson.wind_sweep, lesson.hold_steps)

@@ -140,6 +140,7 @@ class TurnBody(QUndoCommand):
         super().__init__(text)
         self.apply, self.before, self.after = apply, before, after
         self.burst = burst
+        self.turned = after - before   # degrees turned by this command and those merged into it
         self._pushed = False
         self.at = time.monotonic() if at is None else at   # when the last turn of the burst came
 
@@ -153,7 +154,10 @@ class TurnBody(QUndoCommand):
                 or wrap_degrees(other.before) != wrap_degrees(self.after):
             return False
         self.after, self.at = other.after, other.at
-        self.setObsolete(self.after == self.before)   # turned back to where it began: no undo step
+        # turned back to where it began, notch for notch: no undo step (paused, the angles come back
+        # wrapped, so 179 -> 181 -> 179 reads 179 -> -181: the sum of the turns says it is none)
+        self.turned += other.after - other.before
+        self.setObsolete(abs(self.turned) < 1e-9)
         return True
 
     def redo(self):

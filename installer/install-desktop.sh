@@ -41,8 +41,8 @@ fi
 apps="$data/applications" icons="$data/icons/hicolor" mime="$data/mime"
 manifest_dir="$data/feelflow" manifest="$data/feelflow/installed-files.txt"
 for p in "$data" "$bin" "$here"; do
-  case "$p" in *[\\\"\`\$%]*|*$'\n'*|*$'\t'*)
-    die "cannot install from or into a path with \\ \" \` \$ % or a tab/newline in it: $p" ;; esac
+  case "$p" in *[\\\"\`\$%\']*|*$'\n'*|*$'\t'*)
+    die "cannot install from or into a path with \\ \" \` \$ % ' or a tab/newline in it: $p" ;; esac
 done
 
 refresh_databases() {
@@ -115,14 +115,18 @@ if [ -f "$manifest" ]; then
 fi
 
 written=""
-put() {   # put SOURCE_FILE DEST MODE: atomic write (temp file in DEST's folder, then mv)
-  local src="$1" dest="$2" mode="$3" tmp
-  make_dir "$(dirname "$dest")"
+check_free() {   # check_free SOURCE_FILE DEST: DEST is absent, ours, or already holds SOURCE_FILE
+  local src="$1" dest="$2"
   if [ -e "$dest" ] || [ -L "$dest" ]; then
     if [ -z "${ours[$dest]:-}" ] && ! cmp -s "$src" "$dest"; then
       die "$dest already exists and was not written by this installer: move it away first"
     fi
   fi
+}
+put() {   # put SOURCE_FILE DEST MODE: atomic write (temp file in DEST's folder, then mv)
+  local src="$1" dest="$2" mode="$3" tmp
+  make_dir "$(dirname "$dest")"
+  check_free "$src" "$dest"
   tmp="$(mktemp "$(dirname "$dest")/.feelflow-install.XXXXXX")" || die "cannot write into $(dirname "$dest")"
   cat "$src" > "$tmp" && chmod "$mode" "$tmp" && mv -f "$tmp" "$dest" || { rm -f "$tmp"; die "cannot write $dest"; }
   written+="file"$'\t'"$(checksum "$dest")"$'\t'"$dest"$'\n'
@@ -135,11 +139,19 @@ launcher="$bin/feelflow"
 q="'"
 printf '#!/bin/sh\n# FeelFlow, installed by %s/installer/install-desktop.sh (--uninstall removes it)\nexec %s "$@"\n' \
   "$here" "$q$target$q" > "$work/launcher"
-case "$launcher" in *" "*) launcher_exec="\"$launcher\"" ;; *) launcher_exec="$launcher" ;; esac
+case "$launcher" in   # the Desktop Entry spec's reserved characters (those not refused above) need quotes
+  *[\ \>\<\~\|\&\;\*\?\#\(\)]*) launcher_exec="\"$launcher\"" ;;
+  *) launcher_exec="$launcher" ;;
+esac
 entry="$(cat "$here/installer/feelflow.desktop.in")"
 entry="${entry//@LAUNCHER_EXEC@/$launcher_exec}"
 printf '%s\n' "${entry//@LAUNCHER@/$launcher}" > "$work/feelflow.desktop"
 
+# refuse before writing anything, so that a conflict leaves no file behind
+for pair in "$work/launcher|$launcher" "$here/installer/feelflow.svg|$icons/scalable/apps/feelflow.svg" \
+            "$here/installer/feelflow-mime.xml|$mime/packages/feelflow.xml" "$work/feelflow.desktop|$apps/feelflow.desktop"; do
+  check_free "${pair%%|*}" "${pair#*|}"
+done
 put "$work/launcher" "$launcher" 755
 put "$here/installer/feelflow.svg" "$icons/scalable/apps/feelflow.svg" 644
 put "$here/installer/feelflow-mime.xml" "$mime/packages/feelflow.xml" 644

@@ -54,6 +54,21 @@ def test_the_users_zoom_is_kept_until_auto_range(window, qtbot):
     assert plot.follow_range
 
 
+def test_a_zoom_of_the_force_axis_alone_is_kept(window, qtbot):
+    """A wheel over the left axis zooms y only (pyqtgraph keeps x on auto-range): still the
+    user's view, not the "A" button's."""
+    plot = window.plot
+    qtbot.waitUntil(lambda: len(window.sim.history) > 20, timeout=20000)
+    plot.refresh(force=True)
+    box = plot.plot.getViewBox()
+    box.scaleBy(y=0.5)                                     # what ViewBox.wheelEvent(axis=1) does
+    box.sigRangeChangedManually.emit([False, True])
+    zoomed = box.viewRange()[1]
+    assert box.autoRangeEnabled()[0] and not plot.follow_range
+    plot.refresh(force=True)
+    assert box.viewRange()[1] == pytest.approx(zoomed) and not plot.follow_range
+
+
 def test_log_log_view_frames_a_single_speed(window, qtbot):
     plot, sim = window.plot, window.sim
     qtbot.waitUntil(lambda: len(sim.history) > 30, timeout=20000)

@@ -274,3 +274,22 @@ def test_the_wheel_and_the_angle_box_are_refused_while_a_script_drives_the_body(
     window.reset_flow()                      # the script ends: the wheel turns the body again
     wheel(window, 3)
     assert sim.angle_target != angle and window.undo.count() == steps + 1
+
+
+def test_a_paused_wheel_burst_over_180_degrees_and_back_leaves_no_undo_step(window):
+    sim = window.sim
+    window.set_paused(True)
+    window.set_angle(179.0)
+    steps = window.undo.count()
+    wheel(window, 1)
+    wheel(window, -1)
+    assert sim.params.angle_deg == pytest.approx(179.0) and window.undo.count() == steps
+
+
+def test_loading_a_lesson_clears_the_undo_history(window):
+    """A lesson replaces the body and its pose: an undo must not turn the lesson's body to an
+    angle asked for before it (during a motion script it would swing there when the script ends)."""
+    wheel(window, 5)
+    assert window.undo.count() > 0
+    assert window.apply_preset("seed_protocol")
+    assert window.undo.count() == 0

@@ -172,6 +172,26 @@ def test_an_unrelated_feelflow_in_the_way_is_not_overwritten(tmp_path):
     assert theirs.read_text() == "#!/bin/sh\n# pip install --user feelflow\n"
 
 
+def test_a_conflict_on_any_file_writes_nothing(tmp_path):
+    """The last file written (the menu entry) in the way: refused before the first write."""
+    home = tmp_path / "home"
+    theirs = home / ".local" / "share" / "applications" / "feelflow.desktop"
+    theirs.parent.mkdir(parents=True)
+    theirs.write_text("[Desktop Entry]\nName=Someone else's\n")
+    r = run(home, "--no-setup")
+    assert r.returncode == 1 and "not written by this installer" in r.stderr
+    assert sorted(p for p in home.rglob("*") if p.is_file()) == [theirs]
+
+
+def test_a_quote_in_the_home_folder_is_refused(tmp_path):
+    """The launcher quotes its target with single quotes: a path holding one is refused, not broken."""
+    home = tmp_path / "o'brien"
+    home.mkdir()
+    r = run(home, "--no-setup")
+    assert r.returncode == 1 and len(r.stderr.strip().splitlines()) == 1 and "'" in r.stderr
+    assert not any(home.rglob("*"))
+
+
 @pytest.mark.parametrize("args", [["--bogus"], ["--prefix"], ["--uninstall", "extra"]])
 def test_a_bad_option_is_one_line_and_exit_2(tmp_path, args):
     r = run(tmp_path, *args)
