@@ -610,8 +610,7 @@ class MainWindow(QMainWindow):
         swing to the last asked angle): refuse the turn with a status message."""
         if getattr(self.sim, "runner", None) is None:
             return False
-        self.statusBar().showMessage(f"A motion script drives the body: {how} cannot rotate it now "
-                                     "(wait for it to end or reset the flow (R)).", 6000)
+        self._turn_refused("A motion script", how)
         return True
 
     def turn_by_wheel(self, degrees: float) -> bool:
@@ -643,9 +642,10 @@ class MainWindow(QMainWindow):
     def _turn_at_once(self, degrees: float) -> bool:
         return self._apply_shape(angle_deg=wrap_degrees(degrees))
 
-    def _turn_refused(self, driver: str):
+    def _turn_refused(self, driver: str, what: str = "the handle"):
+        """`driver` (viewport.turn_blocker's words) drives the body, so `what` may not turn it."""
         how = "choose Mouse under Input" if self.input_device is not None else "wait for it to end or reset the flow (R)"
-        self.statusBar().showMessage(f"{driver} drives the body: the handle cannot rotate it now ({how}).", 6000)
+        self.statusBar().showMessage(f"{driver} drives the body: {what} cannot rotate it now ({how}).", 6000)
 
     def set_display_mode(self, mode):
         self.display_mode = mode
