@@ -25,6 +25,8 @@ def add_arguments(parser):
                         help="accuracy: only this backend (repeatable; default: numpy float64, numpy float32, gl)")
     parser.add_argument("--variants", action="store_true",
                         help="solver: compare the gl backend's tuning variants (docs/performance.md)")
+    parser.add_argument("--profile", action="store_true",
+                        help="solver: where the gl moving tunnel's wall time goes (docs/performance.md)")
 
 
 def main(args) -> int:

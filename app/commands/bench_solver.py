@@ -262,6 +262,51 @@ def run_variants(quick: bool, seconds: float | None):
 LLVMPIPE_KNOBS = {"LP_NUM_THREADS": ("1", "2", "4"), "LP_NATIVE_VECTOR_WIDTH": ("128", "256", "512")}
 
 
+PROFILE_PARTS = {  # (label, function name, file suffix or None for a built-in method)
+    "draw calls (queue the step; wait while llvmpipe's queue is full)": ("<method 'render' of 'mgl.VertexArray' objects>", None),
+    "end of each step() call: read back, force models, divergence check": ("_resolve_checks", "gl_backend.py"),
+    "moves: set_body (raster, refill with its read and write, uploads)": ("set_body", "gl_backend.py"),
+}
+
+
+def run_profile(seconds: float | None):
+    """The default moving tunnel (512x256, gl) under cProfile: where its wall time goes.
+
+    Each part is the cumulative wall time of one function (docs/performance.md); the parts do
+    not overlap, and the rest is the Python around them. While the main thread waits in a draw
+    call, llvmpipe's threads are busy; during the other parts they have nothing queued."""
+    import cProfile
+    import pstats
+
+    from solver.gl_backend import GLSolver
+
+    ctx, gl_error = _gl_context()
+    if ctx is None:
+        raise UserError(f"--profile needs the gl backend: {gl_error}")
+    nx, ny = 512, 256
+    run = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx))
+    run.advance(200)
+    steps = max(MOVE_EVERY, int(round((seconds if seconds is not None else 5.0) * 400 / MOVE_EVERY)) * MOVE_EVERY)
+    prof = cProfile.Profile()
+    t0, c0 = time.perf_counter(), time.process_time()
+    prof.enable()
+    run.advance(steps)
+    prof.disable()
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    run.solver.close()
+    stats = pstats.Stats(prof).stats
+    parts = {}
+    for label, (name, suffix) in PROFILE_PARTS.items():
+        parts[label] = sum(v[3] for (file, _, fn), v in stats.items()
+                           if fn == name and (suffix is None or file.endswith(suffix)))
+    parts["other Python (scene script, call overhead)"] = max(0.0, wall - sum(parts.values()))
+    return {"machine": machine(), "renderer": ctx.info.get("GL_RENDERER"), "grid": f"{nx}x{ny}",
+            "steps": steps, "wall_s": round(wall, 3), "cpu_s": round(cpu, 3),
+            "mlups": round(nx * ny * steps / wall / 1e6, 2),
+            "parts_s": {k: round(v, 3) for k, v in parts.items()},
+            "parts_fraction": {k: round(v / wall, 3) for k, v in parts.items()}}
+
+
 def _subprocess_tunnel(nx: int, ny: int, seconds: float, env_extra: dict):
     """The default moving-cylinder tunnel in a fresh process with `env_extra` set: wall MLUPS,
     MLUPS per CPU-s and the renderer string, or None where the process failed."""
@@ -280,7 +325,13 @@ def _subprocess_tunnel(nx: int, ny: int, seconds: float, env_extra: dict):
 def main(args) -> int:
     quick = bool(getattr(args, "quick", False))
     seconds = getattr(args, "seconds", None)
-    if getattr(args, "variants", False):
+    if getattr(args, "profile", False):
+        result = run_profile(seconds)
+        print(f"moving-cylinder tunnel {result['grid']}, gl, {result['renderer']}: {result['steps']} steps, "
+              f"{result['wall_s']} s wall, {result['cpu_s']} s CPU (all threads), {result['mlups']} MLUPS under the profiler")
+        for label, t in result["parts_s"].items():
+            print(f"  {label:72s} {t:7.3f} s  {100 * result['parts_fraction'][label]:5.1f} %")
+    elif getattr(args, "variants", False):
         result = run_variants(quick, seconds)
         print(f"gl tuning variants, moving-cylinder tunnel {result['grid']}, {result['renderer']}")
         print(f"  {'variant':62s} {'MLUPS (wall) best/median':>26s} {'per CPU-s best/median':>24s}")

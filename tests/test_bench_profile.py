@@ -1,0 +1,22 @@
+"""`feelflow bench --profile`: where the gl moving tunnel's wall time goes (docs/performance.md)."""
+import json
+
+import pytest
+
+from app.cli import main as cli_main
+
+pytestmark = pytest.mark.gl
+
+
+def test_profile_splits_the_wall_time_of_the_moving_tunnel(tmp_path, gl_context, capsys):
+    out = tmp_path / "profile.json"
+    assert cli_main(["bench", "--profile", "--seconds", "0.1", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    parts = data["parts_s"]
+    assert data["grid"] == "512x256" and data["steps"] >= 10 and data["mlups"] > 0
+    measured = {k: v for k, v in parts.items() if not k.startswith("other")}
+    # every part was entered (the body moved, each call ended with a read-back), and the parts
+    # do not overlap: together they stay within the wall time
+    assert len(measured) == 3 and all(v > 0 for v in measured.values())
+    assert sum(measured.values()) <= data["wall_s"] * 1.01
+    assert "draw calls" in capsys.readouterr().out
