@@ -30,7 +30,8 @@ uniform float omega_plus;      // 1 / tau
 uniform float omega_minus;     // TRT odd rate from the magic number
 uniform vec2 body_force;       // Guo force density F
 #if SPONGE
-uniform sampler2D OMEGA;       // (omega+, omega-) of column ix in texel (ix, 0): the outlet sponge
+uniform sampler2D OMEGA;       // (omega+, omega-, keep) of column ix in texel (ix, 0): the outlet sponge
+                               // and its absorbing layer (numpy: relaxation_rates, absorb_keep)
 #endif
 #if BODY
 uniform usampler2D MASK;       // per node: bit 0 solid; bit i (1..8) q[OPP[i], x] > 0; bit 8+i:
@@ -41,7 +42,7 @@ uniform vec2 body_velocity;    // V
 uniform float body_omega;      // Omega, radians per step, counter-clockwise
 uniform vec2 body_centre;      // X
 #endif
-#if EDGES
+#if EDGES || SPONGE
 uniform sampler2D INFLOW;      // inflow profile(iy) in texel (iy, 0)
 uniform float inflow_ramp;     // ramp(t): u_in(iy, t) = ramp(t) profile(iy)
 #endif
@@ -127,18 +128,24 @@ void collide(inout float f[9], ivec2 x) {
 #endif
     float ux = jx / rho;
     float uy = jy / rho;
-    float usq = ux * ux;
-    usq += uy * uy;
-    usq *= 1.5;
 #if SPONGE
-    vec2 rates = texelFetch(OMEGA, ivec2(x.x, 0), 0).rg;
+    vec3 rates = texelFetch(OMEGA, ivec2(x.x, 0), 0).rgb;
     float op = rates.r;
     float om = rates.g;
+    // absorbing layer: equilibria of (RHO0 + keep drho, keep u + (1 - keep) u_in(iy, t))
+    float deq = drho * rates.b;
+    ux *= rates.b;
+    ux += (inflow_ramp * texelFetch(INFLOW, ivec2(x.y, 0), 0).r) * (1.0 - rates.b);
+    uy *= rates.b;
 #else
     float op = omega_plus;
     float om = omega_minus;
+    float deq = drho;
 #endif
-    f[0] += ((drho - rho * usq) * W[0] - f[0]) * op;
+    float usq = ux * ux;
+    usq += uy * uy;
+    usq *= 1.5;
+    f[0] += ((deq - rho * usq) * W[0] - f[0]) * op;
 #if GUO_FORCE
     float uF = ux * body_force.x + uy * body_force.y;
     f[0] += (1.0 - 0.5 * op) * (W[0] * -3.0) * uF;
@@ -149,7 +156,7 @@ void collide(inout float f[9], ivec2 x) {
         float cx = float(C[i].x);
         float cy = float(C[i].y);
         float cu = 3.0 * (cx * ux + cy * uy);
-        float sym = ((cu * cu * 0.5 - usq) * rho) + drho;
+        float sym = ((cu * cu * 0.5 - usq) * rho) + deq;
         float anti = cu * rho;
         float fi = f[i];
         float fb = f[ib];

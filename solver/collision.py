@@ -24,10 +24,14 @@ class Collider:
     """In-place collision of a (9, ny, nx) array of shifted populations.
 
     omega_p, omega_m: scalars, or (nx,) rows (outlet sponge). force: (Fx, Fy) body-force density.
+    keep: None, or an (nx,) row (the sponge's absorbing layer, solver.numpy_backend.absorb_keep):
+    the equilibria use the density fluctuation drho * keep and the velocity
+    keep u + (1 - keep) u_target, so each collision relaxes the node towards (RHO0, u_target) at
+    omega+ (1 - keep); u_target = (target(iy), 0), `target` passed per call.
     """
 
     def __init__(self, ny: int, nx: int, dtype, omega_p, omega_m, trt: bool, force=(0.0, 0.0),
-                 block_nodes: int = BLOCK_NODES):
+                 block_nodes: int = BLOCK_NODES, keep=None):
         self.nx, self.ny = nx, ny
         self.rows = max(1, min(ny, block_nodes // nx))
         self.dtype = np.dtype(dtype)
@@ -50,18 +54,23 @@ class Collider:
         self.src_p = {k: coef((1.0 - 0.5 * op) * W[k]) for k in range(9)}
         self.src_m = {k: coef((1.0 - 0.5 * om) * W[k]) for k in range(9)}
         shape = (self.rows, nx)
-        names = ("drho", "rho", "hrho", "ux", "uy", "q2", "cu", "sym", "anti", "t1", "t2", "uF")
+        self.keep = None if keep is None else np.asarray(keep, dtype=dt)
+        self.release = None if keep is None else np.asarray(1.0 - np.asarray(keep, np.float64), dtype=dt)
+        names = ("drho", "deq", "rho", "hrho", "ux", "uy", "q2", "cu", "sym", "anti", "t1", "t2", "uF")
         self._s = {n: np.empty(shape, dtype=dt) for n in names}
 
-    def __call__(self, f: np.ndarray) -> float:
-        """Collide f (9, ny, nx) in place; return sum of drho (for the divergence check)."""
+    def __call__(self, f: np.ndarray, target=None) -> float:
+        """Collide f (9, ny, nx) in place; return sum of drho (for the divergence check).
+        target: (ny,) x-velocity the absorbing layer relaxes towards (with `keep` only)."""
         total = 0.0
+        if self.keep is not None:
+            target = np.asarray(target, dtype=self.dtype)[:, None]
         for y0 in range(0, self.ny, self.rows):
             y1 = min(self.ny, y0 + self.rows)
-            total += self._block(f[:, y0:y1, :], y1 - y0)
+            total += self._block(f[:, y0:y1, :], y1 - y0, None if target is None else target[y0:y1])
         return total
 
-    def _block(self, f, n: int) -> float:
+    def _block(self, f, n: int, target=None) -> float:
         s = {k: v[:n] for k, v in self._s.items()}
         drho, rho, hrho, ux, uy, q2 = s["drho"], s["rho"], s["hrho"], s["ux"], s["uy"], s["q2"]
         cu, sym, anti, t1, t2 = s["cu"], s["sym"], s["anti"], s["t1"], s["t2"]
@@ -72,6 +81,11 @@ class Collider:
         for k in (f2, f3, f4, f5, f6, f7, f8):
             drho += k
         add(drho, 1.0, out=rho)
+        if self.keep is None:
+            deq = drho                 # the equilibria's density fluctuation
+        else:
+            deq = s["deq"]
+            mul(drho, self.keep, out=deq)
         sub(f1, f3, out=ux)
         ux += f5
         ux -= f6
@@ -89,6 +103,11 @@ class Collider:
         np.divide(1.0, rho, out=t1)
         ux *= t1
         uy *= t1
+        if self.keep is not None:      # absorbing layer: u -> keep u + (1 - keep) u_target
+            ux *= self.keep
+            mul(target, self.release, out=t1)
+            ux += t1
+            uy *= self.keep
         mul(rho, 0.5, out=hrho)
         mul(ux, ux, out=q2)
         mul(uy, uy, out=t1)
@@ -101,7 +120,7 @@ class Collider:
             uF += t1                   # u . F
         # rest population: f0 += omega+ (w0 (drho - rho/2 3u^2) - f0)
         mul(hrho, q2, out=t1)
-        sub(drho, t1, out=t1)
+        sub(deq, t1, out=t1)
         t1 *= self.op_w[0]
         f0 *= self.one_minus_op
         f0 += t1
@@ -125,7 +144,7 @@ class Collider:
             mul(cu, cu, out=sym)
             sym -= q2
             sym *= hrho
-            sym += drho                # feq+ = w sym
+            sym += deq                 # feq+ = w sym
             mul(rho, cu, out=anti)     # feq- = w anti
             if self.trt:
                 # dp = omega+ (f+ - feq+), dm = omega- (f- - feq-); f_i -= dp + dm, f_ib -= dp - dm

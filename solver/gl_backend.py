@@ -58,7 +58,7 @@ from solver.gl_layout import TEXTURES, pack, texel_box, texels, unpack
 from solver.gl_programs import create_program
 from solver.inflow import profile, ramp
 from solver.lattice import C, OPP, Q, RHO0, equilibrium
-from solver.numpy_backend import relaxation_rates
+from solver.numpy_backend import absorb_keep, relaxation_rates
 
 #: texture units (fixed; every pass binds all it samples)
 UNIT_G = tuple(range(TEXTURES))
@@ -192,8 +192,10 @@ class GLSolver(Solver):
         self._qa_tex.write(np.zeros((ny, nx, 4), "f4"))
         self._qb_tex.write(np.zeros((ny, nx, 4), "f4"))
         self._inflow_tex = tex((ny, 1), 1)
-        self._omega_tex = tex((nx, 1), 2)
-        rates = np.stack(np.broadcast_arrays(np.asarray(op, float) * np.ones(nx), np.asarray(om, float)), -1)
+        self._omega_tex = tex((nx, 1), 3)
+        keep = absorb_keep(cfg)
+        rates = np.stack(np.broadcast_arrays(np.asarray(op, float) * np.ones(nx), np.asarray(om, float),
+                                             np.ones(nx) if keep is None else keep), -1)
         self._omega_tex.write(rates.astype("f4").tobytes())
         self._inflow_key = None
         self._draws, self._draw_regions = [], None
@@ -337,9 +339,9 @@ class GLSolver(Solver):
             self._inflow_tex.write(profile(cfg.ny, self.inflow_speed, cfg.inflow_profile).astype("f4").tobytes())
         r = float(ramp(t, cfg.inflow_ramp_steps))
         if self._uniform_values.get("inflow_ramp") != r:  # constant once the ramp is over
-            self._uniform_values["inflow_ramp"] = r  # also for edge programs compiled later
+            self._uniform_values["inflow_ramp"] = r  # also for programs compiled later
             for key, prog in self._programs.items():
-                if key[1]:
+                if key[1] or key[2]:  # edges (the inlet), sponge (the absorbing layer's target)
                     self._uniforms(prog, inflow_ramp=r)
 
     def _begin_pass(self, fbo, size):

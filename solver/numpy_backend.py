@@ -55,6 +55,22 @@ def relaxation_rates(config: FlowConfig):
     return omega_p, omega_m
 
 
+def absorb_keep(config: FlowConfig):
+    """None, or the (nx,) row keep(ix) = 1 - a s^2 (a = sponge_absorb, s as in the sponge) of
+    the outlet sponge's absorbing layer: there the equilibria use the density fluctuation
+    keep drho and the velocity keep u + (1 - keep) u_in(iy, t), so each collision relaxes the
+    node towards the far-field state (RHO0, the inflow profile: the outflow of a straight tunnel)
+    at omega+ a s^2. Sound leaves the tunnel instead of ringing between the velocity inlet and
+    the pressure outlet (Kam, Leung & Chew, Phys. Rev. E 74 (2006) 036704; Xu & Sagaut,
+    J. Comput. Phys. 245 (2013) 14). docs/algorithm.md, step 3."""
+    L = config.sponge_cells if config.x_boundary == "tunnel" else 0
+    if L == 0 or config.sponge_absorb == 0.0:
+        return None
+    ix = np.arange(config.nx, dtype=np.float64)
+    s = np.clip((ix - (config.nx - L) + 1) / L, 0.0, None)
+    return 1.0 - config.sponge_absorb * s * s
+
+
 class NumpySolver(Solver):
     """Reference D2Q9 solver (docs/algorithm.md), numpy, float64 or float32 storage."""
 
@@ -71,7 +87,8 @@ class NumpySolver(Solver):
         self._gin = np.empty_like(self.g)
         self._w = W.astype(self.dtype)
         op, om = relaxation_rates(cfg)
-        self._collide = Collider(ny, nx, self.dtype, op, om, cfg.collision == "trt", cfg.body_force)
+        self._collide = Collider(ny, nx, self.dtype, op, om, cfg.collision == "trt", cfg.body_force,
+                                 keep=absorb_keep(cfg))
         self._roll = []
         for i in range(Q):
             cx, cy = int(C[i, 0]), int(C[i, 1])
@@ -161,7 +178,7 @@ class NumpySolver(Solver):
             L = b.links
             ys, xs = b.window_slices()
             gin[L.i, L.iy + b.window[1], L.ix + b.window[0]] = incoming(g[:, ys, xs], L)
-        total = self._collide(gin)
+        total = self._collide(gin, self._inflow_velocity(t) if self._collide.keep is not None else None)
         if self._solid_idx is not None:
             gin[:, self._solid_idx[0], self._solid_idx[1]] = self._solid_g
         self.g, self._gin = gin, g

@@ -150,3 +150,13 @@ def test_body_removed_restores_fast_path(request):
 
     solvers, _ = _run_pair(cfg, request, steps=40, motion=place)
     _check_fields(solvers)
+
+
+@pytest.mark.parametrize("nx", [64, 61])
+def test_tunnel_sponge_with_absorbing_layer(nx, request):
+    """The sponge's absorbing layer (FlowConfig.sponge_absorb) on both backends: the equilibria's
+    density fluctuation scaled per column (the OMEGA texture's third channel in GLSL)."""
+    cfg = FlowConfig(nx=nx, ny=32, dtype="float32", collision="trt", inflow_profile="parabolic",
+                     inflow_ramp_steps=20, sponge_cells=12, sponge_absorb=0.3)
+    solvers, _ = _run_pair(cfg, request)
+    _check_fields(solvers)

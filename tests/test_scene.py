@@ -96,6 +96,7 @@ BAD = [
     ({"flow": {"collision": "mrt"}}, "flow.collision: must be one of bgk, trt"),
     ({"flow": {"inflow_profile": "plug"}}, "flow.inflow_profile"),
     ({"flow": {"sponge_cells": 150}}, "flow.sponge_cells"),
+    ({"flow": {"sponge_cells": 20, "sponge_absorb": 0.9}}, "flow.sponge_absorb: must be in 0..0.5, got 0.9"),
     ({"flow": {"viscosity": 0.1}}, "flow.viscosity: unknown key"),
     ({"output": {"forces": ["telepathy"]}}, "output.forces: unknown force model 'telepathy'"),
     ({"output": {"interval": 0}}, "output.interval: must be an integer >= 1, got 0"),

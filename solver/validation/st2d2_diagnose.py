@@ -1,7 +1,7 @@
 """Diagnose Schaefer-Turek 2D-2 (README 'Validation'): record C_D(t), C_L(t) and analyse them.
 
     python -m solver.validation.st2d2_diagnose record --d 20 [--u 0.075] [--ramp-periods 2 | --impulsive]
-        [--sponge CELLS] [--length-d 22] [--conv-times 60] [--sample 2]
+        [--sponge CELLS [--absorb A]] [--length-d 22] [--conv-times 60] [--sample 2]
         [--collision trt|bgk] [--magic 0.1875] [--stress] --out series.npz
     python -m solver.validation.st2d2_diagnose analyse series.npz [...]
 
@@ -34,7 +34,7 @@ def record(a) -> None:
 
     geo = Geometry(a.d, RE, u_max=a.u)
     geo.nx = int(round(a.length_d * a.d))
-    over = dict(sponge_cells=a.sponge, sponge_strength=10.0) if a.sponge else {}
+    over = dict(sponge_cells=a.sponge, sponge_strength=10.0, sponge_absorb=a.absorb) if a.sponge else {}
     over.update(collision=a.collision, trt_magic=a.magic)
     factory = lambda c: create_solver("numpy", c)  # noqa: E731
     if a.impulsive:
@@ -97,6 +97,8 @@ def main() -> None:
     r.add_argument("--ramp-periods", type=float, default=2.0)
     r.add_argument("--impulsive", action="store_true", help="developed channel flow at t = 0 (the old start)")
     r.add_argument("--sponge", type=int, default=0)
+    r.add_argument("--absorb", type=float, default=0.0,
+                   help="with --sponge: its absorbing layer's strength (FlowConfig.sponge_absorb)")
     r.add_argument("--length-d", type=float, default=22.0)
     r.add_argument("--conv-times", type=float, default=60.0)
     r.add_argument("--sample", type=int, default=2)
