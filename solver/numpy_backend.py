@@ -32,6 +32,16 @@ def _roll_segments(s: int, n: int):
     return [(slice(0, n - 1), slice(1, n)), (slice(n - 1, n), slice(0, 1))]
 
 
+def sponge_position(config: FlowConfig):
+    """None (no sponge), or the (nx,) row s = (ix - (nx - L) + 1) / L clipped at 0: 0 before the
+    outlet sponge's L = sponge_cells columns, rising to 1 at the last column."""
+    L = config.sponge_cells if config.x_boundary == "tunnel" else 0
+    if L == 0:
+        return None
+    ix = np.arange(config.nx, dtype=np.float64)
+    return np.clip((ix - (config.nx - L) + 1) / L, 0.0, None)
+
+
 def relaxation_rates(config: FlowConfig):
     """(omega+, omega-) as scalars, or (nx,) rows where the outlet sponge raises nu.
 
@@ -39,10 +49,8 @@ def relaxation_rates(config: FlowConfig):
     Sponge: nu(ix) = nu (1 + (A - 1) s^2), s = (ix - (nx - L) + 1) / L in the last L columns.
     """
     nu = config.nu
-    L = config.sponge_cells if config.x_boundary == "tunnel" else 0
-    if L > 0:
-        ix = np.arange(config.nx, dtype=np.float64)
-        s = np.clip((ix - (config.nx - L) + 1) / L, 0.0, None)
+    s = sponge_position(config)
+    if s is not None:
         nu = nu * (1.0 + (config.sponge_strength - 1.0) * s * s)
     tau = 3.0 * np.asarray(nu, dtype=np.float64) + 0.5
     omega_p = 1.0 / tau
@@ -50,7 +58,7 @@ def relaxation_rates(config: FlowConfig):
         omega_m = 1.0 / (0.5 + config.trt_magic / (tau - 0.5))
     else:
         omega_m = omega_p
-    if L == 0:
+    if s is None:
         return float(omega_p), float(omega_m)
     return omega_p, omega_m
 
@@ -63,11 +71,9 @@ def absorb_keep(config: FlowConfig):
     at omega+ a s^2. Sound leaves the tunnel instead of ringing between the velocity inlet and
     the pressure outlet (Kam, Leung & Chew, Phys. Rev. E 74 (2006) 036704; Xu & Sagaut,
     J. Comput. Phys. 245 (2013) 14). docs/algorithm.md, step 3."""
-    L = config.sponge_cells if config.x_boundary == "tunnel" else 0
-    if L == 0 or config.sponge_absorb == 0.0:
+    s = sponge_position(config)
+    if s is None or config.sponge_absorb == 0.0:
         return None
-    ix = np.arange(config.nx, dtype=np.float64)
-    s = np.clip((ix - (config.nx - L) + 1) / L, 0.0, None)
     return 1.0 - config.sponge_absorb * s * s
 
 
@@ -159,6 +165,7 @@ class NumpySolver(Solver):
         cfg = self.config
         nx = cfg.nx
         t = self.time
+        u_in = None
         # e/f: periodic shift of every population (pull: gin_i(x) = g_i(x - c_i))
         for i in range(Q):
             gi, di = g[i], gin[i]
@@ -178,7 +185,7 @@ class NumpySolver(Solver):
             L = b.links
             ys, xs = b.window_slices()
             gin[L.i, L.iy + b.window[1], L.ix + b.window[0]] = incoming(g[:, ys, xs], L)
-        total = self._collide(gin, self._inflow_velocity(t) if self._collide.keep is not None else None)
+        total = self._collide(gin, u_in)  # u_in: the absorbing layer's target (tunnels only)
         if self._solid_idx is not None:
             gin[:, self._solid_idx[0], self._solid_idx[1]] = self._solid_g
         self.g, self._gin = gin, g
