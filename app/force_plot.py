@@ -15,7 +15,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (QCheckBox, QComboBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget)
 
 from app.files import atomic_path, write_text_atomic
-from app.simulation import FORCE_MODELS, drag_direction
+from app.simulation import FORCE_MODELS, History, drag_direction
 from solver.lattice import CS2
 
 #: the impulsive start's pressure pulse (the flow begins at full speed around a body that was not
@@ -246,10 +246,14 @@ class ForcePlot(QWidget):
         return f"{what}" if not self.sim.params.compare_all else f"{what}, {FORCE_MODELS[model].split(' (')[0].lower()}"
 
     def speed_drag(self):
+        """(relative wind speed, drag) of the settled samples only (History.settled): drag
+        while the wind or the body's speed is changing carries the acceleration's force and is
+        not the steady drag the law describes."""
         sim = self.sim
         _, drag, _ = sim.history.drag_lift(sim.params.force_model)
         w = np.asarray(sim.history.wind, float).reshape(-1, 2)
-        return np.hypot(w[:, 0], w[:, 1]), drag
+        settled = np.asarray(sim.history.settled, bool)
+        return np.hypot(w[settled, 0], w[settled, 1]), drag[settled]
 
     def _draw_speed_view(self):
         us, fs, n = fit_power_law(*self.speed_drag())
@@ -261,7 +265,8 @@ class ForcePlot(QWidget):
             self._set_fit_text(f"fit: drag \u221d U<sup>{n:.2f}</sup>")
         else:
             self.fit_line.setData([], [])
-            self._set_fit_text("fit: needs speeds 1.5\u00d7 apart")
+            self._set_fit_text("fit: needs speeds 1.5\u00d7 apart" if len(us) else
+                               f"fit: hold a speed {History.SETTLE_STEPS} steps")
         self.fitted_exponent = n
         self._set_speed_ranges(us, fs)
 

@@ -29,7 +29,8 @@ class Lesson:
 PRESETS = {
     "drag_speed": Lesson("Drag grows with speed", "drag_speed.toml", plot_view="speed",
                          wind_sweep=(0.02, 0.03, 0.045, 0.065, 0.09),
-                         note="The wind steps up from 0.02 to 0.09; the log-log plot fits drag ~ U^n."),
+                         note="The wind steps up from 0.02 to 0.09, 2000 steps each; the log-log plot fits drag ~ U^n "
+                              "to the steady samples."),
     "shape_matters": Lesson("Shape matters: plate, wedges, cylinder", "shape_matters.toml", display="pressure",
                             note="Switch Shape between plate, wedges and cylinder and compare C_D."),
     "lift": Lesson("Lift on the half airfoil", "lift.toml", display="pressure",

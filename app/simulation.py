@@ -14,6 +14,7 @@ from solver import units
 from app.session import SessionSolver
 from solver.backend import create_solver
 from solver.config import FlowConfig
+from solver.inflow import ramp
 from solver.motion import MotionRunner
 from solver.stability_limit import inside, min_stable_viscosity
 
@@ -71,31 +72,53 @@ class Params:
 
 @dataclass
 class History:
-    """One sample per frame: step, body velocity, relative wind, force of each model in use."""
+    """One sample per frame: step, body velocity, relative wind, force of each model in use, and
+    whether the sample is *settled*: the relative wind has stayed within `WIND_TOLERANCE` of its
+    value for at least `SETTLE_STEPS` steps. Only settled samples are steady drag; the
+    drag-against-speed view fits those (app/force_plot.py). SETTLE_STEPS, measured in the 'Drag
+    grows with speed' lesson (`feelflow report lessons`, README 'Lessons'): 750 steps after a
+    wind change has finished, the drag's 250-step means stay within 5 % of the hold's end value
+    at every wind of the sweep; the first few hundred steps carry the acceleration's added-mass
+    force and the flow's rearrangement (up to +60 %)."""
 
     time: list = field(default_factory=list)
     body_velocity: list = field(default_factory=list)
     wind: list = field(default_factory=list)
     forces: dict = field(default_factory=dict)  # model -> list of (Fx, Fy)
+    settled: list = field(default_factory=list)
+    _wind_ref: tuple = (math.nan, math.nan)      # relative wind when it last changed, and when
+    _since: float = 0.0
 
     MAX = 20000
+    SETTLE_STEPS = 1000
+    WIND_TOLERANCE = 0.02
 
     def add(self, time, body_velocity, wind, forces):
         self.time.append(time)
         self.body_velocity.append(body_velocity)
         self.wind.append(wind)
+        self.settled.append(self._settled(time, wind))
         for name, f in forces.items():
             series = self.forces.setdefault(name, [])
             series.extend([(math.nan, math.nan)] * (len(self.time) - 1 - len(series)))
             series.append(f)
         if len(self.time) > self.MAX:
             cut = len(self.time) - self.MAX
-            del self.time[:cut], self.body_velocity[:cut], self.wind[:cut]
+            del self.time[:cut], self.body_velocity[:cut], self.wind[:cut], self.settled[:cut]
             for series in self.forces.values():
                 del series[:max(0, len(series) - self.MAX)]
 
+    def _settled(self, time, wind) -> bool:
+        ref = self._wind_ref
+        scale = max(math.hypot(*ref), math.hypot(*wind), 1e-9) if all(map(math.isfinite, ref)) else 0.0
+        if not scale or math.hypot(wind[0] - ref[0], wind[1] - ref[1]) > self.WIND_TOLERANCE * scale:
+            self._wind_ref, self._since = tuple(wind), time
+        return time - self._since >= self.SETTLE_STEPS
+
     def clear(self):
         self.time.clear(), self.body_velocity.clear(), self.wind.clear(), self.forces.clear()
+        self.settled.clear()
+        self._wind_ref, self._since = (math.nan, math.nan), 0.0
 
     def __len__(self):
         return len(self.time)
@@ -156,7 +179,16 @@ def stable_params(params: Params, collision: str) -> tuple[Params, str | None]:
 class Simulation:
     """Owns the solver and the body; `advance(n)` runs n steps and records one force sample.
     The wind and viscosity it is given stay inside the measured stable region (`stable_params`);
-    `guard_note` says what the last change had to adjust (None when nothing)."""
+    `guard_note` says what the last change had to adjust (None when nothing).
+
+    A wind sweep (`start_sweep`, the 'Drag grows with speed' lesson) spreads each change of wind
+    over `SWEEP_SLEW_STEPS`: a sudden change sends a pressure pulse (rho c_s dU) through the
+    tunnel that rings between the walls, across the stream, where the outlet's absorbing layer
+    cannot take it out; 500 steps is a little more than that ringing's period at the lessons'
+    128 rows (2 ny / c_s = 443 steps). Measured (`feelflow report lessons --compare`, README
+    'Lessons'): the drag's scatter over the second half of each hold falls severalfold."""
+
+    SWEEP_SLEW_STEPS = 500
 
     def __init__(self, params: Params | None = None, backend: str = "numpy", ctx=None, shape_factory=None,
                  base_config: FlowConfig | None = None):
@@ -177,6 +209,7 @@ class Simulation:
         self._wind_starts_everywhere = base_config is None   # default tunnel: no ramp, see below
         self.params, self.guard_note = stable_params(self.params, self.base_config.collision)
         self.sweep = None            # (wind speeds, steps each, first step): a wind-speed sweep
+        self.sweep_slew_steps = self.SWEEP_SLEW_STEPS
         self.capped = False          # the Mach cap limited the body's speed in the last frame
         self.solver = None
         self._build(keep_flow=False)
@@ -269,16 +302,37 @@ class Simulation:
         self.history.clear()
 
     def start_sweep(self, speeds, hold_steps: int):
-        """Hold each wind speed `hold_steps` steps in turn (the 'drag grows with speed' lesson)."""
-        self.sweep = (tuple(speeds), int(hold_steps), self.solver.time)
+        """Hold each wind speed `hold_steps` steps in turn (the 'drag grows with speed' lesson);
+        the first one from the end of the inlet's start-up ramp, if it is still rising."""
+        start = max(self.solver.time, self.config.inflow_ramp_steps)
+        self.sweep = (tuple(speeds), int(hold_steps), start)
         self.set_flow(wind=speeds[0])
+
+    def sweep_end(self):
+        """The step at which the sweep ends (None without a sweep)."""
+        if self.sweep is None:
+            return None
+        speeds, hold, start = self.sweep
+        return start + len(speeds) * hold
 
     def sweep_stage(self):
         if self.sweep is None:
             return None
         speeds, hold, start = self.sweep
-        k = (self.solver.time - start) // hold
+        k = max(0, self.solver.time - start) // hold
         return k if k < len(speeds) else None
+
+    def sweep_wind(self):
+        """The sweep's wind now: each step to the next speed is spread over `SWEEP_SLEW_STEPS`
+        (linear), not made at once; None when the sweep is over."""
+        k = self.sweep_stage()
+        if k is None:
+            return None
+        speeds, hold, start = self.sweep
+        if k == 0 or self.sweep_slew_steps <= 0:
+            return speeds[k]
+        frac = min(1.0, (self.solver.time - start - k * hold) / self.sweep_slew_steps)
+        return speeds[k - 1] + frac * (speeds[k] - speeds[k - 1])
 
     def start_script(self, script):
         """Drive the body through a solver.motion.MotionScript (mouse and hold-still ignored)."""
@@ -349,17 +403,20 @@ class Simulation:
 
     # --- running --------------------------------------------------------------------------
     def relative_wind(self):
-        return (self.params.wind - self.vel[0], -self.vel[1])
+        """The wind the body meets: the inlet's speed now (on its start-up ramp, solver/inflow.py)
+        less the body's velocity."""
+        wind = self.params.wind * ramp(self.solver.time, self.config.inflow_ramp_steps)
+        return (wind - self.vel[0], -self.vel[1])
 
     def advance(self, n: int):
         """Run n steps, moving the body in chunks of at most half a cell; record a sample."""
         n = max(1, int(n))
         if self.sweep is not None:
-            k = self.sweep_stage()
-            if k is None:
+            wind = self.sweep_wind()
+            if wind is None:
                 self.sweep = None
-            elif self.sweep[0][k] != self.params.wind:
-                self.set_flow(wind=self.sweep[0][k])
+            elif wind != self.params.wind:
+                self.set_flow(wind=wind)
         done = 0
         acc = {}
         self.capped = False

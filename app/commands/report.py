@@ -1,5 +1,7 @@
 """`feelflow report seed`: reproduce the seed's experiments with all four force models and write
 docs/report-seed.md with PNG plots (the work is in app/seed_report.py).
+`feelflow report lessons [--only KEY,...] [--compare] [--json PATH]`: run the Presets menu's
+lessons headless as the window does and print how steady their forces are (app/lesson_report.py).
 
 Parts (`--only`): protocol (or one diameter, protocol:d32), shapes, sweep, lift; each stores its
 series in OUT/report-seed/data-<part>.json (data-protocol-<d>.json per diameter), and the report
@@ -13,11 +15,12 @@ from pathlib import Path
 
 from app.cli import UserError
 
-TARGETS = ("seed",)
+TARGETS = ("seed", "lessons")
 
 
 def add_arguments(parser):
-    parser.add_argument("target", choices=TARGETS, help="which report (seed: the thesis's experiments)")
+    parser.add_argument("target", choices=TARGETS,
+                        help="which report (seed: the thesis's experiments; lessons: the Presets menu's lessons)")
     parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
     parser.add_argument("--quick", action="store_true",
                         help="a few dozen steps per run: a smoke test of the whole chain, not physics")
@@ -25,7 +28,11 @@ def add_arguments(parser):
                         help="steps per protocol phase instead of the scenes' 15000 (stated in the report)")
     parser.add_argument("--only", default=None, metavar="PART[,PART]",
                         help="run only these parts: protocol (or protocol:d16, :d24, :d32), shapes, sweep, "
-                             "lift (default: all)")
+                             "lift (default: all); for lessons, lesson keys (drag_speed, lift, ...)")
+    parser.add_argument("--compare", action="store_true",
+                        help="lessons: also run each one plain (no absorbing layer, wind everywhere from the "
+                             "first step, sudden wind changes)")
+    parser.add_argument("--json", default=None, metavar="PATH", help="lessons: also write the runs as JSON")
     parser.add_argument("--scenes", default="scenes", metavar="DIR", help="folder holding the scenes (default: scenes)")
     parser.add_argument("--out", default="docs", metavar="DIR",
                         help="folder for report-seed.md and report-seed/ (default: docs)")
@@ -34,6 +41,8 @@ def add_arguments(parser):
 
 
 def main(args) -> int:
+    if args.target == "lessons":
+        return lessons(args)
     from app.seed_report import PARTS, PROTOCOL, run_part, save_part, write_report
 
     out = Path(args.out)
@@ -70,3 +79,35 @@ def main(args) -> int:
     path = write_report(out)
     print(f"{path}: written")
     return 0
+
+
+def lessons(args) -> int:
+    import json
+
+    from app.commands.bench_solver import machine
+    from app.files import write_text_atomic
+    from app.headless import gl_context
+    from app.lesson_report import format_table, run_lesson
+    from app.presets import PRESETS
+
+    keys = list(PRESETS)
+    if args.only is not None:
+        keys = [k.strip() for k in args.only.split(",") if k.strip()]
+        bad = [k for k in keys if k not in PRESETS]
+        if bad or not keys:
+            raise UserError(f"--only: unknown lesson {bad[0] if bad else args.only!r}; choose from {', '.join(PRESETS)}")
+    if args.backend == "gl":
+        gl_context()   # one line on stderr, exit 2, when there is no EGL context
+    elif args.backend != "numpy":
+        raise UserError(f"--backend: must be numpy or gl, got {args.backend!r}")
+    runs = []
+    for key in keys:
+        for plain in ((False, True) if args.compare else (False,)):
+            print(f"feelflow report lessons: {key}{' (plain)' if plain else ''} on {args.backend}",
+                  file=sys.stderr, flush=True)
+            runs.append(run_lesson(key, args.backend, plain=plain, make_ctx=gl_context))
+    print(format_table(runs))
+    if args.json:
+        write_text_atomic(args.json, json.dumps({"machine": machine(), "runs": runs}, indent=1) + "\n")
+    return 0
+
