@@ -34,6 +34,7 @@ class ReplaySimulation:
         self.paused = False
         self.last_steps = 0
         self._last_forces: dict = {}
+        self.split_rows = True   # a force row longer than a frame's budget runs in parts (SessionPlayer)
         self._params_cache = None  # (player.events_done, Params)
 
     # --- what the window draws ----------------------------------------------------------
@@ -130,10 +131,13 @@ class ReplaySimulation:
 
     # --- running ------------------------------------------------------------------------
     def advance(self, n: int) -> dict:
-        """Replay about n steps (SessionPlayer.advance); returns {model: (fx, fy)} averaged over
-        them, like Simulation.advance. `last_steps` says how many ran."""
+        """Replay n steps (SessionPlayer.advance, a long force row in parts: a session recorded
+        with one row per 100 steps replays at the window's frame rate, not one frame per row);
+        returns {model: (fx, fy)} of the rows completed, averaged over them, like
+        Simulation.advance (the last ones while a row is still in parts). `last_steps` says how
+        many ran."""
         first = len(self.player.rows)
-        self.last_steps = self.player.advance(max(1, int(n)))
+        self.last_steps = self.player.advance(max(1, int(n)), split_rows=self.split_rows)
         rows = self.player.rows[first:]
         acc: dict = {}
         for row in rows:

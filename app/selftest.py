@@ -1,7 +1,8 @@
 """`feelflow --selftest`: open the real window, run the default scene, drag the body with
 synthetic mouse events, switch shape and force model, save a screenshot, print frames per
 second and solver steps per second; exit 0 only if everything worked (non-blank field, body
-moved, plot has data)."""
+moved, plot has data). `feelflow --selftest gui SESSION` measures the window's replay of SESSION
+instead: frames per second and session steps per second while it replays."""
 from __future__ import annotations
 
 import math
@@ -60,8 +61,10 @@ def field_is_alive(window) -> tuple[bool, str]:
 class SelfTest:
     """Drives the window from a timer; `exit_code` is set when the application quits."""
 
-    def __init__(self, window, seconds: float = 8.0, screenshot: str | None = None, out=sys.stdout):
+    def __init__(self, window, seconds: float = 8.0, screenshot: str | None = None, out=sys.stdout,
+                 replay: bool = False):
         self.window, self.seconds, self.screenshot, self.out = window, max(4.0, seconds), screenshot, out
+        self.replay = replay   # the window replays a session (feelflow --selftest gui SESSION): measure that
         self.exit_code = 1
         self.failures = []
         self.results = {}
@@ -93,6 +96,9 @@ class SelfTest:
         w = self.window
         while w.sim is None:
             yield
+        if self.replay:
+            yield from self._replay_script()
+            return
         yield from self._wait(1.0)                      # warm-up: shader compile, adaptive stepping
         sim = w.sim
         measure = 0.45 * self.seconds
@@ -136,6 +142,30 @@ class SelfTest:
             w.save_screenshot(self.screenshot)
             self.results["screenshot"] = self.screenshot
 
+    def _replay_script(self):
+        """The replay's frame rate and steps per second, and that it moves on."""
+        w = self.window
+        while w.replay is None:
+            yield
+        yield from self._wait(1.0)
+        r = w.replay
+        self.results["grid"] = f"{r.config.nx}x{r.config.ny}"
+        for split in (False, True):   # rows whole (as before the fifth session), then long rows in parts
+            r.split_rows = split
+            yield from self._wait(0.5)
+            s0, f0, t0 = r.step, w.viewport.frames, time.perf_counter()
+            yield from self._wait(0.3 * self.seconds)
+            dt = time.perf_counter() - t0
+            steps, frames = r.step - s0, w.viewport.frames - f0
+            self.results.setdefault("replay", []).append(
+                (split, frames / dt, steps / dt, steps / max(1, frames)))
+            if steps <= 0 and not r.done:
+                self.failures.append("the replay did not move on")
+        self.results.update(replay_rows=len(r.player.rows), replay_step=r.step, replay_total=r.player.total_steps)
+        if self.screenshot:
+            w.save_screenshot(self.screenshot)
+            self.results["screenshot"] = self.screenshot
+
     def _finish(self):
         if not self._timer.isActive():
             return
@@ -148,6 +178,12 @@ class SelfTest:
                   f"({r['mlups']:.1f} MLUPS, {r['steps_per_frame']:.1f} steps/frame)", file=self.out)
             print(f"selftest: frame budget: {r['step_ms']:.2f} ms per solver step, "
                   f"{r['rest_of_frame_ms']:.1f} ms per frame for everything else (drawing, Qt)", file=self.out)
+        for split, fps, steps_s, per_frame in r.get("replay", []):
+            print(f"selftest: replay, {'long rows in parts' if split else 'rows whole'}: {fps:.1f} frames/s, "
+                  f"{steps_s:.0f} session steps/s ({per_frame:.1f} steps/frame)", file=self.out)
+        if "replay_step" in r:
+            print(f"selftest: replay at step {r['replay_step']} of {r['replay_total']}, "
+                  f"{r['replay_rows']} force rows replayed", file=self.out)
         if "body_moved_cells" in r:
             print(f"selftest: body moved {r['body_moved_cells']:.1f} cells when dragged", file=self.out)
         if "screenshot" in r:

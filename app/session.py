@@ -304,6 +304,7 @@ class SessionSolver:
         self.inflow_speed = None     # None: the config's
         self.paused = False
         self.clock = recorder.step if recorder is not None else 0
+        self._part = None            # a force row being run in parts (step_part), or None
 
     @property
     def solver(self):
@@ -384,6 +385,41 @@ class SessionSolver:
             self._record_row(done, {m: (math.nan, math.nan) for m in self.models}, body)
             raise
         self._record_row(n, self._solver.forces(), body)
+
+    def step_part(self, k: int, row_steps: int) -> bool:
+        """Run k steps of a force row of `row_steps` steps that is run in parts (a replay that
+        draws between them); the row is recorded when its last part has run, with the forces
+        averaged over the parts weighted by their steps (equal to one `step(row_steps)` up to
+        rounding; the flow itself is the same). Returns True when the row is complete.
+        `partial_steps` says how far the current row has got."""
+        k, row_steps = int(k), int(row_steps)
+        part = self._part
+        if part is None:
+            part = self._part = {"done": 0, "sums": {}, "body": self._body_row(), "start": self._solver.time}
+        k = max(1, min(k, row_steps - part["done"]))
+        try:
+            self._solver.step(k)
+        except SolverDiverged as exc:
+            self._part = None
+            done = part["done"] + max(1, min(k, exc.step - part["start"] - part["done"]))
+            self._record_row(done, {m: (math.nan, math.nan) for m in self.models}, part["body"])
+            raise
+        sums = part["sums"]
+        for m, (fx, fy) in self._solver.forces().items():
+            sx, sy = sums.get(m, (0.0, 0.0))
+            sums[m] = (sx + fx * k, sy + fy * k)
+        part["done"] += k
+        if part["done"] < row_steps:
+            return False
+        self._part = None
+        self._record_row(row_steps, {m: (sx / row_steps, sy / row_steps) for m, (sx, sy) in sums.items()},
+                         part["body"])
+        return True
+
+    @property
+    def partial_steps(self) -> int:
+        """Steps run of a force row still in parts (0 between rows)."""
+        return 0 if self._part is None else self._part["done"]
 
     def _body_row(self):
         if self.shape is None:

@@ -4,8 +4,11 @@ between two calls (`feelflow session replay` runs the same player to the end in 
 `SessionPlayer` feeds the events of a `Session` in recorded order (`seq`) through the same
 `SessionSolver` that recorded them (app/session.py), so on the recording backend and machine
 the force series comes out bit for bit (docs/sessions.md, "Replay and playback"). A force row
-is one `step(n)` call: the player never splits it, so one `advance` may run past its budget by
-at most the steps of one row.
+is one `step(n)` call: by default the player never splits it, so one `advance` may run past its
+budget by at most the steps of one row; with `split_rows=True` (the window's replay) it runs a
+row longer than the whole budget in parts that fit it (`SessionSolver.step_part`: the same flow, the row's forces
+equal up to rounding), so a session recorded with long rows (`feelflow run --record`, a row per
+output interval) replays as smoothly as one recorded in the window.
 
 Qt-free: used by `app.session.replay`, the window's replay (app/replay_simulation.py) and tests.
 """
@@ -86,8 +89,13 @@ class SessionPlayer:
 
     @property
     def step(self) -> int:
-        """Session steps replayed so far."""
-        return self._driver.clock
+        """Session steps replayed so far (with the parts of a row in progress)."""
+        return self._driver.clock + self._driver.partial_steps
+
+    @property
+    def row_index(self) -> int:
+        """The force row the flow is in (its parts running) or last completed; -1 before any."""
+        return len(self.rows) - (0 if self._driver.partial_steps else 1)
 
     @property
     def total_steps(self) -> int:
@@ -125,17 +133,31 @@ class SessionPlayer:
         return self._driver.models
 
     # --- running ---------------------------------------------------------------------------
-    def advance(self, max_steps: int) -> int:
-        """Apply events until `max_steps` solver steps are simulated (at least one force row
-        unless done; a row is never split) and return the steps simulated. It stops right after
-        a row, before the inputs that lead to the next one, so `shape` is the pose the flow last
-        felt."""
+    def advance(self, max_steps: int, split_rows: bool = False) -> int:
+        """Apply events until `max_steps` solver steps are simulated and return the steps
+        simulated. A row that fits in `max_steps` is never split (at least one force row runs
+        unless done); a longer one runs whole without `split_rows`, and in parts of the budget
+        with it, across calls (`rows` gets it when its last part has run). It stops right
+        after a row or part, before the inputs that lead to the next one, so `shape` is the
+        pose the flow last felt (that of row `row_index`)."""
         steps = 0
         events = self._events
+        max_steps = max(1, int(max_steps))
         while self._next < len(events):
             ev = events[self._next]
-            if steps and steps + self._row_ahead[self._next] > max_steps:
-                break
+            if split_rows and ev[0] == "forces" and (self._driver.partial_steps or ev[2] > max_steps):
+                k = min(ev[2] - self._driver.partial_steps, max_steps - steps)
+                if k <= 0:
+                    break
+                if self._run_row(self._next, ev, part=k):
+                    self._next += 1
+                steps += k
+                if steps >= max_steps:
+                    break
+                continue
+            ahead = self._row_ahead[self._next]
+            if steps and steps + ahead > max_steps and not (split_rows and ahead > max_steps):
+                break   # (a row longer than the budget is split anyway: start it in this call)
             self._apply(self._next, ev)
             self._next += 1
             if ev[0] == "forces":
@@ -156,17 +178,36 @@ class SessionPlayer:
             elif kind == "parameter":
                 self._parameter(ev[2], ev[3])
             else:
-                try:
-                    driver.step(ev[2])
-                except SolverDiverged:
-                    self.diverged_at = driver.clock
-                step, n, body, forces = self.recorder.rows(len(self.rows))[0]
-                self.rows.append(ReplayedRow(step, n, body, forces, self.inflow_speed))
+                self._run_row(k, ev)
         except SessionError:
             raise
         except (ValueError, BackendError) as exc:  # the file asks for something impossible (here)
-            raise SessionError(f"{self.session.source}: event {k} ({ev[0]} at step {ev[1]}) cannot be replayed: "
-                               f"{str(exc).splitlines()[0]}") from None
+            raise self._cannot(k, ev, exc) from None
+
+    def _run_row(self, k: int, ev, part: int | None = None) -> bool:
+        """The force row `ev` (event k): whole, or `part` more of its steps. True when the row
+        is complete (and appended to `rows`)."""
+        driver = self._driver
+        try:
+            try:
+                if part is None:
+                    driver.step(ev[2])
+                    complete = True
+                else:
+                    complete = driver.step_part(part, ev[2])
+            except SolverDiverged:
+                self.diverged_at = driver.clock
+                complete = True
+        except (ValueError, BackendError) as exc:
+            raise self._cannot(k, ev, exc) from None
+        if complete:
+            step, n, body, forces = self.recorder.rows(len(self.rows))[0]
+            self.rows.append(ReplayedRow(step, n, body, forces, self.inflow_speed))
+        return complete
+
+    def _cannot(self, k: int, ev, exc) -> SessionError:
+        return SessionError(f"{self.session.source}: event {k} ({ev[0]} at step {ev[1]}) cannot be replayed: "
+                            f"{str(exc).splitlines()[0]}")
 
     def _parameter(self, name, value) -> None:
         driver = self._driver

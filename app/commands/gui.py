@@ -2,7 +2,8 @@
 
 `feelflow gui FILE.ffsession` opens the window and replays that session in it as soon as the live
 tunnel runs (what File > Replay session does); the desktop entry's `Exec=... gui %f` uses it, so
-double-clicking a session file in the file manager replays it.
+double-clicking a session file in the file manager replays it; `feelflow --selftest gui FILE`
+measures that replay (frames and session steps per second).
 
 The OpenGL surface format (3.3 core, no depth buffer, no vsync) is set before the QApplication
 exists (shared/notes/gl-qt-on-this-machine.md). Without a display there is no window: one line
@@ -92,7 +93,7 @@ def main(args) -> int:
     if selftest:
         from app.selftest import SelfTest
 
-        test = SelfTest(window, seconds=args.seconds, screenshot=args.screenshot)
+        test = SelfTest(window, seconds=args.seconds, screenshot=args.screenshot, replay=session is not None)
         window.show()
         app.exec()
         if window.startup_error:
