@@ -3,22 +3,23 @@
 Measured by `feelflow validate --case stability --json docs/bench/stability.json`
 (solver/validation/stability.py: a plate thinner than a cell at 45 deg, an impulsively started
 cylinder, a cylinder shaken and spun at the Mach cap, the wedge pointing upstream; 192 x 96,
-float32, 6 d / U steps a point, AMD EPYC 2 vCPUs, 2026-11-21; the map is in the README's
-Validation section). What the data say (lattice units, U the wind, nu the viscosity, d the body
-size in cells):
+float32, 6 d / U steps a point, the window's absorbing sponge, AMD EPYC 2 vCPUs, 2026-11-22;
+the map is in the README's Validation section). What the data say (lattice units, U the wind,
+nu the viscosity, d the body size in cells):
 
 * TRT (Lambda = 3/16, the window's operator): the most restrictive case is the shaken cylinder.
   Its highest cell Reynolds number Re_cell = U / nu below which every point was stable is
-  8.75 / 6.25 / 4.375 at d = 10 / 20 / 40: neither Re_cell nor Re_D = U d / nu is constant, but
-  Re_cell sqrt(d) is (27.7 / 27.95 / 27.7). The fixed-body cases (plate, wedge, impulsive start)
-  stay stable up to Re_cell = 10 at d = 20 (sqrt(d) Re_cell = 44.7) and fail from 11.25.
-* BGK: no point of the scan failed within 6 d / U (up to Re_cell = 45 at d = 20, the panel's
-  extreme corner), but runs of 30 d / U at that corner do fail (`python -m
-  solver.validation.stability --u 0.09 --nu 0.002 --collision bgk --convective-times 30`: the
-  thin plate runs away after 2400 steps, 10.8 d / U, the shaken cylinder and the wedge diverge at
-  steps 3189 and 5398).
-  Its limit is therefore not measured; BGK gets TRT's K, at which all four cases ran 30 d / U
-  stably with both operators (`... --u 0.09 --k 27.67 --collision bgk|trt --convective-times 30`).
+  8.75 / 8.75 / 4.375 at d = 10 / 20 / 40: neither Re_cell nor Re_D = U d / nu is constant;
+  Re_cell sqrt(d) is 27.7 / 39.1 / 27.7 (27.7 / 27.95 / 27.7 without the absorbing layer, the
+  fourth session's run), and K is the smallest. The fixed-body cases (plate, wedge, impulsive
+  start) stay stable up to Re_cell = 10 at d = 20 (sqrt(d) Re_cell = 44.7) and fail from 11.25.
+* BGK: within 6 d / U only the shaken cylinder failed, at the panel's extreme corner (Re_cell
+  45 at d = 20; K_bgk = 156.5); runs of 30 d / U at that corner (`python -m
+  solver.validation.stability --u 0.09 --nu 0.002 --collision bgk --convective-times 30`): the
+  shaken cylinder runs away after 1200 steps, the other three last.
+  Its limit is therefore not measured finely; BGK gets TRT's K, at which all four cases ran
+  30 d / U stably with both operators (`... --u 0.09 --k 27.67 --collision bgk|trt
+  --convective-times 30`).
 
 So the limit is `U sqrt(d) / nu <= K` with K per collision operator (the smallest measured
 Re_cell sqrt(d) below which every run was stable); below d = 10 (the smallest size scanned) the

@@ -52,6 +52,15 @@ def test_panel_extreme_corner_diverges(scene, backend, request):
     assert p.state == "diverged", p.to_dict()   # SolverDiverged raised by the backend's check
 
 
+def test_the_scan_runs_the_windows_tunnel():
+    """The scan's tunnel is the window's: its sponge and the sponge's absorbing layer."""
+    from app.simulation import default_base_config
+
+    window = default_base_config(stability.GRID)
+    scan = stability.scene_config("plate45", "trt", 0.05, 0.02)
+    assert (scan.sponge_cells, scan.sponge_absorb, scan.dtype) == (window.sponge_cells, window.sponge_absorb, window.dtype)
+
+
 def test_quick_case_meets_its_checks(request):
     r = stability.run(factory("numpy", request), quick=True)
     assert r.passed, r.to_dict()["quantities"]
