@@ -2,6 +2,8 @@
 docs/report-seed.md with PNG plots (the work is in app/seed_report.py).
 `feelflow report lessons [--only KEY,...] [--compare] [--json PATH]`: run the Presets menu's
 lessons headless as the window does and print how steady their forces are (app/lesson_report.py).
+`feelflow report scenes [--only NAME,...] [--compare] [--json PATH]`: run the example scenes with an
+outlet sponge as `feelflow run` does and print how calm their tunnel is (app/scene_report.py).
 
 Parts (`--only`): protocol (or one diameter, protocol:d32), shapes, sweep, lift; each stores its
 series in OUT/report-seed/data-<part>.json (data-protocol-<d>.json per diameter), and the report
@@ -15,12 +17,13 @@ from pathlib import Path
 
 from app.cli import UserError
 
-TARGETS = ("seed", "lessons")
+TARGETS = ("seed", "lessons", "scenes")
 
 
 def add_arguments(parser):
     parser.add_argument("target", choices=TARGETS,
-                        help="which report (seed: the thesis's experiments; lessons: the Presets menu's lessons)")
+                        help="which report (seed: the thesis's experiments; lessons: the Presets menu's lessons; "
+                             "scenes: how calm the example scenes' tunnels are)")
     parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
     parser.add_argument("--quick", action="store_true",
                         help="a few dozen steps per run: a smoke test of the whole chain, not physics")
@@ -28,11 +31,12 @@ def add_arguments(parser):
                         help="steps per protocol phase instead of the scenes' 15000 (stated in the report)")
     parser.add_argument("--only", default=None, metavar="PART[,PART]",
                         help="run only these parts: protocol (or protocol:d16, :d24, :d32), shapes, sweep, "
-                             "lift (default: all); for lessons, lesson keys (drag_speed, lift, ...)")
+                             "lift (default: all); for lessons, lesson keys (drag_speed, lift, ...); for "
+                             "scenes, scene names (default, plate, ...)")
     parser.add_argument("--compare", action="store_true",
                         help="lessons: also run each one plain (no absorbing layer, wind everywhere from the "
-                             "first step, sudden wind changes)")
-    parser.add_argument("--json", default=None, metavar="PATH", help="lessons: also write the runs as JSON")
+                             "first step, sudden wind changes); scenes: also without the absorbing layer")
+    parser.add_argument("--json", default=None, metavar="PATH", help="lessons, scenes: also write the runs as JSON")
     parser.add_argument("--scenes", default="scenes", metavar="DIR", help="folder holding the scenes (default: scenes)")
     parser.add_argument("--out", default="docs", metavar="DIR",
                         help="folder for report-seed.md and report-seed/ (default: docs)")
@@ -43,6 +47,8 @@ def add_arguments(parser):
 def main(args) -> int:
     if args.target == "lessons":
         return lessons(args)
+    if args.target == "scenes":
+        return scene_calm(args)
     from app.seed_report import PARTS, PROTOCOL, run_part, save_part, write_report
 
     out = Path(args.out)
@@ -111,3 +117,33 @@ def lessons(args) -> int:
         write_text_atomic(args.json, json.dumps({"machine": machine(), "runs": runs}, indent=1) + "\n")
     return 0
 
+
+
+def scene_calm(args) -> int:
+    import json
+
+    from app.commands.bench_solver import machine
+    from app.files import write_text_atomic
+    from app.scene_report import SCENES, format_table, run_scene_calm
+
+    folder = Path(args.scenes)
+    names = list(SCENES)
+    if args.only is not None:
+        names = [k.strip() for k in args.only.split(",") if k.strip()]
+        bad = [k for k in names if k not in SCENES]
+        if bad or not names:
+            raise UserError(f"--only: unknown scene {bad[0] if bad else args.only!r}; choose from {', '.join(SCENES)}")
+    missing = [n for n in names if not (folder / f"{n}.toml").is_file()]
+    if missing:
+        raise UserError(f"--scenes: {str(folder / (missing[0] + '.toml'))!r} not found")
+    runs = []
+    for name in names:
+        for without in ((False, True) if args.compare else (False,)):
+            print(f"feelflow report scenes: {name}{' (without the absorbing layer)' if without else ''} "
+                  f"on {args.backend}", file=sys.stderr, flush=True)
+            runs.append(run_scene_calm(folder / f"{name}.toml", args.backend, without_layer=without,
+                                       steps=40 if args.quick else None))
+    print(format_table(runs))
+    if args.json:
+        write_text_atomic(args.json, json.dumps({"machine": machine(), "runs": runs}, indent=1) + "\n")
+    return 0
