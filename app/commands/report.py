@@ -88,20 +88,11 @@ def main(args) -> int:
 
 
 def lessons(args) -> int:
-    import json
-
-    from app.commands.bench_solver import machine
-    from app.files import write_text_atomic
     from app.headless import gl_context
     from app.lesson_report import format_table, run_lesson
     from app.presets import PRESETS
 
-    keys = list(PRESETS)
-    if args.only is not None:
-        keys = [k.strip() for k in args.only.split(",") if k.strip()]
-        bad = [k for k in keys if k not in PRESETS]
-        if bad or not keys:
-            raise UserError(f"--only: unknown lesson {bad[0] if bad else args.only!r}; choose from {', '.join(PRESETS)}")
+    keys = _chosen(args.only, list(PRESETS), "lesson")
     if args.backend == "gl":
         gl_context()   # one line on stderr, exit 2, when there is no EGL context
     elif args.backend != "numpy":
@@ -112,27 +103,14 @@ def lessons(args) -> int:
             print(f"feelflow report lessons: {key}{' (plain)' if plain else ''} on {args.backend}",
                   file=sys.stderr, flush=True)
             runs.append(run_lesson(key, args.backend, plain=plain, make_ctx=gl_context))
-    print(format_table(runs))
-    if args.json:
-        write_text_atomic(args.json, json.dumps({"machine": machine(), "runs": runs}, indent=1) + "\n")
-    return 0
-
+    return _print_runs(runs, format_table(runs), args.json)
 
 
 def scene_calm(args) -> int:
-    import json
-
-    from app.commands.bench_solver import machine
-    from app.files import write_text_atomic
     from app.scene_report import SCENES, format_table, run_scene_calm
 
     folder = Path(args.scenes)
-    names = list(SCENES)
-    if args.only is not None:
-        names = [k.strip() for k in args.only.split(",") if k.strip()]
-        bad = [k for k in names if k not in SCENES]
-        if bad or not names:
-            raise UserError(f"--only: unknown scene {bad[0] if bad else args.only!r}; choose from {', '.join(SCENES)}")
+    names = _chosen(args.only, list(SCENES), "scene")
     missing = [n for n in names if not (folder / f"{n}.toml").is_file()]
     if missing:
         raise UserError(f"--scenes: {str(folder / (missing[0] + '.toml'))!r} not found")
@@ -143,7 +121,29 @@ def scene_calm(args) -> int:
                   f"on {args.backend}", file=sys.stderr, flush=True)
             runs.append(run_scene_calm(folder / f"{name}.toml", args.backend, without_layer=without,
                                        steps=40 if args.quick else None))
-    print(format_table(runs))
-    if args.json:
-        write_text_atomic(args.json, json.dumps({"machine": machine(), "runs": runs}, indent=1) + "\n")
+    return _print_runs(runs, format_table(runs), args.json)
+
+
+def _chosen(only: str | None, choices: list[str], what: str) -> list[str]:
+    """The names given to --only (comma-separated), all of `choices` without it; UserError names
+    the first unknown one."""
+    if only is None:
+        return choices
+    names = [k.strip() for k in only.split(",") if k.strip()]
+    bad = [k for k in names if k not in choices]
+    if bad or not names:
+        raise UserError(f"--only: unknown {what} {bad[0] if bad else only!r}; choose from {', '.join(choices)}")
+    return names
+
+
+def _print_runs(runs: list[dict], table: str, json_path: str | None) -> int:
+    """Print the report's table; with --json also write the runs and the machine (atomically)."""
+    import json
+
+    from app.commands.bench_solver import machine
+    from app.files import write_text_atomic
+
+    print(table)
+    if json_path:
+        write_text_atomic(json_path, json.dumps({"machine": machine(), "runs": runs}, indent=1) + "\n")
     return 0
