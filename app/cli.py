@@ -17,7 +17,7 @@ COMMANDS = {
     "validate": "run the physics validation cases and print a table",
     "bench": "measure solver speed (both backends) or the haptic loop",
     "devices": "list haptic devices: serial ports, HID devices, simulators",
-    "report": "reproduce the seed's experiments and write a Markdown report",
+    "report": "reports: the seed's experiments (Markdown), how steady the lessons and example scenes are",
     "session": "inspect, replay or export a recorded session file",
 }
 
