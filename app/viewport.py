@@ -48,6 +48,8 @@ BODY_EDGE = QColor(20, 20, 20)
 DRAG_COLOUR = QColor(230, 40, 40)
 LIFT_COLOUR = QColor(40, 120, 255)
 COLOUR_BAR_MARGIN = 132  # pixels on the right kept for the colour bar
+#: the dashed line where the outlet zone (the sponge, docs/algorithm.md step 3) begins
+OUTLET_LINE = QColor(255, 255, 255, 150)
 WHEEL_DEG_PER_NOTCH = 2.0  # one notch of the mouse wheel (120 eighths of a degree) turns the body this far
 MOUSE_HINT = ("Drag the body to move it; drag its round handle or turn the mouse wheel to rotate it "
               "(hold Shift for 15\u00b0 steps).")
@@ -227,6 +229,7 @@ class Viewport(QOpenGLWidget):
         p.setRenderHint(QPainter.Antialiasing)
         if self.mode == "tracers" and self.tracers is not None:
             self._paint_tracers(p)
+        self._paint_outlet_zone(p)
         self._paint_body(p)
         self._paint_turn_handle(p)
         if self.show_arrows and self.arrow_forces and self.sim.shape is not None:
@@ -366,6 +369,26 @@ class Viewport(QOpenGLWidget):
         p.setFont(font)
         p.drawText(QRectF(x - 22, 4, COLOUR_BAR_MARGIN - 2, top - 8), Qt.AlignLeft | Qt.AlignBottom | Qt.TextWordWrap,
                    mode.unit)
+
+    def outlet_zone_x(self):
+        """Widget x where the outlet zone begins, None without one. In the zone (the sponge's last
+        `sponge_cells` columns) the fluid is thickened and, with the absorbing layer, drawn
+        towards the inflow so that vortices and sound leave the tunnel: the flow there is not
+        the test section's, and the line and its label tell a class so."""
+        cfg = self.sim.config
+        if cfg.x_boundary != "tunnel" or cfg.sponge_cells <= 0:
+            return None
+        return self.to_widget(cfg.nx - cfg.sponge_cells - 0.5, 0.0).x()
+
+    def _paint_outlet_zone(self, p: QPainter):
+        x = self.outlet_zone_x()
+        if x is None:
+            return
+        r = self.lattice_rect()
+        p.setPen(QPen(OUTLET_LINE, 1.5, Qt.DashLine))
+        p.drawLine(QPointF(x, r.top()), QPointF(x, r.bottom()))
+        self._label(p, QPointF(x + 6, r.bottom() - 8), "outlet zone", QColor(230, 230, 230), size=12,
+                    box=QColor(0, 0, 0, 110))
 
     def _paint_notes(self, p: QPainter):
         sim = self.sim

@@ -404,3 +404,27 @@ def test_a_backend_that_cannot_run_is_a_dialog_and_a_clean_close(qtbot, tmp_path
     assert "cannot run here" in shown[0] and "unknown backend" in shown[0]
     assert w.sim is None and w.startup_error
     qtbot.waitUntil(lambda: not w.isVisible(), timeout=5000)
+
+
+def test_the_outlet_zone_is_marked_where_the_sponge_begins(window, qtbot, tmp_path):
+    """A dashed line at the first sponge column (and a label): the flow beyond it is the outlet's."""
+    from PySide6.QtGui import QImage
+
+    cfg = window.sim.config
+    view = window.viewport
+    x = view.outlet_zone_x()
+    assert x == pytest.approx(view.to_widget(cfg.nx - cfg.sponge_cells - 0.5, 0.0).x())
+    path = tmp_path / "shot.png"
+    window.save_screenshot(str(path))
+    image = QImage(str(path))
+    origin = view.mapTo(window, view.rect().topLeft())
+    r = view.lattice_rect()
+    rows = range(int(r.top()) + 2, int(r.bottom()) - 30)
+
+    def brightness(px, py):
+        c = image.pixelColor(int(px) + origin.x(), int(py) + origin.y())
+        return c.red() + c.green() + c.blue()
+
+    on_line = sum(abs(brightness(x, y) - brightness(x - 4, y)) > 40 for y in rows)
+    off_line = sum(abs(brightness(x - 8, y) - brightness(x - 12, y)) > 40 for y in rows)
+    assert on_line > 0.3 * len(rows) and off_line < 0.05 * len(rows), (on_line, off_line, len(rows))
