@@ -138,9 +138,7 @@ class SelfTest:
         if len(fresh) == 0 or not np.isfinite(fresh).any():
             self.failures.append("the plot got no data from the pressure model")
         w.refresh_readouts()
-        if self.screenshot:
-            w.save_screenshot(self.screenshot)
-            self.results["screenshot"] = self.screenshot
+        self._save_screenshot()
 
     def _replay_script(self):
         """The replay's frame rate and steps per second, and that it moves on."""
@@ -162,8 +160,11 @@ class SelfTest:
             if steps <= 0 and not r.done:
                 self.failures.append("the replay did not move on")
         self.results.update(replay_rows=len(r.player.rows), replay_step=r.step, replay_total=r.player.total_steps)
+        self._save_screenshot()
+
+    def _save_screenshot(self):
         if self.screenshot:
-            w.save_screenshot(self.screenshot)
+            self.window.save_screenshot(self.screenshot)
             self.results["screenshot"] = self.screenshot
 
     def _finish(self):

@@ -6,9 +6,9 @@ between two calls (`feelflow session replay` runs the same player to the end in 
 the force series comes out bit for bit (docs/sessions.md, "Replay and playback"). A force row
 is one `step(n)` call: by default the player never splits it, so one `advance` may run past its
 budget by at most the steps of one row; with `split_rows=True` (the window's replay) it runs a
-row longer than the whole budget in parts that fit it (`SessionSolver.step_part`: the same flow, the row's forces
-equal up to rounding), so a session recorded with long rows (`feelflow run --record`, a row per
-output interval) replays as smoothly as one recorded in the window.
+row longer than the whole budget in parts that fit it (`SessionSolver.step_part`: the same
+flow, the row's forces equal up to rounding), so a session recorded with long rows (`feelflow
+run --record`, a row per output interval) replays as smoothly as one recorded in the window.
 
 Qt-free: used by `app.session.replay`, the window's replay (app/replay_simulation.py) and tests.
 """

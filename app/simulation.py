@@ -75,11 +75,12 @@ class History:
     """One sample per frame: step, body velocity, relative wind, force of each model in use, and
     whether the sample is *settled*: the relative wind has stayed within `WIND_TOLERANCE` of its
     value for at least `SETTLE_STEPS` steps. Only settled samples are steady drag; the
-    drag-against-speed view fits those (app/force_plot.py). SETTLE_STEPS, measured in the 'Drag
-    grows with speed' lesson (`feelflow report lessons`, README 'Lessons'): 750 steps after a
-    wind change has finished, the drag's 250-step means stay within 5 % of the hold's end value
-    at every wind of the sweep; the first few hundred steps carry the acceleration's added-mass
-    force and the flow's rearrangement (up to +60 %)."""
+    drag-against-speed view fits those (app/force_plot.py). SETTLE_STEPS was chosen from a probe
+    of the 'Drag grows with speed' lesson (fifth session, not a command: indicative only): 750
+    steps after a wind change had finished, the drag's 250-step means stayed within 5 % of the
+    hold's end value at every wind of the sweep, while the first few hundred steps carry the
+    acceleration's added-mass force and the flow's rearrangement (up to +60 %). What the choice
+    gives is measured by `feelflow report lessons` (README 'Lessons': the fitted exponent)."""
 
     time: list = field(default_factory=list)
     body_velocity: list = field(default_factory=list)
