@@ -1,0 +1,14 @@
+"""`feelflow bench --variants`: the ratios it takes within each interleaved round
+(app/commands/bench_solver.py `against_numpy`)."""
+from app.commands.bench_solver import BOX, DEFAULT_TUNNEL, NUMPY_TUNNEL, against_numpy
+
+
+def test_ratios_are_taken_within_each_round_not_between_the_best_figures():
+    # a slow spell in round 2 slows every run of that round alike
+    wall = {NUMPY_TUNNEL: [50.0, 25.0, 40.0], DEFAULT_TUNNEL: [40.0, 30.0, 32.0], BOX: [90.0, 60.0, 100.0]}
+    out = against_numpy(wall)
+    tunnel, ceiling = out["gl tunnel / numpy tunnel"], out["ceiling: gl box / numpy tunnel"]
+    assert tunnel["samples"] == [0.8, 1.2, 0.8] and tunnel["best"] == 1.2 and tunnel["median"] == 0.8
+    assert ceiling["samples"] == [1.8, 2.4, 2.5] and ceiling["median"] == 2.4
+    # the ratio of the best figures (40 / 50 = 0.8) would hide round 2's 1.2
+    assert tunnel["best"] != max(wall[DEFAULT_TUNNEL]) / max(wall[NUMPY_TUNNEL])
