@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.bouzidi import BodyLinks, build_links, wall_velocity
+from solver.bouzidi import BodyLinks, build_links, periodic_wrap, wall_velocity
 from solver.lattice import C, Q, RHO0, W, equilibrium
 from solver.speed_limit import cap_rigid_motion
 
@@ -195,7 +195,7 @@ def make_body_state(shape, velocity, omega, config, margin: int, raster=None) ->
     window = expand_box(raster.window, margin, nx, ny)
     x0, y0, x1, y1 = window
     links = build_links(raster.q[:, y0:y1, x0:x1], raster.solid[y0:y1, x0:x1], x0, y0,
-                        (shape.x, shape.y), vel, om)
+                        (shape.x, shape.y), vel, om, wrap=periodic_wrap(config, window))
     return BodyState(shape, vel, om, capped, raster, window, links)
 
 

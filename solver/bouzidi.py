@@ -51,11 +51,22 @@ def wall_velocity(px, py, center, velocity, omega):
     return (velocity[0] - omega * (np.asarray(py) - cy), velocity[1] + omega * (np.asarray(px) - cx))
 
 
-def build_links(q: np.ndarray, solid: np.ndarray, x0: int, y0: int, center, velocity, omega) -> BodyLinks:
+def periodic_wrap(config, window) -> tuple[bool, bool]:
+    """(x, y): whether the window (x0, y0, x1, y1) spans a periodic direction of the domain
+    whole, so that a second node across the periodic seam is the window's other edge."""
+    x0, y0, x1, y1 = window
+    return (config.x_boundary == "periodic" and x0 == 0 and x1 == config.nx,
+            config.y_boundary == "periodic" and y0 == 0 and y1 == config.ny)
+
+
+def build_links(q: np.ndarray, solid: np.ndarray, x0: int, y0: int, center, velocity, omega,
+                wrap: tuple[bool, bool] = (False, False)) -> BodyLinks:
     """All body links of a window (q: (9, h, w), solid: (h, w), lower-left node (x0, y0)).
 
     The window must reach one node beyond every cut link inside the domain: a second node
-    outside the window counts as outside the domain (half-way rule).
+    outside the window counts as outside the domain (half-way rule), except across a periodic
+    seam the window spans whole (`wrap`, from `periodic_wrap`): there it is the node at the
+    window's other edge, where periodic streaming takes it from.
     """
     h, w = solid.shape
     fluid = ~solid
@@ -66,6 +77,10 @@ def build_links(q: np.ndarray, solid: np.ndarray, x0: int, y0: int, center, velo
     qq = q[ib, iy, ix].astype(np.float64)
     cx, cy = C[i, 0], C[i, 1]
     fy, fx = iy + cy, ix + cx
+    if wrap[0]:
+        fx = fx % w
+    if wrap[1]:
+        fy = fy % h
     inside = (fy >= 0) & (fy < h) & (fx >= 0) & (fx < w)
     fyc, fxc = np.clip(fy, 0, h - 1), np.clip(fx, 0, w - 1)
     second = inside & fluid[fyc, fxc] & (q[i, iy, ix] == 0)

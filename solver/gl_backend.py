@@ -103,28 +103,27 @@ def _triangles(rects) -> np.ndarray:
     return np.asarray(out, dtype="f4").reshape(-1, 2)
 
 
-def node_mask(solid: np.ndarray, q: np.ndarray, box) -> np.ndarray:
+def node_mask(solid: np.ndarray, q: np.ndarray, box, links=None, window=None) -> np.ndarray:
     """The shader's node mask over box (x0, y0, x1, y1), uint32 (h, w), from full-grid arrays.
 
-    bit 0: solid; bit i (1..8): q[OPP[i], x] > 0 (rule 1a for f_i^in); bit 8+i: additionally
-    q < 1/2, x + c_i is a fluid node in the domain and q[i, x] == 0 (two-node interpolation).
+    bit 0: solid; bit i (1..8): q[OPP[i], x] > 0 (rule 1a for f_i^in); bit 8+i: the link takes
+    the two-node interpolation (q < 1/2 and a fluid second node x + c_i): set from the body's
+    `links` (solver.bouzidi, built on the force `window` (x0, y0, ...)), so that both backends
+    make the same choice, across a periodic seam too (the shader takes the second node's
+    population as streamed, which wraps there).
     """
-    ny, nx = solid.shape
     x0, y0, x1, y1 = box
     sl = (slice(y0, y1), slice(x0, x1))
-    # fluid flags of box + 1, with the outside of the domain counted as not fluid
-    fluid_pad = np.zeros((y1 - y0 + 2, x1 - x0 + 2), bool)
-    ya, yb, xa, xb = max(y0 - 1, 0), min(y1 + 1, ny), max(x0 - 1, 0), min(x1 + 1, nx)
-    fluid_pad[ya - y0 + 1:yb - y0 + 1, xa - x0 + 1:xb - x0 + 1] = ~solid[ya:yb, xa:xb]
     mask = solid[sl].astype(np.uint32)
     for i in range(1, Q):
-        ib = OPP[i]
-        cut = (q[ib][sl] > 0) & ~solid[sl]
-        cx, cy = int(C[i, 0]), int(C[i, 1])
-        second_fluid = fluid_pad[1 + cy:y1 - y0 + 1 + cy, 1 + cx:x1 - x0 + 1 + cx]
-        two_node = cut & (q[ib][sl] < 0.5) & second_fluid & (q[i][sl] == 0)
+        cut = (q[OPP[i]][sl] > 0) & ~solid[sl]
         mask |= cut.astype(np.uint32) << np.uint32(i)
-        mask |= two_node.astype(np.uint32) << np.uint32(8 + i)
+    if links is not None and len(links):
+        two = links.b != 0
+        ys, xs = links.iy[two] + window[1] - y0, links.ix[two] + window[0] - x0
+        inside = (ys >= 0) & (ys < y1 - y0) & (xs >= 0) & (xs < x1 - x0)
+        bits = np.left_shift(np.uint32(1), (8 + links.i[two][inside]).astype(np.uint32))
+        np.bitwise_or.at(mask, (ys[inside], xs[inside]), bits)
     return mask
 
 
@@ -693,7 +692,7 @@ class GLSolver(Solver):
             mask = np.zeros((h, w), np.uint32)
             q = np.zeros((Q, h, w), np.float32)
         else:
-            mask = node_mask(body.raster.solid, body.raster.q, box)
+            mask = node_mask(body.raster.solid, body.raster.q, box, body.links, body.window)
             q = body.raster.q[:, y0:y1, x0:x1].astype(np.float32)
         viewport = (x0, y0, w, h)
         self._mask_tex.write(np.ascontiguousarray(mask).tobytes(), viewport=viewport)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver.bouzidi import BodyLinks, build_links, incoming, outgoing
+from solver.bouzidi import BodyLinks, build_links, incoming, outgoing, periodic_wrap
 from solver.forces.base import BodyWindow, ForceModel
 from solver.lattice import C
 
@@ -19,8 +19,11 @@ def window_links(window: BodyWindow) -> BodyLinks:
     """The window's body links: the backend's, or built from its q and solid."""
     if window.links is not None:
         return window.links
+    h, w = window.solid.shape
+    box = (window.x0, window.y0, window.x0 + w, window.y0 + h)
     return build_links(window.q, window.solid, window.x0, window.y0,
-                       (window.shape.x, window.shape.y), window.velocity, window.omega)
+                       (window.shape.x, window.shape.y), window.velocity, window.omega,
+                       wrap=periodic_wrap(window.config, box))
 
 
 class GalileanMomentumExchange(ForceModel):
