@@ -59,10 +59,12 @@ def node_velocity(shape, velocity, omega, x0, y0, h, w):
     return np.broadcast_to(ux, (h, w)).astype(np.float64), np.broadcast_to(uy, (h, w)).astype(np.float64)
 
 
-def _neighbour_sum(field: np.ndarray) -> np.ndarray:
-    """Sum of a (h, w) field over the 8 lattice neighbours (zero outside the window)."""
+def _neighbour_sum(field: np.ndarray, wrap: tuple[bool, bool] = (False, False)) -> np.ndarray:
+    """Sum of a (h, w) field over the 8 lattice neighbours: zero outside the window, except
+    across a periodic direction the window spans whole (`wrap`, x and y: periodic_wrap)."""
     h, w = field.shape
-    pad = np.pad(field, 1)
+    pad = np.pad(field, ((0, 0), (1, 1)), mode="wrap" if wrap[0] else "constant")
+    pad = np.pad(pad, ((1, 1), (0, 0)), mode="wrap" if wrap[1] else "constant")
     out = np.zeros((h, w), dtype=pad.dtype)
     for k in range(1, Q):
         cx, cy = int(C[k, 0]), int(C[k, 1])
@@ -71,11 +73,12 @@ def _neighbour_sum(field: np.ndarray) -> np.ndarray:
 
 
 def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, velocity, omega,
-           x0: int, y0: int):
+           x0: int, y0: int, wrap: tuple[bool, bool] = (False, False)):
     """Cover, uncover and re-equilibrate the solid nodes of a window of full f* (in place).
 
     f: (9, h, w) float64 post-collision populations; masks cut to the same window, which must
-    reach one node beyond every old and new solid node (or the domain edge).
+    reach one node beyond every old and new solid node (or the domain edge); `wrap`: the
+    window spans a periodic direction whole, so neighbours continue across the seam.
     Covered nodes (new & ~old) give their momentum to the body; uncovered ones (old & ~new)
     get f^eq(rho_new, u_body) and take momentum -rho_new u_body from it; every solid node gets
     f^eq(RHO0, u_body). The mass this creates or destroys (solid nodes hold RHO0) goes back to
@@ -107,8 +110,8 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
     if uncovered.any():
         rho = f.sum(axis=0)
         donor = ~new_solid & ~uncovered
-        rsum = _neighbour_sum(np.where(donor, rho, 0.0))
-        cnt = _neighbour_sum(donor.astype(np.float64))
+        rsum = _neighbour_sum(np.where(donor, rho, 0.0), wrap)
+        cnt = _neighbour_sum(donor.astype(np.float64), wrap)
         rho_new = np.where(cnt > 0, rsum / np.maximum(cnt, 1), RHO0)[uncovered]
         uxu, uyu = ux[uncovered], uy[uncovered]
         f[:, uncovered] = equilibrium(rho_new, uxu, uyu)
@@ -117,7 +120,7 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
         lost += RHO0 * int(uncovered.sum()) - float(rho_new.sum())
     if new_solid.any():
         f[:, new_solid] = equilibrium(np.full(int(new_solid.sum()), RHO0), ux[new_solid], uy[new_solid])
-    ring = ~new_solid & (_neighbour_sum((new_solid | old_solid).astype(np.float64)) > 0)
+    ring = ~new_solid & (_neighbour_sum((new_solid | old_solid).astype(np.float64), wrap) > 0)
     if lost != 0.0 and ring.any():
         fr = f[:, ring]
         rho_r = fr.sum(axis=0)
@@ -147,7 +150,8 @@ def move_body(old, new, config, read_window, write_nodes):
     new_solid = new.solid[ys, xs] if new else np.zeros(shape, bool)
     motion = new if new is not None else old
     f = read_window(x0, y0, x1, y1)
-    impulse, changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0)
+    impulse, changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0,
+                              wrap=periodic_wrap(config, (x0, y0, x1, y1)))
     write_nodes(x0, y0, f, changed)
     return impulse
 
