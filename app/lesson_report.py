@@ -94,7 +94,7 @@ def format_table(runs: list[dict]) -> str:
     for r in runs:
         fit = ""
         if "sweep" in r:
-            fit = f"{_num(r['exponent_settled'])} / {_num(r['exponent_all_samples'])}"
+            fit = f"{table_number(r['exponent_settled'])} / {table_number(r['exponent_all_samples'])}"
         lines.append(f"| {r['lesson']} | {'plain' if r['plain'] else 'as shipped'} | {r['steps']} | {r['wall_s']:.1f} "
                      f"| {r['drag_std_rel']:.4f} | {r['lift_mean'] / abs(r['drag_mean']):+.4f} "
                      f"| {r['lift_std_rel']:.4f} | {fit} |")
@@ -105,10 +105,12 @@ def format_table(runs: list[dict]) -> str:
         for r in sweeps:
             for row in r["sweep"]:
                 lines.append(f"| {r['lesson']} | {'plain' if r['plain'] else 'as shipped'} | {row['wind']:g} "
-                             f"| {_num(row['drag_settled'], '.5g')} | {row['drag_second_half']:.5g} "
+                             f"| {table_number(row['drag_settled'], '.5g')} | {row['drag_second_half']:.5g} "
                              f"| {row['std_rel_second_half']:.4f} | {row['settled_samples']} |")
     return "\n".join(lines)
 
 
-def _num(x, fmt=".3f") -> str:
+def table_number(x, fmt=".3f") -> str:
+    """A table cell for a number that may be missing: "-" for None or not finite (the reports'
+    tables, here and in app/scene_report.py)."""
     return "-" if x is None or not np.isfinite(x) else format(x, fmt)

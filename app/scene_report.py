@@ -71,15 +71,13 @@ def _relative(spread: float, mean: float) -> float:
 
 def format_table(runs: list[dict]) -> str:
     """Markdown: one row per run."""
+    from app.lesson_report import table_number
+
     lines = ["| scene | grid | absorbing layer | steps | wall s | inlet column mean u / U after the ramp (min - max) "
              "| drag, 2nd half | drag std / mean, 2nd half |",
              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in runs:
         lines.append(f"| {r['scene']} | {r['grid']} | {r['layer']:g} | {r['steps']} | {r['wall_s']:.1f} "
                      f"| {r['mean_u_min']:.3f} - {r['mean_u_max']:.3f} (from step {r['from_step']}) "
-                     f"| {r['drag_mean_second_half']:.5g} | {_num(r['drag_std_rel_second_half'])} |")
+                     f"| {r['drag_mean_second_half']:.5g} | {table_number(r['drag_std_rel_second_half'])} |")
     return "\n".join(lines)
-
-
-def _num(x: float) -> str:
-    return "-" if not np.isfinite(x) else f"{x:.3f}"
