@@ -63,15 +63,49 @@ class Shape(ABC):
         """JSON-ready description; `shapes.from_dict` reverses it."""
 
 
-@dataclass(frozen=True)
 class BodyRaster:
     """A shape on the lattice (docs/algorithm.md, 'Links cut by the body').
+
+    Held on `box` (x0, y0, x1, y1), the shape's bounding box grown by a cell and clipped to the
+    grid: every solid node and every cut link lies in it, so a move costs the body's size, not
+    the grid's. `crop(box)` cuts any window from it; `solid` and `q` are the full-grid arrays,
+    built on first use (tests, file export), not on the solver's paths.
 
     solid: bool (ny, nx), nodes inside the body.
     q: (9, ny, nx) float64, cut fraction in (0, 1] of the link from fluid node x along c_i, 0 if uncut.
     window: (x0, y0, x1, y1) half-open index box containing every solid node and cut link.
     """
 
-    solid: np.ndarray
-    q: np.ndarray
-    window: tuple[int, int, int, int]
+    def __init__(self, box_solid: np.ndarray, box_q: np.ndarray, box: tuple[int, int, int, int],
+                 grid: tuple[int, int], window: tuple[int, int, int, int]):
+        self.box_solid, self.box_q = box_solid, box_q
+        self.box, self.grid, self.window = tuple(box), tuple(grid), tuple(window)
+        self._full = None
+
+    def crop(self, box) -> tuple[np.ndarray, np.ndarray]:
+        """(solid (h, w) bool, q (9, h, w) float64) over box (x0, y0, x1, y1), zero outside `box`."""
+        x0, y0, x1, y1 = box
+        solid = np.zeros((y1 - y0, x1 - x0), dtype=bool)
+        q = np.zeros((self.box_q.shape[0], y1 - y0, x1 - x0), dtype=np.float64)
+        bx0, by0, bx1, by1 = self.box
+        ox0, oy0, ox1, oy1 = max(x0, bx0), max(y0, by0), min(x1, bx1), min(y1, by1)
+        if ox0 < ox1 and oy0 < oy1:
+            dst = (slice(oy0 - y0, oy1 - y0), slice(ox0 - x0, ox1 - x0))
+            src = (slice(oy0 - by0, oy1 - by0), slice(ox0 - bx0, ox1 - bx0))
+            solid[dst] = self.box_solid[src]
+            q[(slice(None),) + dst] = self.box_q[(slice(None),) + src]
+        return solid, q
+
+    def _full_arrays(self):
+        if self._full is None:
+            nx, ny = self.grid
+            self._full = self.crop((0, 0, nx, ny))
+        return self._full
+
+    @property
+    def solid(self) -> np.ndarray:
+        return self._full_arrays()[0]
+
+    @property
+    def q(self) -> np.ndarray:
+        return self._full_arrays()[1]

@@ -27,14 +27,13 @@ _STENCIL = np.arange(-2, 4)
 
 def rasterise(shape: Shape, nx: int, ny: int, margin: int = 2) -> BodyRaster:
     """Solid mask, cut fractions and window of `shape` on an nx x ny lattice (node (ix, iy) at
-    position (ix, iy)); work is confined to the body's bounding box grown by one cell."""
-    solid = np.zeros((ny, nx), dtype=bool)
-    q = np.zeros((len(LINKS), ny, nx), dtype=np.float64)
+    position (ix, iy)); work and storage are confined to the body's bounding box grown by one
+    cell (BodyRaster.box)."""
     xmin, ymin, xmax, ymax = shape.bounding_box()
     x0, y0 = max(0, math.floor(xmin) - 1), max(0, math.floor(ymin) - 1)
     x1, y1 = min(nx, math.ceil(xmax) + 2), min(ny, math.ceil(ymax) + 2)
     if x0 >= x1 or y0 >= y1:  # entirely outside the lattice
-        return BodyRaster(solid=solid, q=q, window=(0, 0, 0, 0))
+        return BodyRaster(np.zeros((0, 0), bool), np.zeros((len(LINKS), 0, 0)), (0, 0, 0, 0), (nx, ny), (0, 0, 0, 0))
 
     box = (x0, y0, x1, y1)
     if isinstance(shape, PolygonalShape):
@@ -42,9 +41,7 @@ def rasterise(shape: Shape, nx: int, ny: int, margin: int = 2) -> BodyRaster:
     else:
         box_solid, box_q = _generic_box(shape, box)
     _cut_every_link_into_solid(box_solid, box_q)
-    solid[y0:y1, x0:x1] = box_solid
-    q[:, y0:y1, x0:x1] = box_q
-    return BodyRaster(solid=solid, q=q, window=_window(box_solid, box_q, box, nx, ny, margin))
+    return BodyRaster(box_solid, box_q, box, (nx, ny), _window(box_solid, box_q, box, nx, ny, margin))
 
 
 def _generic_box(shape: Shape, box):

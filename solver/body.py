@@ -8,7 +8,7 @@ on it and writes the changed nodes back.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -144,10 +144,9 @@ def move_body(old, new, config, read_window, write_nodes):
     if box is None:
         return 0.0, 0.0
     x0, y0, x1, y1 = expand_box(box, 1, config.nx, config.ny)
-    ys, xs = slice(y0, y1), slice(x0, x1)
     shape = (y1 - y0, x1 - x0)
-    old_solid = old.solid[ys, xs] if old else np.zeros(shape, bool)
-    new_solid = new.solid[ys, xs] if new else np.zeros(shape, bool)
+    old_solid = old.raster.crop((x0, y0, x1, y1))[0] if old else np.zeros(shape, bool)
+    new_solid = new.raster.crop((x0, y0, x1, y1))[0] if new else np.zeros(shape, bool)
     motion = new if new is not None else old
     f = read_window(x0, y0, x1, y1)
     impulse, changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0,
@@ -161,7 +160,8 @@ class BodyState:
     """The body on the grid: shape at its pose, capped motion, raster, windows and links.
 
     window: (x0, y0, x1, y1) force window (raster window + margin, clipped to the domain);
-    links: the Bouzidi body links of that window; solid_nodes: (ny_idx, nx_idx) of solid nodes.
+    links: the Bouzidi body links of that window. `solid` is the full-grid mask (built on first
+    use: for tests and the window's overlays, not the solver's per-move paths).
     """
 
     shape: object
@@ -171,6 +171,7 @@ class BodyState:
     raster: object
     window: tuple[int, int, int, int]
     links: BodyLinks
+    _window_arrays: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
     def solid(self) -> np.ndarray:
@@ -181,9 +182,10 @@ class BodyState:
         return slice(y0, y1), slice(x0, x1)
 
     def window_arrays(self):
-        """(solid, q) cut to the force window."""
-        ys, xs = self.window_slices()
-        return self.raster.solid[ys, xs], self.raster.q[:, ys, xs]
+        """(solid, q) cut to the force window (computed once per body state)."""
+        if self._window_arrays is None:
+            self._window_arrays = self.raster.crop(self.window)
+        return self._window_arrays
 
 
 def make_body_state(shape, velocity, omega, config, margin: int, raster=None) -> BodyState:
@@ -197,10 +199,12 @@ def make_body_state(shape, velocity, omega, config, margin: int, raster=None) ->
     if raster is None:
         raster = rasterise(shape, nx, ny, 0)
     window = expand_box(raster.window, margin, nx, ny)
-    x0, y0, x1, y1 = window
-    links = build_links(raster.q[:, y0:y1, x0:x1], raster.solid[y0:y1, x0:x1], x0, y0,
-                        (shape.x, shape.y), vel, om, wrap=periodic_wrap(config, window))
-    return BodyState(shape, vel, om, capped, raster, window, links)
+    x0, y0 = window[:2]
+    solid, q = raster.crop(window)
+    links = build_links(q, solid, x0, y0, (shape.x, shape.y), vel, om, wrap=periodic_wrap(config, window))
+    state = BodyState(shape, vel, om, capped, raster, window, links)
+    state._window_arrays = (solid, q)
+    return state
 
 
 def shifted(f: np.ndarray) -> np.ndarray:

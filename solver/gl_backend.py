@@ -104,7 +104,8 @@ def _triangles(rects) -> np.ndarray:
 
 
 def node_mask(solid: np.ndarray, q: np.ndarray, box, links=None, window=None) -> np.ndarray:
-    """The shader's node mask over box (x0, y0, x1, y1), uint32 (h, w), from full-grid arrays.
+    """The shader's node mask over box (x0, y0, x1, y1), uint32 (h, w), from `solid` (h, w) and
+    `q` (9, h, w) cut to that box (BodyRaster.crop).
 
     bit 0: solid; bit i (1..8): q[OPP[i], x] > 0 (rule 1a for f_i^in); bit 8+i: the link takes
     the two-node interpolation (q < 1/2 and a fluid second node x + c_i): set from the body's
@@ -113,10 +114,9 @@ def node_mask(solid: np.ndarray, q: np.ndarray, box, links=None, window=None) ->
     population as streamed, which wraps there).
     """
     x0, y0, x1, y1 = box
-    sl = (slice(y0, y1), slice(x0, x1))
-    mask = solid[sl].astype(np.uint32)
+    mask = solid.astype(np.uint32)
     for i in range(1, Q):
-        cut = (q[OPP[i]][sl] > 0) & ~solid[sl]
+        cut = (q[OPP[i]] > 0) & ~solid
         mask |= cut.astype(np.uint32) << np.uint32(i)
     if links is not None and len(links):
         two = links.b != 0
@@ -692,8 +692,9 @@ class GLSolver(Solver):
             mask = np.zeros((h, w), np.uint32)
             q = np.zeros((Q, h, w), np.float32)
         else:
-            mask = node_mask(body.raster.solid, body.raster.q, box, body.links, body.window)
-            q = body.raster.q[:, y0:y1, x0:x1].astype(np.float32)
+            solid, q = body.raster.crop(box)
+            mask = node_mask(solid, q, box, body.links, body.window)
+            q = q.astype(np.float32)
         viewport = (x0, y0, w, h)
         self._mask_tex.write(np.ascontiguousarray(mask).tobytes(), viewport=viewport)
         self._qa_tex.write(np.ascontiguousarray(np.moveaxis(q[1:5], 0, -1)).tobytes(), viewport=viewport)

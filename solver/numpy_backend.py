@@ -115,7 +115,7 @@ class NumpySolver(Solver):
         self.body = new
         if new is not None:
             wx0, wy0, wx1, wy1 = new.raster.window  # holds every solid node
-            sy, sx = np.nonzero(new.solid[wy0:wy1, wx0:wx1])
+            sy, sx = np.nonzero(new.raster.crop((wx0, wy0, wx1, wy1))[0])
             sy, sx = sy + wy0, sx + wx0
             self._solid_idx = (sy, sx)
             self._solid_g = self.g[:, sy, sx].copy()

@@ -98,7 +98,7 @@ def test_body_upload_touches_only_the_window(request):
     inside = np.zeros((32, 64), bool)
     inside[y0:y1, x0:x1] = True
     assert np.all(mask[~inside] == sentinel)  # untouched outside the changed box
-    assert np.array_equal(mask[y0:y1, x0:x1], node_mask(s.body.raster.solid, s.body.raster.q, (x0, y0, x1, y1),
+    assert np.array_equal(mask[y0:y1, x0:x1], node_mask(*s.body.raster.crop((x0, y0, x1, y1)), (x0, y0, x1, y1),
                                                           s.body.links, s.body.window))
     assert np.array_equal((mask[y0:y1, x0:x1] & 1).astype(bool), s.body.raster.solid[y0:y1, x0:x1])
     s.set_body(None)
