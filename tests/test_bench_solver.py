@@ -1,6 +1,6 @@
 """`feelflow bench --variants`: the ratios it takes within each interleaved round
 (app/commands/bench_solver.py `against_numpy`)."""
-from app.commands.bench_solver import BOX, DEFAULT_TUNNEL, NUMPY_TUNNEL, against_numpy
+from app.commands.bench_solver import BOX, DEFAULT_TUNNEL, NO_BODY_ONE_CALL, NUMPY_TUNNEL, STAIRCASE, against_numpy
 
 
 def test_ratios_are_taken_within_each_round_not_between_the_best_figures():
@@ -12,3 +12,13 @@ def test_ratios_are_taken_within_each_round_not_between_the_best_figures():
     assert ceiling["samples"] == [1.8, 2.4, 2.5] and ceiling["median"] == 2.4
     # the ratio of the best figures (40 / 50 = 0.8) would hide round 2's 1.2
     assert tunnel["best"] != max(wall[DEFAULT_TUNNEL]) / max(wall[NUMPY_TUNNEL])
+
+
+def test_the_staircase_prices_each_part_within_each_round():
+    # the tunnel without its body, in the same rounds: its ratio per round, between tunnel and box
+    wall = {NUMPY_TUNNEL: [50.0, 25.0], DEFAULT_TUNNEL: [40.0, 30.0], NO_BODY_ONE_CALL: [70.0, 45.0],
+            BOX: [90.0, 60.0]}
+    out = against_numpy(wall)
+    label = next(lab for lab, name in STAIRCASE if name == NO_BODY_ONE_CALL)
+    assert out[label]["samples"] == [1.4, 1.8]
+    assert list(out) == ["gl tunnel / numpy tunnel", label, "ceiling: gl box / numpy tunnel"]  # runs not there are left out

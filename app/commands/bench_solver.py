@@ -188,6 +188,14 @@ def _format_row(r) -> str:
 #: the runs of `--variants` that `against_numpy` divides
 DEFAULT_TUNNEL = "default: the step's own pass copies it to a band area"
 BOX = "empty periodic box (default)"
+#: the tunnel with parts taken away, each run in one step(n) call a round (no call ends):
+#: against numpy they say what the tunnel would reach if those parts cost nothing
+FIXED_ONE_CALL = "default, cylinder not moved, one step(n) call a round"
+FIXED_NO_FORCE_ONE_CALL = "default, cylinder not moved, no force model, one step(n) call a round"
+NO_BODY_ONE_CALL = "tunnel without a body (edges and sponge only), one step(n) call a round"
+STAIRCASE = (("free moves and call ends (not moved, one call) / numpy", FIXED_ONE_CALL),
+             ("... and no force model / numpy", FIXED_NO_FORCE_ONE_CALL),
+             ("... and no body (edges, sponge) / numpy", NO_BODY_ONE_CALL))
 NUMPY_TUNNEL = "numpy backend, the same moving tunnel (the reference)"
 VARIANTS = {
     "one program for every node (no regions)": {"split": False},
@@ -213,10 +221,19 @@ def against_numpy(wall: dict) -> dict:
     with no walls, inlet, outlet, sponge, body, moves, force model or read-back, so no tunnel
     built on that pass does less work per node. Where box / numpy stays below a target (issue 4:
     2x), no change to the tunnel's boundaries, moves or read-backs reaches it on this machine
-    today; only a faster pass or renderer could."""
+    today; only a faster pass or renderer could.
+
+    Between the two, where those runs are there (STAIRCASE), the tunnel with parts taken away:
+    the cylinder not moved and all steps in one call (what a design with moves and read-backs
+    that never drain llvmpipe's queue could reach at best), then also without a force model,
+    then without the body: each ratio bounds what the tunnel reaches if what is taken away
+    cost nothing, so the steps between them price each part against the target."""
     ref = wall[NUMPY_TUNNEL]
     out = {}
-    for label, name in (("gl tunnel / numpy tunnel", DEFAULT_TUNNEL), ("ceiling: gl box / numpy tunnel", BOX)):
+    pairs = (("gl tunnel / numpy tunnel", DEFAULT_TUNNEL),) + STAIRCASE + (("ceiling: gl box / numpy tunnel", BOX),)
+    for label, name in pairs:
+        if name not in wall:
+            continue
         ratios = [round(g / n, 3) for g, n in zip(wall[name], ref)]
         out[label] = _stats(ratios)
     return out
@@ -249,8 +266,15 @@ def run_variants(quick: bool, seconds: float | None):
     runs["default, no force model (no window readback)"] = no_force
     runs["default, cylinder not moved, step(10) calls"] = SceneRun(
         "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False)
-    runs["default, cylinder not moved, one step(n) call a round"] = SceneRun(
+    runs[FIXED_ONE_CALL] = SceneRun(
         "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False, call_steps=None)
+    runs[FIXED_NO_FORCE_ONE_CALL] = SceneRun(
+        "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False, call_steps=None)
+    runs[FIXED_NO_FORCE_ONE_CALL].solver.enable_force_models([])
+    runs[NO_BODY_ONE_CALL] = SceneRun(
+        "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False, call_steps=None)
+    runs[NO_BODY_ONE_CALL].solver.enable_force_models([])
+    runs[NO_BODY_ONE_CALL].solver.set_body(None)
     runs[BOX] = SceneRun("box", GLSolver(scene_config("box", nx, ny), ctx=ctx))
     runs[NUMPY_TUNNEL] = SceneRun("tunnel", create_solver("numpy", scene_config("tunnel", nx, ny)))
     wall = {name: [] for name in runs}
@@ -361,15 +385,15 @@ def main(args) -> int:
     elif getattr(args, "variants", False):
         result = run_variants(quick, seconds)
         print(f"gl tuning variants, moving-cylinder tunnel {result['grid']}, {result['renderer']}")
-        print(f"  {'variant':62s} {'MLUPS (wall) best/median':>26s} {'per CPU-s best/median':>24s}")
+        print(f"  {'variant':72s} {'MLUPS (wall) best/median':>26s} {'per CPU-s best/median':>24s}")
         for name, v in result["variants"].items():
             w, c = v["wall"], v["per_cpu_s"]
-            print(f"  {name:62s} {w['best']:12.1f} {w['median']:9.1f} {c['best']:14.1f} {c['median']:9.1f}")
+            print(f"  {name:72s} {w['best']:12.1f} {w['median']:9.1f} {c['best']:14.1f} {c['median']:9.1f}")
         for label, v in result["against_numpy"].items():
-            print(f"  {label:62s} {v['best']:11.2f}x {v['median']:8.2f}x   (ratios within each round)")
+            print(f"  {label:72s} {v['best']:11.2f}x {v['median']:8.2f}x   (ratios within each round)")
         print("  step variant drawn over the whole grid (MLUPS per CPU-s, best/median):")
         for name, v in result["step_variants_full_grid_mlups_per_cpu_s"].items():
-            print(f"    {name:60s} {v['best']:12.1f} {v['median']:9.1f}")
+            print(f"    {name:70s} {v['best']:12.1f} {v['median']:9.1f}")
         print("  llvmpipe settings, default moving tunnel in a fresh process (MLUPS wall, per CPU-s, renderer):")
         for knob, m in result["llvmpipe_knobs"].items():
             print(f"    {knob:28s} " + (f"{m['mlups']:8.1f} {m['mlups_per_cpu_s']:8.1f}  {m['renderer']}"
