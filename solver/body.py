@@ -63,8 +63,12 @@ def _neighbour_sum(field: np.ndarray, wrap: tuple[bool, bool] = (False, False)) 
     """Sum of a (h, w) field over the 8 lattice neighbours: zero outside the window, except
     across a periodic direction the window spans whole (`wrap`, x and y: periodic_wrap)."""
     h, w = field.shape
-    pad = np.pad(field, ((0, 0), (1, 1)), mode="wrap" if wrap[0] else "constant")
-    pad = np.pad(pad, ((1, 1), (0, 0)), mode="wrap" if wrap[1] else "constant")
+    pad = np.zeros((h + 2, w + 2), dtype=field.dtype)  # as np.pad: x (wrap or zero), then y, corners included
+    pad[1:-1, 1:-1] = field
+    if wrap[0]:
+        pad[1:-1, 0], pad[1:-1, -1] = field[:, -1], field[:, 0]
+    if wrap[1]:
+        pad[0], pad[-1] = pad[-2], pad[1]
     out = np.zeros((h, w), dtype=pad.dtype)
     for k in range(1, Q):
         cx, cy = int(C[k, 0]), int(C[k, 1])
