@@ -2,14 +2,15 @@
 
     python -m solver.validation.st2d2_diagnose record --d 20 [--u 0.075] [--ramp-periods 2 | --impulsive]
         [--sponge CELLS [--absorb A]] [--length-d 22] [--conv-times 60] [--sample 2]
-        [--collision trt|bgk] [--magic 0.1875] [--stress] --out series.npz
+        [--collision trt|bgk] [--magic 0.1875] [--stress] [--backend numpy|gl] --out series.npz
     python -m solver.validation.st2d2_diagnose analyse series.npz [...]
 
 `analyse` folds the last three shedding periods (upward zero crossings of C_L) into a
 period-averaged signal and prints: per-period C_D maxima, mean C_D, C_D,max and C_L,max of the
 raw and the period-averaged signal, the rms of C_D around the period-averaged signal (what does
 not repeat: sound), and the strongest lines of the C_D spectrum in units of the shedding
-frequency. Run from the repository root (numpy backend).
+frequency. Run from the repository root (numpy backend; `--backend gl` runs the fragment-shader
+backend, float32, on an EGL standalone context, several times faster on this machine).
 
 `--stress` also records C_D from a second, independent force evaluation of the same flow: the
 pressure (lattice equation of state, `solver.forces.pressure`) plus the viscous stress
@@ -36,7 +37,13 @@ def record(a) -> None:
     geo.nx = int(round(a.length_d * a.d))
     over = dict(sponge_cells=a.sponge, sponge_strength=10.0, sponge_absorb=a.absorb) if a.sponge else {}
     over.update(collision=a.collision, trt_magic=a.magic)
-    factory = lambda c: create_solver("numpy", c)  # noqa: E731
+    if a.backend == "gl":  # a diagnostic: the CLI's one-line EGL error handling is app's (solver may not import it)
+        import moderngl
+
+        ctx = moderngl.create_context(standalone=True, backend="egl", require=330)
+        factory = lambda c: create_solver("gl", c, ctx=ctx)  # noqa: E731
+    else:
+        factory = lambda c: create_solver("numpy", c)  # noqa: E731
     if a.impulsive:
         solver = geo.start(factory, **over)
     else:
@@ -106,6 +113,7 @@ def main() -> None:
     r.add_argument("--magic", type=float, default=3.0 / 16.0, help="TRT magic parameter Lambda")
     r.add_argument("--stress", action="store_true",
                    help="also record C_D from pressure + viscous stress integration (slower)")
+    r.add_argument("--backend", choices=("numpy", "gl"), default="numpy")
     r.add_argument("--out", required=True)
     an = sub.add_parser("analyse")
     an.add_argument("paths", nargs="+")
