@@ -184,3 +184,21 @@ def test_random_polygons_agree_with_exact_tests(seed):
     test_solid_mask_equals_contains_at_nodes(shape)
     test_q_equals_exact_segment_test_on_every_fluid_node(shape)
     test_lattice_invariants(shape)
+
+
+@pytest.mark.parametrize("shape", [SHAPES[0], SHAPES[5], SHAPES[11]])
+def test_raster_is_held_on_the_body_box_and_crops_like_the_full_grid(shape):
+    """A move costs the body's size, not the grid's: the raster keeps its bounding box (grown by a
+    cell) only, and crop() of any window, inside, across or outside that box, equals the slice of
+    the full-grid arrays (zero where the box does not reach)."""
+    nx, ny = 400, 300
+    r = rasterise(shape, nx, ny)
+    x0, y0, x1, y1 = r.box
+    assert (x1 - x0) * (y1 - y0) < 40 * 40 and r.box_q.shape == (9, y1 - y0, x1 - x0)
+    for win in [r.window, (0, 0, nx, ny), (x0 - 3, y0 + 2, x1 - 4, y1 + 5), (x1 + 1, y1 + 1, x1 + 9, y1 + 4)]:
+        wx0, wy0, wx1, wy1 = max(0, win[0]), max(0, win[1]), min(nx, win[2]), min(ny, win[3])
+        solid, q = r.crop((wx0, wy0, wx1, wy1))
+        assert np.array_equal(solid, r.solid[wy0:wy1, wx0:wx1])
+        assert np.array_equal(q, r.q[:, wy0:wy1, wx0:wx1])
+    assert r.solid.shape == (ny, nx) and r.q.shape == (9, ny, nx)
+    assert r.solid.sum() == r.box_solid.sum() and np.count_nonzero(r.q) == np.count_nonzero(r.box_q)
