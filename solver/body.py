@@ -8,7 +8,7 @@ on it and writes the changed nodes back.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -164,8 +164,8 @@ class BodyState:
     """The body on the grid: shape at its pose, capped motion, raster, windows and links.
 
     window: (x0, y0, x1, y1) force window (raster window + margin, clipped to the domain);
-    links: the Bouzidi body links of that window. `solid` is the full-grid mask (built on first
-    use: for tests and the window's overlays, not the solver's per-move paths).
+    links: the Bouzidi body links of that window; window_solid_q: (solid, q) cut to that window.
+    `solid` is the full-grid mask (built on first use: for tests, not the solver's paths).
     """
 
     shape: object
@@ -175,7 +175,7 @@ class BodyState:
     raster: object
     window: tuple[int, int, int, int]
     links: BodyLinks
-    _window_arrays: tuple | None = field(default=None, repr=False, compare=False)
+    window_solid_q: tuple
 
     @property
     def solid(self) -> np.ndarray:
@@ -186,10 +186,8 @@ class BodyState:
         return slice(y0, y1), slice(x0, x1)
 
     def window_arrays(self):
-        """(solid, q) cut to the force window (computed once per body state)."""
-        if self._window_arrays is None:
-            self._window_arrays = self.raster.crop(self.window)
-        return self._window_arrays
+        """(solid, q) cut to the force window."""
+        return self.window_solid_q
 
 
 def make_body_state(shape, velocity, omega, config, margin: int, raster=None) -> BodyState:
@@ -206,9 +204,7 @@ def make_body_state(shape, velocity, omega, config, margin: int, raster=None) ->
     x0, y0 = window[:2]
     solid, q = raster.crop(window)
     links = build_links(q, solid, x0, y0, (shape.x, shape.y), vel, om, wrap=periodic_wrap(config, window))
-    state = BodyState(shape, vel, om, capped, raster, window, links)
-    state._window_arrays = (solid, q)
-    return state
+    return BodyState(shape, vel, om, capped, raster, window, links, (solid, q))
 
 
 def shifted(f: np.ndarray) -> np.ndarray:

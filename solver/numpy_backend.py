@@ -114,9 +114,9 @@ class NumpySolver(Solver):
         self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         self.body = new
         if new is not None:
-            wx0, wy0, wx1, wy1 = new.raster.window  # holds every solid node
-            sy, sx = np.nonzero(new.raster.crop((wx0, wy0, wx1, wy1))[0])
-            sy, sx = sy + wy0, sx + wx0
+            bx0, by0 = new.raster.box[:2]  # the raster's box holds every solid node
+            sy, sx = np.nonzero(new.raster.box_solid)
+            sy, sx = sy + by0, sx + bx0
             self._solid_idx = (sy, sx)
             self._solid_g = self.g[:, sy, sx].copy()
             self.speed_capped = new.capped or self.inflow_capped

@@ -266,15 +266,14 @@ def run_variants(quick: bool, seconds: float | None):
     runs["default, no force model (no window readback)"] = no_force
     runs["default, cylinder not moved, step(10) calls"] = SceneRun(
         "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False)
-    runs[FIXED_ONE_CALL] = SceneRun(
-        "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False, call_steps=None)
-    runs[FIXED_NO_FORCE_ONE_CALL] = SceneRun(
-        "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False, call_steps=None)
-    runs[FIXED_NO_FORCE_ONE_CALL].solver.enable_force_models([])
-    runs[NO_BODY_ONE_CALL] = SceneRun(
-        "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False, call_steps=None)
-    runs[NO_BODY_ONE_CALL].solver.enable_force_models([])
-    runs[NO_BODY_ONE_CALL].solver.set_body(None)
+    for name, forces, body in ((FIXED_ONE_CALL, True, True), (FIXED_NO_FORCE_ONE_CALL, False, True),
+                               (NO_BODY_ONE_CALL, False, False)):
+        run = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False, call_steps=None)
+        if not forces:
+            run.solver.enable_force_models([])
+        if not body:
+            run.solver.set_body(None)
+        runs[name] = run
     runs[BOX] = SceneRun("box", GLSolver(scene_config("box", nx, ny), ctx=ctx))
     runs[NUMPY_TUNNEL] = SceneRun("tunnel", create_solver("numpy", scene_config("tunnel", nx, ny)))
     wall = {name: [] for name in runs}
