@@ -134,6 +134,10 @@ class GLSolver(Solver):
     #: default tuning (docs/performance.md measures each choice)
     TUNING = {"split": True, "divergence": "tiles", "check_every": CHECK_EVERY, "window": "state",
               "draw": "scissor"}
+    #: called once per block of steps after its draws are queued and before its results are
+    #: read back (llvmpipe still busy with the queued steps); None in normal use. `feelflow bench
+    #: --variants` puts CPU work there to measure what overlapping it with the GPU gains.
+    before_read = None
 
     def __init__(self, config, ctx=None, tuning: dict | None = None):
         super().__init__(config)
@@ -416,6 +420,8 @@ class GLSolver(Solver):
                 elif with_forces:
                     self._queue_checks(band, src, tiles=False)
             self._queue_checks(0, None, tiles=not self._discard)
+            if self.before_read is not None:
+                self.before_read()
             try:
                 windows = self._resolve_checks(t0, k, impulses if with_forces and not read_now else None,
                                                others if slots else None)

@@ -22,3 +22,18 @@ def test_the_staircase_prices_each_part_within_each_round():
     label = next(lab for lab, name in STAIRCASE if name == NO_BODY_ONE_CALL)
     assert out[label]["samples"] == [1.4, 1.8]
     assert list(out) == ["gl tunnel / numpy tunnel", label, "ceiling: gl box / numpy tunnel"]  # runs not there are left out
+
+
+def test_cpu_work_cost_is_the_added_time_per_call_within_each_round():
+    from app.commands.bench_solver import (MOVE_EVERY, WORK_AFTER_READ, WORK_BEFORE_READ,
+                                           cpu_work_cost)
+
+    nodes = 100_000  # a call of MOVE_EVERY steps at 50 MLUPS takes 20 ms, at 40 MLUPS 25 ms
+    wall = {DEFAULT_TUNNEL: [50.0, 25.0], WORK_AFTER_READ: [40.0, 20.0], WORK_BEFORE_READ: [50.0, 25.0]}
+    out = cpu_work_cost(wall, nodes)
+    per_call = nodes * MOVE_EVERY / 1e6 * 1e3  # ms per call at 1 MLUPS
+    assert out["after the read"]["samples"] == [round(per_call / 40 - per_call / 50, 3),
+                                                round(per_call / 20 - per_call / 25, 3)]
+    assert out["after the read"]["samples"][0] == 5.0
+    assert out["before the read (GPU busy)"]["samples"] == [0.0, 0.0]  # fully overlapped
+    assert cpu_work_cost({DEFAULT_TUNNEL: [50.0]}, nodes) == {}  # runs not there are left out

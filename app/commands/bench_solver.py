@@ -72,11 +72,12 @@ class SceneRun:
     was placed, and `call_steps` sets how many steps each `step()` call runs (None: all n at
     once) instead of MOVE_EVERY."""
 
-    def __init__(self, scene, solver, moves: bool = True, call_steps: int | None = MOVE_EVERY):
+    def __init__(self, scene, solver, moves: bool = True, call_steps: int | None = MOVE_EVERY,
+                 after_call=None):
         from shapes import Cylinder
 
         self.scene, self.solver = scene, solver
-        self.moves, self.call_steps = moves, call_steps
+        self.moves, self.call_steps, self.after_call = moves, call_steps, after_call
         cfg = solver.config
         self.k = 0
         if scene == "tunnel":
@@ -99,6 +100,8 @@ class SceneRun:
         while done < n:
             chunk = n - done if self.call_steps is None else min(self.call_steps, n - done)
             self.solver.step(chunk)
+            if self.after_call is not None:
+                self.after_call()
             self.k += chunk
             done += chunk
             if self.scene == "tunnel" and self.moves:
@@ -197,6 +200,13 @@ STAIRCASE = (("free moves and call ends (not moved, one call) / numpy", FIXED_ON
              ("... and no force model / numpy", FIXED_NO_FORCE_ONE_CALL),
              ("... and no body (edges, sponge) / numpy", NO_BODY_ONE_CALL))
 NUMPY_TUNNEL = "numpy backend, the same moving tunnel (the reference)"
+#: the premise of a design whose moves and read-backs never drain llvmpipe's queue: CPU work done
+#: while llvmpipe still has steps queued is free. Two runs of the default tunnel add the same
+#: Python busy work to every step(10) call: once after the call's read (llvmpipe idle), once
+#: before it (GLSolver.before_read: llvmpipe busy with the call's last queued steps).
+CPU_WORK_MS = 3.0
+WORK_AFTER_READ = f"default + {CPU_WORK_MS:g} ms of Python per step(10) call, after its read"
+WORK_BEFORE_READ = f"default + {CPU_WORK_MS:g} ms of Python per step(10) call, before its read (GPU busy)"
 VARIANTS = {
     "one program for every node (no regions)": {"split": False},
     "regions, read back every step": {"check_every": 1, "window": "read"},
@@ -239,6 +249,28 @@ def against_numpy(wall: dict) -> dict:
     return out
 
 
+def cpu_work_cost(wall: dict, nodes: int) -> dict:
+    """Per round, the wall milliseconds per step(MOVE_EVERY) call that CPU_WORK_MS of CPU work
+    added to the default tunnel, placed after the call's read and before it (from MLUPS
+    measured in the same round). Overlap gains where 'before' costs less than 'after'."""
+    def per_call_ms(mlups):
+        return nodes * MOVE_EVERY / (mlups * 1e6) * 1e3
+
+    out = {}
+    for label, name in (("after the read", WORK_AFTER_READ), ("before the read (GPU busy)", WORK_BEFORE_READ)):
+        if name in wall and DEFAULT_TUNNEL in wall:
+            added = [round(per_call_ms(w) - per_call_ms(d), 3) for w, d in zip(wall[name], wall[DEFAULT_TUNNEL])]
+            out[label] = {"best": min(added), "median": float(np.median(added)), "samples": added}
+    return out
+
+
+def busy_python(ms: float) -> None:
+    """Keep this thread busy for `ms` of its own CPU time (the CPU work of cpu_work_cost)."""
+    end = time.thread_time() + ms / 1e3
+    while time.thread_time() < end:
+        pass
+
+
 def _stats(values):
     return {"best": max(values), "median": float(np.median(values)), "samples": values}
 
@@ -274,6 +306,10 @@ def run_variants(quick: bool, seconds: float | None):
         if not body:
             run.solver.set_body(None)
         runs[name] = run
+    runs[WORK_AFTER_READ] = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx),
+                                     after_call=lambda: busy_python(CPU_WORK_MS))
+    runs[WORK_BEFORE_READ] = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx))
+    runs[WORK_BEFORE_READ].solver.before_read = lambda: busy_python(CPU_WORK_MS)
     runs[BOX] = SceneRun("box", GLSolver(scene_config("box", nx, ny), ctx=ctx))
     runs[NUMPY_TUNNEL] = SceneRun("tunnel", create_solver("numpy", scene_config("tunnel", nx, ny)))
     wall = {name: [] for name in runs}
@@ -299,6 +335,7 @@ def run_variants(quick: bool, seconds: float | None):
     result = {"grid": f"{nx}x{ny}", "renderer": ctx.info.get("GL_RENDERER"), "machine": machine(),
               "variants": {n: {"wall": _stats(wall[n]), "per_cpu_s": _stats(per_cpu[n])} for n in runs},
               "against_numpy": against_numpy(wall),
+              "cpu_work_ms_per_call": {"work_ms": CPU_WORK_MS, **cpu_work_cost(wall, nx * ny)},
               "step_variants_full_grid_mlups_per_cpu_s": {n: _stats(v) for n, v in cost.items()}}
     result["llvmpipe_knobs"] = {
         f"{var}={value}": _subprocess_tunnel(nx, ny, seconds * rounds, {var: value})
@@ -390,6 +427,11 @@ def main(args) -> int:
             print(f"  {name:72s} {w['best']:12.1f} {w['median']:9.1f} {c['best']:14.1f} {c['median']:9.1f}")
         for label, v in result["against_numpy"].items():
             print(f"  {label:72s} {v['best']:11.2f}x {v['median']:8.2f}x   (ratios within each round)")
+        work = result["cpu_work_ms_per_call"]
+        for label in ("after the read", "before the read (GPU busy)"):
+            if label in work:
+                print(f"  {work['work_ms']:g} ms of Python per step(10) call {label:40s} adds "
+                      f"{work[label]['median']:6.2f} ms a call (median; best {work[label]['best']:.2f})")
         print("  step variant drawn over the whole grid (MLUPS per CPU-s, best/median):")
         for name, v in result["step_variants_full_grid_mlups_per_cpu_s"].items():
             print(f"    {name:70s} {v['best']:12.1f} {v['median']:9.1f}")
