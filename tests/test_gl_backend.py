@@ -129,6 +129,27 @@ def test_blocks_of_steps_give_the_forces_and_state_of_single_steps(gl_context, w
     assert abs(f_block[0]) > 0  # the cylinder feels the flow
 
 
+def test_before_read_runs_once_per_block_while_its_steps_are_still_unread(gl_context):
+    """GLSolver.before_read (the bench's overlap probe, docs/performance.md 'Ninth session') is
+    called once per block of steps, after the block's draws and before its read-back, and
+    changes nothing: the same state and forces as without it."""
+    cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)
+    runs = []
+    for hook in (False, True):
+        s = create_solver("gl", cfg, ctx=gl_context, tuning={"check_every": 8})
+        s.enable_force_models(["momentum_exchange"])
+        s.set_body(Cylinder(6.0, x=20.0, y=16.0))
+        times = []
+        if hook:
+            s.before_read = lambda s=s: times.append(s.time)
+        s.step(20)
+        runs.append((s.forces()["momentum_exchange"], s.distributions()))
+        if hook:
+            assert times == [8, 16, 20]  # the draws of each block queued, none of it read yet
+    (f0, g0), (f1, g1) = runs
+    assert np.array_equal(g0, g1) and f0 == f1
+
+
 def test_window_wider_than_the_band_area_falls_back_to_the_atlas(gl_context):
     """A body window wider than the band area (BAND_WIDTH) takes the atlas path, same numbers."""
     from shapes import FlatPlate
