@@ -42,7 +42,14 @@ API for the app (a QOpenGLWidget sharing this context):
   step, so a NaN never vanishes from the fluid) and the windows and sums are read once. A non-finite sum
   replays the block from its start state, which a third state side keeps, with a check after
   every step: `solver.backend.SolverDiverged` names the exact step, as in the reference; a
-  non-finite body window raises it with the step of that window. (An occlusion query counting
+  non-finite body window raises it with the step of that window.
+- Where the only force models are the momentum exchanges (LINK_SUM_MODELS; tuning
+  forces="gpu", the default), the pass sums their links on the GPU instead of copying the
+  window (`shaders/link_sums.glsl`: one RGBA32F texel of partial sums per window texel), and a
+  block reads back one attachment of the band area instead of five; the sums are the
+  Galilean-invariant and classic momentum exchange of solver/forces/momentum_exchange.py, from
+  the same stored populations and the same Bouzidi rule as the step (forces="window": the
+  window and the models' own code, as for every other model). (An occlusion query counting
   fragments that a non-finite node discards, tuning divergence="discard", halved the step's
   speed on llvmpipe: docs/performance.md.)
 """
@@ -57,7 +64,7 @@ from solver.forces.base import BodyWindow
 from solver.gl_layout import TEXTURES, pack, texel_box, texels, unpack
 from solver.gl_programs import create_program
 from solver.inflow import profile, ramp
-from solver.lattice import C, OPP, Q, RHO0, equilibrium
+from solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 from solver.numpy_backend import absorb_keep, relaxation_rates
 
 #: texture units (fixed; every pass binds all it samples)
@@ -72,6 +79,8 @@ CHECK_EVERY = 32
 #: width in nodes of the band area right of the lattice in each state texture (tuning
 #: window="state"): each step's draw copies the body window of its source state into a slot there
 BAND_WIDTH = 128
+#: force models whose link sums the step's pass computes on the GPU (shaders/link_sums.glsl)
+LINK_SUM_MODELS = frozenset({"momentum_exchange", "momentum_exchange_classic"})
 _Y_MODE = {"no_slip": 0, "free_slip": 1, "periodic": 2}
 
 
@@ -133,7 +142,7 @@ class GLSolver(Solver):
     name = "gl"
     #: default tuning (docs/performance.md measures each choice)
     TUNING = {"split": True, "divergence": "tiles", "check_every": CHECK_EVERY, "window": "state",
-              "draw": "scissor"}
+              "draw": "scissor", "forces": "gpu"}
     #: called once per block of steps after its draws are queued and before its results are
     #: read back (llvmpipe still busy with the queued steps); None in normal use. `feelflow bench
     #: --variants` puts CPU work there to measure what overlapping it with the GPU gains.
@@ -211,6 +220,8 @@ class GLSolver(Solver):
         self._check_every = max(1, min(CHECK_EVERY, int(self.tuning["check_every"])))
         self._window_mode = self.tuning["window"]
         self._band_copy = None  # (vao, vbo, slot layout) of the window copy into the band area
+        self._band_sums = None  # (vao, vbo) of the link sums into the same slots (LINK_SUM_MODELS)
+        self._block_sums = False  # the block being drawn sums links instead of copying windows
         self._pending, self._idle_queries = [], []  # divergence="discard": (step, query)
 
         self._impulse = (0.0, 0.0)
@@ -329,6 +340,10 @@ class GLSolver(Solver):
         for key, prog in self._programs.items():
             if key[0]:
                 self._uniforms(prog, body_velocity=velocity, body_omega=omega, body_centre=centre)
+        if self._band_sums is not None:
+            window = (0, 0, 0, 0) if b is None else tuple(int(v) for v in b.window)
+            self._uniforms(self._band_sums[0].program, body_velocity=velocity, body_omega=omega,
+                           body_centre=centre, window=window)
 
     def _update_inflow(self, t):
         """u_in(iy, t) = ramp(t) profile(iy) (solver/inflow.py): the ramp as a uniform each
@@ -380,6 +395,8 @@ class GLSolver(Solver):
             self._render_regions()
         if slot is not None:
             vao, _, (cols, ww, wh) = self._band_copy
+            if self._block_sums:
+                vao = self._band_sums[0]
             k0, y0 = texel_box(self.body.window)[:2]
             vao.program["shift"].value = (k0 - self._kx - (slot % cols) * ww, y0 - (slot // cols) * wh)
             vao.render(moderngl.TRIANGLES, vertices=6, first=6 * slot)
@@ -405,6 +422,7 @@ class GLSolver(Solver):
                 k = min(k, 2 * slots)
             t0, start, impulses = self.time, self._cur, []
             others = [side for side in range(3) if side != start]
+            self._block_sums = bool(slots) and self._sums_forces()
             read_now = []  # tuning window="read": each window read right after its step is queued
             for band in range(k):
                 impulses.append(self._impulse)
@@ -430,9 +448,9 @@ class GLSolver(Solver):
                 if exc.step == self.time and not self._discard:  # only the final state is known bad
                     self._replay(start, t0, k)
                 raise
-            for win in windows:
-                for name, model in self._models.items():
-                    fx, fy = model.compute(win)
+            for win in windows:  # a BodyWindow, or (block_sums) the step's forces already
+                forces = win if self._block_sums else {name: model.compute(win) for name, model in self._models.items()}
+                for name, (fx, fy) in forces.items():
                     sums[name][0] += fx
                     sums[name][1] += fy
             done += k
@@ -467,7 +485,55 @@ class GLSolver(Solver):
             vbo.orphan(len(data))
             vbo.write(data)
             self._band_copy = (self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")]), vbo, layout)
+        if self._sums_forces() and (self._band_sums is None or self._band_sums[1] is not self._band_copy[1]):
+            if self._band_sums is None:
+                prog = create_program(self.ctx, "rect_vertex.glsl", "link_sums.glsl")
+                self._uniforms(prog, **dict(zip(G_NAMES, UNIT_G)), MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
+                               N=(self.nx, self.ny), grid_size=(float(self._tex_size[0]), float(self.ny)))
+                self._objects.append(prog)
+            else:
+                prog = self._band_sums[0].program
+                self._band_sums[0].release()
+            self._band_sums = (self.ctx.vertex_array(prog, [(self._band_copy[1], "2f", "in_pos")]), self._band_copy[1])
+            self._upload_body_uniforms()
         return cols * rows
+
+    def _sums_forces(self) -> bool:
+        """Whether the enabled force models are all link sums the pass computes (LINK_SUM_MODELS)."""
+        return (self.tuning["forces"] == "gpu" and bool(self._models) and set(self._models) <= LINK_SUM_MODELS
+                and self.body is not None)
+
+    def _band_link_forces(self, sides, bands: int, impulses, t0: int):
+        """Each step's forces {model: (fx, fy)} from its slot of link sums (shaders/link_sums.glsl)
+        in the band areas (step b: slot b // 2 of side sides[b % 2]; attachment 0 only, summed
+        in float64), plus the links' constant K and, for the Galilean-invariant form, the step's
+        cover/uncover impulse. Returns (forces per step, the first step whose sums are not finite
+        or None)."""
+        _, _, (cols, ww, wh) = self._band_copy
+        areas = {}
+        i = self.body.links.i
+        kx, ky = (-2.0 * RHO0 * (W[i, None] * C[i]).sum(axis=0)) if len(i) else (0.0, 0.0)
+        out, bad = [], None
+        for b in range(bands):
+            side, slot = sides[b % 2], b // 2
+            if side not in areas:
+                used = (bands - 1 - b % 2) // 2 + 1  # slots this side holds
+                h = -(-used // cols) * wh
+                data = self._fbo[side].read(viewport=(self._kx, 0, cols * ww, h), components=4, attachment=0, dtype="f4")
+                areas[side] = np.frombuffer(data, dtype="f4").reshape(h, cols * ww, 4)
+            c, r = slot % cols, slot // cols
+            s = areas[side][r * wh:(r + 1) * wh, c * ww:(c + 1) * ww].sum(axis=(0, 1), dtype=np.float64)
+            if not np.all(np.isfinite(s)):
+                bad = t0 + b
+                break
+            forces = {}
+            if "momentum_exchange" in self._models:
+                forces["momentum_exchange"] = (float(s[0] + s[2] + kx + impulses[b][0]),
+                                               float(s[1] + s[3] + ky + impulses[b][1]))
+            if "momentum_exchange_classic" in self._models:
+                forces["momentum_exchange_classic"] = (float(s[0] + kx), float(s[1] + ky))
+            out.append(forces)
+        return out, bad
 
     def _band_windows(self, sides, bands: int) -> list[np.ndarray]:
         """The stored g (9, h, w) of each step's body window from the band areas: step b's
@@ -637,7 +703,12 @@ class GLSolver(Solver):
         elif not self._tiles_finite(0):
             bad.append((self.time, "density is no longer finite"))
         windows = []
-        if impulses and band_sides is not None:
+        if impulses and band_sides is not None and self._block_sums:
+            windows, step = self._band_link_forces(band_sides, bands, impulses, t0)
+            if step is not None:
+                bad.append((step, "non-finite populations around the body"))
+            impulses = None  # the forces are done
+        elif impulses and band_sides is not None:
             step_windows = self._band_windows(band_sides, bands)
         elif impulses:
             g = unpack([np.frombuffer(self._atlas["fbo"].read(viewport=(tw, 0, ww, height), components=4,
@@ -787,6 +858,9 @@ class GLSolver(Solver):
             for obj in self._atlas["objects"]:
                 obj.release()
         self._atlas, self._check_progs = None, None
+        if self._band_sums is not None:
+            self._band_sums[0].release()
+            self._band_sums = None
         if self._band_copy is not None:
             self._band_copy[0].release()
             self._band_copy[1].release()

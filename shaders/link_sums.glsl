@@ -1,0 +1,78 @@
+#version 330 core
+// The momentum exchange's link sums of one step on the GPU (docs/algorithm.md 'Forces'; Wen,
+// Zhang, Tu, Wang & Fang 2014; Ladd 1994), drawn by the step's own pass into a slot of the band
+// area (as copy_window.glsl would copy the window there), so that a block reads back one RGBA32F
+// texel per window texel instead of the window's five.
+//
+// Each fragment takes the two nodes x of one texel of the body's force window and sums, over
+// their cut links (x, ib) (bits of MASK, as lbm_step.glsl rule a), from the stored
+// post-collision populations g* = f* - w RHO0 of the step's source state:
+//   S1 = sum -c_i (g*_ib(x) + g_i^in(x)),   S2 = sum -u_w (g*_ib(x) - g_i^in(x)),
+// with g_i^in(x) from the same Bouzidi rule, moving-wall term included, as lbm_step.glsl.
+// The backend sums the texels in float64 and adds the links' constant K = -2 RHO0 sum w_i c_i
+// and the cover/uncover impulse J: Galilean-invariant F = S1 + S2 + K + J, classic F = S1 + K,
+// the numbers solver/forces/momentum_exchange.py computes from the window (f = g + w RHO0).
+// @LATTICE
+// @INCLUDE paired_layout.glsl
+
+uniform usampler2D MASK;       // lbm_step.glsl: bit 0 solid; bit i link cut; bit 8+i two-node rule
+uniform sampler2D QA;          // q[1..4, x]
+uniform sampler2D QB;          // q[5..8, x]
+uniform vec2 body_velocity;    // V
+uniform float body_omega;      // Omega, radians per step, counter-clockwise
+uniform vec2 body_centre;      // X
+uniform ivec2 N;               // (nx, ny) in nodes
+uniform ivec4 window;          // the force window (x0, y0, x1, y1) in nodes
+uniform ivec2 shift;           // state texel = target texel + shift
+
+layout(location = 0) out vec4 sums;  // (S1.x, S1.y, S2.x, S2.y) of this texel's two nodes
+
+ivec2 wrap(ivec2 p) {
+    return ivec2((p.x + N.x) % N.x, (p.y + N.y) % N.y);
+}
+
+vec2 wall_velocity(vec2 xw) {  // rigid-body velocity at xw, as lbm_step.glsl
+    vec2 r = xw - body_centre;
+    return body_velocity + body_omega * vec2(-r.y, r.x);
+}
+
+void add_node(ivec2 x, inout vec2 s1, inout vec2 s2) {
+    if (x.x < window.x || x.x >= window.z) return;
+    uint m = texelFetch(MASK, x, 0).r;
+    if ((m & 1u) != 0u || (m & 0x1FEu) == 0u) return;  // solid, or no cut link
+    float own[9];
+    load_node(x, own);
+    vec4 qa = texelFetch(QA, x, 0);
+    vec4 qb = texelFetch(QB, x, 0);
+    float qs[9] = float[9](0.0, qa.x, qa.y, qa.z, qa.w, qb.x, qb.y, qb.z, qb.w);
+    for (int i = 1; i < Q; ++i) {
+        if ((m & (1u << uint(i))) == 0u) continue;
+        int ib = OPP[i];
+        ivec2 ci = C[i];
+        float q = qs[ib];
+        vec2 uw = wall_velocity(vec2(x) + q * vec2(C[ib]));
+        float cu = dot(vec2(ci), uw);
+        float gin;
+        if (q >= 0.5)
+            gin = 1.0 / (2.0 * q) * own[ib] + (2.0 * q - 1.0) / (2.0 * q) * own[i]
+                  + 3.0 / q * W[i] * RHO0 * cu;
+        else if ((m & (1u << uint(8 + i))) != 0u)
+            gin = 2.0 * q * own[ib] + (1.0 - 2.0 * q) * pop(ib, wrap(x + ci)) + 6.0 * W[i] * RHO0 * cu;
+        else
+            gin = own[ib] + 6.0 * W[i] * RHO0 * cu;
+        float gout = own[ib];
+        s1 -= vec2(ci) * (gout + gin);
+        s2 -= uw * (gout - gin);
+    }
+}
+
+void main() {
+    ivec2 k = ivec2(gl_FragCoord.xy) + shift;  // the state texel
+    vec2 s1 = vec2(0.0);
+    vec2 s2 = vec2(0.0);
+    if (k.y >= window.y && k.y < window.w) {
+        add_node(ivec2(2 * k.x, k.y), s1, s2);
+        add_node(ivec2(2 * k.x + 1, k.y), s1, s2);
+    }
+    sums = vec4(s1, s2);
+}
