@@ -1,10 +1,12 @@
 #version 330 core
 // The momentum exchange's link sums of one step on the GPU (docs/algorithm.md 'Forces'; Wen,
 // Zhang, Tu, Wang & Fang 2014; Ladd 1994), drawn by the step's own pass into a slot of the band
-// area (as copy_window.glsl would copy the window there), so that a block reads back one RGBA32F
-// texel per window texel instead of the window's five.
+// area: one RGBA32F texel per state texel with a cut link, so that a block reads back those few
+// texels instead of the window's five attachments. The state texels with links are listed in
+// LINK_TEXELS, packed row by row; one rectangle covers the list (llvmpipe pays per primitive:
+// a point per texel cost the step about 10 %, the rectangle next to nothing).
 //
-// Each fragment takes the two nodes x of one texel of the body's force window and sums, over
+// Each fragment takes the two nodes x of one listed state texel and sums, over
 // their cut links (x, ib) (bits of MASK, as lbm_step.glsl rule a), from the stored
 // post-collision populations g* = f* - w RHO0 of the step's source state:
 //   S1 = sum -c_i (g*_ib(x) + g_i^in(x)),   S2 = sum -u_w (g*_ib(x) - g_i^in(x)),
@@ -23,7 +25,8 @@ uniform float body_omega;      // Omega, radians per step, counter-clockwise
 uniform vec2 body_centre;      // X
 uniform ivec2 N;               // (nx, ny) in nodes
 uniform ivec4 window;          // the force window (x0, y0, x1, y1) in nodes
-uniform ivec2 shift;           // state texel = target texel + shift
+uniform sampler2D LINK_TEXELS;  // (k, y, 1, 0): the state texels with links; (0, 0, 0, 0) past the list
+uniform ivec2 slot_origin;     // the slot's lower-left texel in the target
 
 layout(location = 0) out vec4 sums;  // (S1.x, S1.y, S2.x, S2.y) of this texel's two nodes
 
@@ -67,10 +70,11 @@ void add_node(ivec2 x, inout vec2 s1, inout vec2 s2) {
 }
 
 void main() {
-    ivec2 k = ivec2(gl_FragCoord.xy) + shift;  // the state texel
+    vec4 entry = texelFetch(LINK_TEXELS, ivec2(gl_FragCoord.xy) - slot_origin, 0);
+    ivec2 k = ivec2(entry.xy);
     vec2 s1 = vec2(0.0);
     vec2 s2 = vec2(0.0);
-    if (k.y >= window.y && k.y < window.w) {
+    if (entry.z > 0.5 && k.y >= window.y && k.y < window.w) {
         add_node(ivec2(2 * k.x, k.y), s1, s2);
         add_node(ivec2(2 * k.x + 1, k.y), s1, s2);
     }

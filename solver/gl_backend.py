@@ -69,7 +69,7 @@ from solver.numpy_backend import absorb_keep, relaxation_rates
 
 #: texture units (fixed; every pass binds all it samples)
 UNIT_G = tuple(range(TEXTURES))
-UNIT_MASK, UNIT_QA, UNIT_QB, UNIT_INFLOW, UNIT_OMEGA = 5, 6, 7, 8, 9
+UNIT_MASK, UNIT_QA, UNIT_QB, UNIT_INFLOW, UNIT_OMEGA, UNIT_LINKS = 5, 6, 7, 8, 9, 10
 #: sampler uniforms of the population textures
 G_NAMES = tuple(f"G{t}" for t in range(TEXTURES))
 #: region rectangles are aligned to llvmpipe's 4x4 shading blocks
@@ -220,7 +220,7 @@ class GLSolver(Solver):
         self._check_every = max(1, min(CHECK_EVERY, int(self.tuning["check_every"])))
         self._window_mode = self.tuning["window"]
         self._band_copy = None  # (vao, vbo, slot layout) of the window copy into the band area
-        self._band_sums = None  # (vao, vbo) of the link sums into the same slots (LINK_SUM_MODELS)
+        self._band_sums = None  # (vao, vbo, n, texels, body, list texture, slot layout) of the link sums
         self._block_sums = False  # the block being drawn sums links instead of copying windows
         self._pending, self._idle_queries = [], []  # divergence="discard": (step, query)
 
@@ -395,11 +395,17 @@ class GLSolver(Solver):
             self._render_regions()
         if slot is not None:
             vao, _, (cols, ww, wh) = self._band_copy
-            if self._block_sums:
-                vao = self._band_sums[0]
             k0, y0 = texel_box(self.body.window)[:2]
-            vao.program["shift"].value = (k0 - self._kx - (slot % cols) * ww, y0 - (slot // cols) * wh)
-            vao.render(moderngl.TRIANGLES, vertices=6, first=6 * slot)
+            shift = (k0 - self._kx - (slot % cols) * ww, y0 - (slot // cols) * wh)
+            if self._block_sums:  # the link texels' list (_build_link_points)
+                vao, _, n = self._band_sums[:3]
+                if n:
+                    self._band_sums[5].use(location=UNIT_LINKS)
+                    vao.program["slot_origin"].value = (self._kx + (slot % cols) * ww, (slot // cols) * wh)
+                    vao.render(moderngl.TRIANGLES, vertices=6, first=6 * slot)
+            else:
+                vao.program["shift"].value = shift
+                vao.render(moderngl.TRIANGLES, vertices=6, first=6 * slot)
         self._cur = dst
         self.time += 1
         if self._discard:
@@ -485,18 +491,45 @@ class GLSolver(Solver):
             vbo.orphan(len(data))
             vbo.write(data)
             self._band_copy = (self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")]), vbo, layout)
-        if self._sums_forces() and (self._band_sums is None or self._band_sums[1] is not self._band_copy[1]):
-            if self._band_sums is None:
-                prog = create_program(self.ctx, "rect_vertex.glsl", "link_sums.glsl")
-                self._uniforms(prog, **dict(zip(G_NAMES, UNIT_G)), MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
-                               N=(self.nx, self.ny), grid_size=(float(self._tex_size[0]), float(self.ny)))
-                self._objects.append(prog)
-            else:
-                prog = self._band_sums[0].program
-                self._band_sums[0].release()
-            self._band_sums = (self.ctx.vertex_array(prog, [(self._band_copy[1], "2f", "in_pos")]), self._band_copy[1])
-            self._upload_body_uniforms()
+        if self._sums_forces() and (self._band_sums is None or self._band_sums[4] is not self.body):
+            self._build_link_points()
         return cols * rows
+
+    def _build_link_points(self):
+        """The link sums' list (shaders/link_sums.glsl): the state texels (k, y) with a cut link,
+        packed row by row into a texture as wide as a slot, and one rectangle per slot over the
+        rows the list takes."""
+        links = self.body.links
+        x0w, y0w = self.body.window[:2]
+        texel = np.unique(np.stack([(x0w + links.ix) // 2, y0w + links.iy], axis=1), axis=0)
+        cols, ww, wh = self._band_copy[2]
+        if (self._band_sums is not None and self._band_sums[6] == self._band_copy[2]
+                and np.array_equal(self._band_sums[3], texel)):  # the same list: keep it
+            self._band_sums = self._band_sums[:4] + (self.body,) + self._band_sums[5:]
+            self._upload_body_uniforms()
+            return
+        rows = max(1, -(-len(texel) // ww))
+        table = np.zeros((rows * ww, 4), "f4")
+        table[:len(texel), :2] = texel
+        table[:len(texel), 2] = 1.0
+        if self._band_sums is None:
+            prog = create_program(self.ctx, "rect_vertex.glsl", "link_sums.glsl")
+            self._uniforms(prog, **dict(zip(G_NAMES, UNIT_G)), MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
+                           LINK_TEXELS=UNIT_LINKS, N=(self.nx, self.ny),
+                           grid_size=(float(self._tex_size[0]), float(self.ny)))
+            self._objects.append(prog)
+        else:
+            prog = self._band_sums[0].program
+            for obj in self._band_sums[:2] + self._band_sums[5:6]:
+                obj.release()
+        tex = self.ctx.texture((ww, rows), 4, table.tobytes(), dtype="f4")
+        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        slots = [(self._kx + c * ww, r * wh, self._kx + (c + 1) * ww, r * wh + rows)
+                 for r in range(self.ny // wh) for c in range(cols)]
+        vbo = self.ctx.buffer(_triangles(slots).tobytes())
+        vao = self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
+        self._band_sums = (vao, vbo, len(texel), texel, self.body, tex, self._band_copy[2])
+        self._upload_body_uniforms()
 
     def _sums_forces(self) -> bool:
         """Whether the enabled force models are all link sums the pass computes (LINK_SUM_MODELS)."""
@@ -510,6 +543,8 @@ class GLSolver(Solver):
         cover/uncover impulse. Returns (forces per step, the first step whose sums are not finite
         or None)."""
         _, _, (cols, ww, wh) = self._band_copy
+        n = self._band_sums[2]
+        rows, cols_ = np.divmod(np.arange(n), ww)  # where point j lies in its slot
         areas = {}
         i = self.body.links.i
         kx, ky = (-2.0 * RHO0 * (W[i, None] * C[i]).sum(axis=0)) if len(i) else (0.0, 0.0)
@@ -522,7 +557,7 @@ class GLSolver(Solver):
                 data = self._fbo[side].read(viewport=(self._kx, 0, cols * ww, h), components=4, attachment=0, dtype="f4")
                 areas[side] = np.frombuffer(data, dtype="f4").reshape(h, cols * ww, 4)
             c, r = slot % cols, slot // cols
-            s = areas[side][r * wh:(r + 1) * wh, c * ww:(c + 1) * ww].sum(axis=(0, 1), dtype=np.float64)
+            s = areas[side][r * wh + rows, c * ww + cols_].sum(axis=0, dtype=np.float64)
             if not np.all(np.isfinite(s)):
                 bad = t0 + b
                 break
@@ -859,7 +894,8 @@ class GLSolver(Solver):
                 obj.release()
         self._atlas, self._check_progs = None, None
         if self._band_sums is not None:
-            self._band_sums[0].release()
+            for obj in self._band_sums[:2] + self._band_sums[5:6]:
+                obj.release()
             self._band_sums = None
         if self._band_copy is not None:
             self._band_copy[0].release()

@@ -189,7 +189,8 @@ def _format_row(r) -> str:
 
 # --- tuning variants (docs/performance.md) ---------------------------------------------------
 #: the runs of `--variants` that `against_numpy` divides
-DEFAULT_TUNNEL = "default: the step's own pass copies it to a band area"
+DEFAULT_TUNNEL = "default: the step's own pass sums the links into a band area"
+WINDOW_COPY_TUNNEL = "the step's own pass copies the window to a band area (forces=window)"
 BOX = "empty periodic box (default)"
 #: the tunnel with parts taken away, each run in one step(n) call a round (no call ends):
 #: against numpy they say what the tunnel would reach if those parts cost nothing
@@ -212,6 +213,7 @@ VARIANTS = {
     "regions, read back every step": {"check_every": 1, "window": "read"},
     "default, force window read right after each step": {"window": "read"},
     "blocks of 32, a pass per step copies the window to an atlas": {"window": "atlas"},
+    WINDOW_COPY_TUNNEL: {"forces": "window"},
     DEFAULT_TUNNEL: {},
     "default, regions as two triangles each, not scissored": {"draw": "triangles"},
     "default, divergence by discard + occlusion query": {"divergence": "discard"},
