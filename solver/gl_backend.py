@@ -45,8 +45,9 @@ API for the app (a QOpenGLWidget sharing this context):
   non-finite body window raises it with the step of that window.
 - Where the only force models are the momentum exchanges (LINK_SUM_MODELS; tuning
   forces="gpu", the default), the pass sums their links on the GPU instead of copying the
-  window (`shaders/link_sums.glsl`: one RGBA32F texel of partial sums per window texel), and a
-  block reads back one attachment of the band area instead of five; the sums are the
+  window (`shaders/link_sums.glsl`: one RGBA32F texel of partial sums per state texel with a cut
+  link, from a packed list, `LinkSums`), and a block reads back those texels of one attachment
+  of the band area instead of the window's five; the sums are the
   Galilean-invariant and classic momentum exchange of solver/forces/momentum_exchange.py, from
   the same stored populations and the same Bouzidi rule as the step (forces="window": the
   window and the models' own code, as for every other model). (An occlusion query counting
@@ -54,6 +55,8 @@ API for the app (a QOpenGLWidget sharing this context):
   speed on llvmpipe: docs/performance.md.)
 """
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import moderngl
 import numpy as np
@@ -82,6 +85,28 @@ BAND_WIDTH = 128
 #: force models whose link sums the step's pass computes on the GPU (shaders/link_sums.glsl)
 LINK_SUM_MODELS = frozenset({"momentum_exchange", "momentum_exchange_classic"})
 _Y_MODE = {"no_slip": 0, "free_slip": 1, "periodic": 2}
+
+
+@dataclass
+class LinkSums:
+    """The link sums' draw (shaders/link_sums.glsl) for one body state and band-slot layout.
+
+    texels: (n, 2) the state texels (k, y) that hold a cut link; `table` lists them packed row
+    by row, (k, y, 1, 0) each, in a texture as wide as a slot; `vao` draws, per slot, one
+    rectangle over the rows the list takes (llvmpipe pays per primitive, so not a point per
+    texel: docs/performance.md). List entry j lands on texel (j % ww, j // ww) of its slot.
+    """
+
+    vao: object
+    vbo: object
+    table: object
+    texels: np.ndarray
+    layout: tuple
+    body: object
+
+    def release(self) -> None:
+        for obj in (self.vao, self.vbo, self.table):
+            obj.release()
 
 
 def _box_minus(outer, inner):
@@ -220,7 +245,7 @@ class GLSolver(Solver):
         self._check_every = max(1, min(CHECK_EVERY, int(self.tuning["check_every"])))
         self._window_mode = self.tuning["window"]
         self._band_copy = None  # (vao, vbo, slot layout) of the window copy into the band area
-        self._band_sums = None  # (vao, vbo, n, texels, body, list texture, slot layout) of the link sums
+        self._band_sums = None  # LinkSums: the link sums' draw (LINK_SUM_MODELS)
         self._block_sums = False  # the block being drawn sums links instead of copying windows
         self._pending, self._idle_queries = [], []  # divergence="discard": (step, query)
 
@@ -342,7 +367,7 @@ class GLSolver(Solver):
                 self._uniforms(prog, body_velocity=velocity, body_omega=omega, body_centre=centre)
         if self._band_sums is not None:
             window = (0, 0, 0, 0) if b is None else tuple(int(v) for v in b.window)
-            self._uniforms(self._band_sums[0].program, body_velocity=velocity, body_omega=omega,
+            self._uniforms(self._band_sums.vao.program, body_velocity=velocity, body_omega=omega,
                            body_centre=centre, window=window)
 
     def _update_inflow(self, t):
@@ -395,16 +420,15 @@ class GLSolver(Solver):
             self._render_regions()
         if slot is not None:
             vao, _, (cols, ww, wh) = self._band_copy
-            k0, y0 = texel_box(self.body.window)[:2]
-            shift = (k0 - self._kx - (slot % cols) * ww, y0 - (slot // cols) * wh)
-            if self._block_sums:  # the link texels' list (_build_link_points)
-                vao, _, n = self._band_sums[:3]
-                if n:
-                    self._band_sums[5].use(location=UNIT_LINKS)
-                    vao.program["slot_origin"].value = (self._kx + (slot % cols) * ww, (slot // cols) * wh)
-                    vao.render(moderngl.TRIANGLES, vertices=6, first=6 * slot)
+            if self._block_sums:  # the link sums over the list of texels with links
+                sums = self._band_sums
+                if len(sums.texels):
+                    sums.table.use(location=UNIT_LINKS)
+                    sums.vao.program["slot_origin"].value = (self._kx + (slot % cols) * ww, (slot // cols) * wh)
+                    sums.vao.render(moderngl.TRIANGLES, vertices=6, first=6 * slot)
             else:
-                vao.program["shift"].value = shift
+                k0, y0 = texel_box(self.body.window)[:2]
+                vao.program["shift"].value = (k0 - self._kx - (slot % cols) * ww, y0 - (slot // cols) * wh)
                 vao.render(moderngl.TRIANGLES, vertices=6, first=6 * slot)
         self._cur = dst
         self.time += 1
@@ -491,44 +515,43 @@ class GLSolver(Solver):
             vbo.orphan(len(data))
             vbo.write(data)
             self._band_copy = (self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")]), vbo, layout)
-        if self._sums_forces() and (self._band_sums is None or self._band_sums[4] is not self.body):
-            self._build_link_points()
+        if self._sums_forces() and (self._band_sums is None or self._band_sums.body is not self.body):
+            self._build_link_sums()
         return cols * rows
 
-    def _build_link_points(self):
-        """The link sums' list (shaders/link_sums.glsl): the state texels (k, y) with a cut link,
-        packed row by row into a texture as wide as a slot, and one rectangle per slot over the
-        rows the list takes."""
+    def _build_link_sums(self):
+        """The LinkSums of the current body and band layout; the list and its draw are kept
+        while the set of texels with links stays the same (most moves)."""
         links = self.body.links
         x0w, y0w = self.body.window[:2]
         texel = np.unique(np.stack([(x0w + links.ix) // 2, y0w + links.iy], axis=1), axis=0)
-        cols, ww, wh = self._band_copy[2]
-        if (self._band_sums is not None and self._band_sums[6] == self._band_copy[2]
-                and np.array_equal(self._band_sums[3], texel)):  # the same list: keep it
-            self._band_sums = self._band_sums[:4] + (self.body,) + self._band_sums[5:]
+        layout = self._band_copy[2]
+        cols, ww, wh = layout
+        old = self._band_sums
+        if old is not None and old.layout == layout and np.array_equal(old.texels, texel):
+            old.body = self.body
             self._upload_body_uniforms()
             return
         rows = max(1, -(-len(texel) // ww))
         table = np.zeros((rows * ww, 4), "f4")
         table[:len(texel), :2] = texel
         table[:len(texel), 2] = 1.0
-        if self._band_sums is None:
+        if old is None:
             prog = create_program(self.ctx, "rect_vertex.glsl", "link_sums.glsl")
             self._uniforms(prog, **dict(zip(G_NAMES, UNIT_G)), MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
                            LINK_TEXELS=UNIT_LINKS, N=(self.nx, self.ny),
                            grid_size=(float(self._tex_size[0]), float(self.ny)))
             self._objects.append(prog)
         else:
-            prog = self._band_sums[0].program
-            for obj in self._band_sums[:2] + self._band_sums[5:6]:
-                obj.release()
+            prog = old.vao.program
+            old.release()
         tex = self.ctx.texture((ww, rows), 4, table.tobytes(), dtype="f4")
         tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
         slots = [(self._kx + c * ww, r * wh, self._kx + (c + 1) * ww, r * wh + rows)
                  for r in range(self.ny // wh) for c in range(cols)]
         vbo = self.ctx.buffer(_triangles(slots).tobytes())
         vao = self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
-        self._band_sums = (vao, vbo, len(texel), texel, self.body, tex, self._band_copy[2])
+        self._band_sums = LinkSums(vao, vbo, tex, texel, layout, self.body)
         self._upload_body_uniforms()
 
     def _sums_forces(self) -> bool:
@@ -543,8 +566,7 @@ class GLSolver(Solver):
         cover/uncover impulse. Returns (forces per step, the first step whose sums are not finite
         or None)."""
         _, _, (cols, ww, wh) = self._band_copy
-        n = self._band_sums[2]
-        rows, cols_ = np.divmod(np.arange(n), ww)  # where point j lies in its slot
+        rows, cols_ = np.divmod(np.arange(len(self._band_sums.texels)), ww)  # list entry j in its slot
         areas = {}
         i = self.body.links.i
         kx, ky = (-2.0 * RHO0 * (W[i, None] * C[i]).sum(axis=0)) if len(i) else (0.0, 0.0)
@@ -894,8 +916,7 @@ class GLSolver(Solver):
                 obj.release()
         self._atlas, self._check_progs = None, None
         if self._band_sums is not None:
-            for obj in self._band_sums[:2] + self._band_sums[5:6]:
-                obj.release()
+            self._band_sums.release()
             self._band_sums = None
         if self._band_copy is not None:
             self._band_copy[0].release()
