@@ -520,38 +520,44 @@ class GLSolver(Solver):
         return cols * rows
 
     def _build_link_sums(self):
-        """The LinkSums of the current body and band layout; the list and its draw are kept
-        while the set of texels with links stays the same (most moves)."""
+        """The LinkSums of the current body and band layout. Its list texture and rectangles are
+        made once per layout and rewritten when the set of texels with links changes (at a move,
+        when llvmpipe's queue is empty: a write to a texture a queued step reads would wait)."""
         links = self.body.links
         x0w, y0w = self.body.window[:2]
-        texel = np.unique(np.stack([(x0w + links.ix) // 2, y0w + links.iy], axis=1), axis=0)
+        key = np.unique((y0w + links.iy) * self._kx + (x0w + links.ix) // 2)  # sorted by (y, k)
+        texel = np.stack([key % self._kx, key // self._kx], axis=1)
         layout = self._band_copy[2]
         cols, ww, wh = layout
-        old = self._band_sums
-        if old is not None and old.layout == layout and np.array_equal(old.texels, texel):
-            old.body = self.body
+        sums = self._band_sums
+        if sums is not None and sums.layout == layout and np.array_equal(sums.texels, texel):
+            sums.body = self.body  # the same list: keep it
             self._upload_body_uniforms()
             return
+        if sums is None or sums.layout != layout:
+            if sums is None:
+                prog = create_program(self.ctx, "rect_vertex.glsl", "link_sums.glsl")
+                self._uniforms(prog, **dict(zip(G_NAMES, UNIT_G)), MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
+                               LINK_TEXELS=UNIT_LINKS, N=(self.nx, self.ny),
+                               grid_size=(float(self._tex_size[0]), float(self.ny)))
+                self._objects.append(prog)
+            else:
+                prog = sums.vao.program
+                sums.release()
+            table = self.ctx.texture((ww, wh), 4, dtype="f4")  # the list never outgrows the window
+            table.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            vbo = self.ctx.buffer(reserve=cols * (self.ny // wh) * 6 * 2 * 4)
+            vao = self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
+            sums = self._band_sums = LinkSums(vao, vbo, table, texel[:0], layout, self.body)
         rows = max(1, -(-len(texel) // ww))
-        table = np.zeros((rows * ww, 4), "f4")
-        table[:len(texel), :2] = texel
-        table[:len(texel), 2] = 1.0
-        if old is None:
-            prog = create_program(self.ctx, "rect_vertex.glsl", "link_sums.glsl")
-            self._uniforms(prog, **dict(zip(G_NAMES, UNIT_G)), MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
-                           LINK_TEXELS=UNIT_LINKS, N=(self.nx, self.ny),
-                           grid_size=(float(self._tex_size[0]), float(self.ny)))
-            self._objects.append(prog)
-        else:
-            prog = old.vao.program
-            old.release()
-        tex = self.ctx.texture((ww, rows), 4, table.tobytes(), dtype="f4")
-        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        entries = np.zeros((rows * ww, 4), "f4")
+        entries[:len(texel), :2] = texel
+        entries[:len(texel), 2] = 1.0
+        sums.table.write(entries.tobytes(), viewport=(0, 0, ww, rows))
         slots = [(self._kx + c * ww, r * wh, self._kx + (c + 1) * ww, r * wh + rows)
                  for r in range(self.ny // wh) for c in range(cols)]
-        vbo = self.ctx.buffer(_triangles(slots).tobytes())
-        vao = self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
-        self._band_sums = LinkSums(vao, vbo, tex, texel, layout, self.body)
+        sums.vbo.write(_triangles(slots).tobytes())
+        sums.texels, sums.body = texel, self.body
         self._upload_body_uniforms()
 
     def _sums_forces(self) -> bool:
