@@ -27,7 +27,7 @@ API for the app (a QOpenGLWidget sharing this context):
 - `grid_size` -> (nx, ny); `renderer` -> the GL renderer string; `finish()` waits for the GPU.
 - Every pass sets the state it needs: `ctx.enable_only(moderngl.NOTHING)` (Qt enters paintGL
   with blending on), no scissor, its own framebuffer and viewport, and binds every texture unit
-  it samples (units 0..9) right before drawing. Nothing is restored: after `step()` or
+  it samples (units 0..10) right before drawing. Nothing is restored: after `step()` or
   `field_texture()` the bound framebuffer is the solver's, so a paintGL must re-bind its own
   (`ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`) and its own textures.
 - Steps run in blocks of up to CHECK_EVERY (32) steps with nothing read back inside a block
