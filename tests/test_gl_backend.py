@@ -161,6 +161,24 @@ def test_link_sums_on_the_gpu_give_the_momentum_exchanges_of_the_window(gl_conte
     assert not np.allclose(f_win[:, 0], f_win[:, 1])  # the two forms differ on a moving body
 
 
+@pytest.mark.parametrize("forces", ["gpu", "window"])
+def test_a_non_finite_body_window_raises_with_its_step_on_either_force_path(gl_context, forces):
+    """A NaN next to the body is reported from the step whose window holds it, the same step
+    and message whether the pass summed the links (forces="gpu") or copied the window."""
+    cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04)
+    s = create_solver("gl", cfg, ctx=gl_context, tuning={"forces": forces})
+    s.enable_force_models(["momentum_exchange"])
+    s.set_body(Cylinder(8.0, x=20.0, y=16.0))
+    s.step(5)
+    f = s.distributions()
+    f[:, 16, 25] = np.nan  # the fluid node right of the cylinder (x = 24 is its edge)
+    s.set_distributions(f)
+    with pytest.raises(SolverDiverged) as err:
+        s.step(10)
+    assert err.value.step == 5 and "around the body" in str(err.value)
+    assert s._block_sums == (forces == "gpu")
+
+
 def test_before_read_runs_once_per_block_while_its_steps_are_still_unread(gl_context):
     """GLSolver.before_read (the bench's overlap probe, docs/performance.md 'Ninth session') is
     called once per block of steps, after the block's draws and before its read-back, and
