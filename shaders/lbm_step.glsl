@@ -38,9 +38,7 @@ uniform usampler2D MASK;       // per node: bit 0 solid; bit i (1..8) q[OPP[i], 
                                // that link takes the two-node interpolation (q < 1/2, x + c_i fluid)
 uniform sampler2D QA;          // q[1..4, x]
 uniform sampler2D QB;          // q[5..8, x]
-uniform vec2 body_velocity;    // V
-uniform float body_omega;      // Omega, radians per step, counter-clockwise
-uniform vec2 body_centre;      // X
+// @INCLUDE body_links.glsl
 #endif
 #if EDGES || SPONGE
 uniform sampler2D INFLOW;      // inflow profile(iy) in texel (iy, 0)
@@ -184,13 +182,6 @@ void collide(inout float f[9], ivec2 x) {
     }
 }
 
-#if BODY
-vec2 wall_velocity(vec2 xw) {  // rigid-body velocity at xw (algorithm.md, 'Links cut')
-    vec2 r = xw - body_centre;
-    return body_velocity + body_omega * vec2(-r.y, r.x);
-}
-#endif
-
 #if EDGES
 vec2 stored_velocity(float g[9]) {  // sum c f* / sum f* of shifted populations
     float rho = RHO0;
@@ -244,14 +235,8 @@ void node_update(ivec2 x, inout float gin[9], float own[9], float west[9]) {
 #if BODY
         if ((m & (1u << uint(i))) != 0u) {  // rule a: Bouzidi with the moving-wall term
             float q = qs[ib];
-            float cu = dot(vec2(ci), wall_velocity(vec2(x) + q * vec2(C[ib])));
-            if (q >= 0.5)
-                gin[i] = 1.0 / (2.0 * q) * own[ib] + (2.0 * q - 1.0) / (2.0 * q) * own[i]
-                         + 3.0 / q * W[i] * RHO0 * cu;
-            else if ((m & (1u << uint(8 + i))) != 0u)
-                gin[i] = 2.0 * q * own[ib] + (1.0 - 2.0 * q) * plain[ib] + 6.0 * W[i] * RHO0 * cu;
-            else
-                gin[i] = own[ib] + 6.0 * W[i] * RHO0 * cu;
+            gin[i] = bouzidi_incoming(i, q, (m & (1u << uint(8 + i))) != 0u, own[ib], own[i], plain[ib],
+                                      wall_velocity(vec2(x) + q * vec2(C[ib])));
             continue;
         }
 #endif

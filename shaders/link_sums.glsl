@@ -10,19 +10,17 @@
 // their cut links (x, ib) (bits of MASK, as lbm_step.glsl rule a), from the stored
 // post-collision populations g* = f* - w RHO0 of the step's source state:
 //   S1 = sum -c_i (g*_ib(x) + g_i^in(x)),   S2 = sum -u_w (g*_ib(x) - g_i^in(x)),
-// with g_i^in(x) from the same Bouzidi rule, moving-wall term included, as lbm_step.glsl.
+// with g_i^in(x) from the rule lbm_step.glsl streams with (body_links.glsl, rule 1a).
 // The backend sums the texels in float64 and adds the links' constant K = -2 RHO0 sum w_i c_i
 // and the cover/uncover impulse J: Galilean-invariant F = S1 + S2 + K + J, classic F = S1 + K,
 // the numbers solver/forces/momentum_exchange.py computes from the window (f = g + w RHO0).
 // @LATTICE
 // @INCLUDE paired_layout.glsl
+// @INCLUDE body_links.glsl
 
 uniform usampler2D MASK;       // lbm_step.glsl: bit 0 solid; bit i link cut; bit 8+i two-node rule
 uniform sampler2D QA;          // q[1..4, x]
 uniform sampler2D QB;          // q[5..8, x]
-uniform vec2 body_velocity;    // V
-uniform float body_omega;      // Omega, radians per step, counter-clockwise
-uniform vec2 body_centre;      // X
 uniform ivec2 N;               // (nx, ny) in nodes
 uniform ivec4 window;          // the force window (x0, y0, x1, y1) in nodes
 uniform sampler2D LINK_TEXELS;  // (k, y, 1, 0): the state texels with links; (0, 0, 0, 0) past the list
@@ -32,11 +30,6 @@ layout(location = 0) out vec4 sums;  // (S1.x, S1.y, S2.x, S2.y) of this texel's
 
 ivec2 wrap(ivec2 p) {
     return ivec2((p.x + N.x) % N.x, (p.y + N.y) % N.y);
-}
-
-vec2 wall_velocity(vec2 xw) {  // rigid-body velocity at xw, as lbm_step.glsl
-    vec2 r = xw - body_centre;
-    return body_velocity + body_omega * vec2(-r.y, r.x);
 }
 
 void add_node(ivec2 x, inout vec2 s1, inout vec2 s2) {
@@ -54,15 +47,9 @@ void add_node(ivec2 x, inout vec2 s1, inout vec2 s2) {
         ivec2 ci = C[i];
         float q = qs[ib];
         vec2 uw = wall_velocity(vec2(x) + q * vec2(C[ib]));
-        float cu = dot(vec2(ci), uw);
-        float gin;
-        if (q >= 0.5)
-            gin = 1.0 / (2.0 * q) * own[ib] + (2.0 * q - 1.0) / (2.0 * q) * own[i]
-                  + 3.0 / q * W[i] * RHO0 * cu;
-        else if ((m & (1u << uint(8 + i))) != 0u)
-            gin = 2.0 * q * own[ib] + (1.0 - 2.0 * q) * pop(ib, wrap(x + ci)) + 6.0 * W[i] * RHO0 * cu;
-        else
-            gin = own[ib] + 6.0 * W[i] * RHO0 * cu;
+        bool two_node = (m & (1u << uint(8 + i))) != 0u;
+        float second = two_node ? pop(ib, wrap(x + ci)) : 0.0;
+        float gin = bouzidi_incoming(i, q, two_node, own[ib], own[i], second, uw);
         float gout = own[ib];
         s1 -= vec2(ci) * (gout + gin);
         s2 -= uw * (gout - gin);

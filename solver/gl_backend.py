@@ -531,8 +531,7 @@ class GLSolver(Solver):
         cols, ww, wh = layout
         sums = self._band_sums
         if sums is not None and sums.layout == layout and np.array_equal(sums.texels, texel):
-            sums.body = self.body  # the same list: keep it
-            self._upload_body_uniforms()
+            sums.body = self.body  # the same list: keep it (set_body has set the body's uniforms)
             return
         if sums is None or sums.layout != layout:
             if sums is None:
@@ -549,6 +548,7 @@ class GLSolver(Solver):
             vbo = self.ctx.buffer(reserve=cols * (self.ny // wh) * 6 * 2 * 4)
             vao = self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
             sums = self._band_sums = LinkSums(vao, vbo, table, texel[:0], layout, self.body)
+            self._upload_body_uniforms()  # a new vertex array or program: the body's uniforms
         rows = max(1, -(-len(texel) // ww))
         entries = np.zeros((rows * ww, 4), "f4")
         entries[:len(texel), :2] = texel
@@ -558,7 +558,6 @@ class GLSolver(Solver):
                  for r in range(self.ny // wh) for c in range(cols)]
         sums.vbo.write(_triangles(slots).tobytes())
         sums.texels, sums.body = texel, self.body
-        self._upload_body_uniforms()
 
     def _sums_forces(self) -> bool:
         """Whether the enabled force models are all link sums the pass computes (LINK_SUM_MODELS)."""
