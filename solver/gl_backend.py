@@ -109,17 +109,6 @@ class LinkSums:
             obj.release()
 
 
-def _box_minus(outer, inner):
-    """Rectangles (x0, y0, x1, y1) covering `outer` minus `inner` (half-open boxes)."""
-    ox0, oy0, ox1, oy1 = outer
-    ix0, iy0 = max(inner[0], ox0), max(inner[1], oy0)
-    ix1, iy1 = min(inner[2], ox1), min(inner[3], oy1)
-    if ix0 >= ix1 or iy0 >= iy1:
-        return [outer]
-    rects = [(ox0, oy0, ox1, iy0), (ox0, iy1, ox1, oy1), (ox0, iy0, ix0, iy1), (ix1, iy0, ox1, iy1)]
-    return [r for r in rects if r[0] < r[2] and r[1] < r[3]]
-
-
 def _tile_block(nx: int) -> tuple[int, int]:
     """(BLOCK_X, BLOCK_Y) of the finite check: 256 nodes a tile, at least 128 tiles across
     (two of llvmpipe's 64-pixel bins, so both threads reduce) where the grid allows."""
@@ -235,7 +224,9 @@ class GLSolver(Solver):
                                              np.ones(nx) if keep is None else keep), -1)
         self._omega_tex.write(rates.astype("f4").tobytes())
         self._inflow_key = None
-        self._draws, self._draw_regions = [], None
+        self._draws, self._draw_regions = [], None  # [(vertex array, scissor boxes or None)]
+        self._vaos = {}  # region key -> (vertex array, vbo), made on first use
+        self._fragments_per_step = 0
         self._field = None
         self._discard = self.tuning["divergence"] == "discard"
         # divergence checks and force windows of up to CHECK_EVERY steps, read back at once
@@ -280,6 +271,10 @@ class GLSolver(Solver):
 
         Rectangles are aligned to llvmpipe's 4x4 pixel blocks (a partly covered block runs the
         whole shader), so the edge strips are ALIGN wide and the body window is grown to them.
+        The body window is drawn last, over the fast path or edge strip beneath it (its variant
+        writes every texel it covers; _set_rects draws the keys in order, body keys last): one
+        rectangle per variant instead of the interior cut into four around the window, and the
+        other regions stay the same as the body moves (docs/performance.md, tenth session).
         """
         nx, ny, a = self._kx, self.ny, ALIGN  # texel columns
         if window is not None:
@@ -293,16 +288,14 @@ class GLSolver(Solver):
             if window is not None and window[0] < window[2] and window[1] < window[3]:
                 w = (window[0] // a * a, window[1] // a * a, min(nx, -(-window[2] // a) * a),
                      min(ny, -(-window[3] // a) * a))
-                parts = {(0, 0, 0): _box_minus((0, 0, nx, ny), w), (1, 0, 0): [w]}
-            return {k: v for k, v in parts.items() if v}
+                parts[(1, 0, 0)] = [w]
+            return parts
         interior = (a, a, x1, y1)
         edges = [(0, 0, nx, a), (0, y1, nx, ny), (0, a, a, y1), (x1, a, nx, y1)]
         parts = {(0, 0, 0): [interior], (0, 1, sp): edges}
         if window is not None and window[0] < window[2] and window[1] < window[3]:
             w = (window[0] // a * a, window[1] // a * a, min(nx, -(-window[2] // a) * a),
                  min(ny, -(-window[3] // a) * a))
-            parts[(0, 0, 0)] = _box_minus(interior, w)
-            parts[(0, 1, sp)] = [r for e in edges for r in _box_minus(e, w)]
             inside = w[0] >= a and w[1] >= a and w[2] <= x1 and w[3] <= y1
             parts[(1, 0, sp) if inside else (1, 1, sp)] = [w]
         if sp:  # the sponge columns (aligned down) get the variant with per-column rates
@@ -323,32 +316,40 @@ class GLSolver(Solver):
         return bool(d["X_PERIODIC"] and d["Y_MODE"] == 2 and self.nx % 2 == 0 and not self._sponge)
 
     def _set_rects(self, window):
-        """Draws of every region (see _regions), in this order each step; kept when the
-        (block-aligned) regions did not change. Default (tuning draw="scissor"): per rectangle,
-        one triangle covering the texture, clipped by the scissor box to the rectangle, so every
-        4x4 block inside is fully covered; drawn as two triangles (draw="triangles"), the 4x4
-        blocks along the diagonal are shaded twice, once per triangle, which doubles the cost
-        of the 4-texel edge strips (docs/performance.md)."""
+        """Draws of every region (see _regions), in key order each step, so the body window's
+        variant (key[0] = 1) comes last, over what is beneath it; kept when the (block-aligned)
+        regions did not change. Default (tuning draw="scissor"): per rectangle, one triangle
+        covering the texture, clipped by the scissor box to the rectangle, so every 4x4 block
+        inside is fully covered, and a move changes only the body window's scissor box; drawn
+        as two triangles (draw="triangles"), the 4x4 blocks along the diagonal are shaded twice,
+        once per triangle, which doubles the cost of the 4-texel edge strips
+        (docs/performance.md)."""
         regions = sorted(self._regions(window).items())
         if regions == self._draw_regions:
             return
         self._draw_regions = regions
-        for vao, vbo, _ in self._draws:
-            vao.release()
-            vbo.release()
-        self._draws = []
+        # fragments each step writes (the body window twice): the occlusion count to expect
+        self._fragments_per_step = sum((x1 - x0) * (y1 - y0) for _, rects in regions for x0, y0, x1, y1 in rects)
         w, h = self._tex_size
+        draws = []
         for key, rects in regions:
             if self.tuning["draw"] == "scissor":
                 data, scissors = _triangles([(0, 0, 2 * w, 2 * h)])[[0, 1, 5]], rects
             else:
                 data, scissors = _triangles(rects), None
-            vbo = self.ctx.buffer(data.tobytes())
-            vao = self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")])
-            self._draws.append((vao, vbo, scissors))
+            if key not in self._vaos:
+                vbo = self.ctx.buffer(data.tobytes())
+                self._vaos[key] = (self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")]), vbo)
+            vao, vbo = self._vaos[key]
+            if scissors is None:
+                vbo.orphan(data.nbytes)
+                vbo.write(data.tobytes())
+                vao.vertices = len(data)
+            draws.append((vao, scissors))
+        self._draws = draws
 
     def _render_regions(self):
-        for vao, _, scissors in self._draws:
+        for vao, scissors in self._draws:
             if scissors is None:
                 vao.render(moderngl.TRIANGLES)
                 continue
@@ -759,7 +760,7 @@ class GLSolver(Solver):
         if self._discard:
             for step, query in self._pending:
                 self._idle_queries.append(query)
-                if query.samples != self._kx * self.ny and not bad:
+                if query.samples != self._fragments_per_step and not bad:
                     bad.append((step, "density is no longer finite"))
             self._pending = []
         elif not self._tiles_finite(0):
@@ -912,9 +913,9 @@ class GLSolver(Solver):
         return tex
 
     def close(self) -> None:
-        for obj in [*(o for d in self._draws for o in d[:2]), *self._objects, *self._programs.values()]:
+        for obj in [*(o for pair in self._vaos.values() for o in pair), *self._objects, *self._programs.values()]:
             obj.release()
-        self._draws, self._objects, self._programs = [], [], {}
+        self._draws, self._vaos, self._objects, self._programs = [], {}, [], {}
         self._field = None
         if self._atlas is not None:
             for obj in self._atlas["objects"]:

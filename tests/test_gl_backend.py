@@ -80,6 +80,23 @@ def test_divergence_raises_with_the_step(gl_context, check):
     assert err.value.step == 6
 
 
+def test_discard_check_counts_the_body_window_drawn_over_the_interior(gl_context):
+    """The body window's variant is drawn over the fast path beneath it, so a step writes those
+    fragments twice: the occlusion-query check must expect that count, and still catch a NaN."""
+    cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)
+    s = create_solver("gl", cfg, ctx=gl_context, tuning={"divergence": "discard"})
+    s.set_body(Cylinder(6.0, x=20.0, y=16.0), velocity=(0.0, 0.02))
+    s.step(12)  # healthy: no false alarm
+    s.set_body(Cylinder(6.0, x=20.0, y=16.3), velocity=(0.0, 0.02))
+    s.step(12)
+    f = s.distributions()
+    f[2, 16, 40] = np.nan
+    s.set_distributions(f)
+    with pytest.raises(SolverDiverged) as err:
+        s.step(5)
+    assert err.value.step == 25
+
+
 def test_body_upload_touches_only_the_window(request):
     """Moving the body rewrites the mask (and q) only around the old and new windows; removing
     the body clears them there."""
