@@ -114,15 +114,12 @@ def _cut_every_link_into_solid(box_solid, box_q) -> None:
     """A fluid -> solid link always crosses the boundary; if round-off at a vertex lost the
     crossing, put the wall at the solid node (q = 1)."""
     h, w = box_solid.shape
-    fluid = ~box_solid
-    for i in range(1, len(LINKS)):
-        cx, cy = LINKS[i]
-        target = np.zeros_like(box_solid)  # beyond the box (grown by a cell) all is fluid
-        target[max(0, -cy):h - max(0, cy), max(0, -cx):w - max(0, cx)] = \
-            box_solid[max(0, cy):h - max(0, -cy), max(0, cx):w - max(0, -cx)]
-        lost = fluid & target & (box_q[i] <= 0.0)
-        if lost.any():
-            box_q[i][lost] = 1.0
+    pad = np.zeros((h + 2, w + 2), dtype=bool)  # beyond the box (grown by a cell) all is fluid
+    pad[1:-1, 1:-1] = box_solid
+    target = np.stack([pad[1 + cy:1 + cy + h, 1 + cx:1 + cx + w] for cx, cy in LINKS[1:]])
+    lost = ~box_solid & target & (box_q[1:] <= 0.0)  # lost[i - 1]: x fluid, x + c_i solid, no cut
+    if lost.any():
+        box_q[1:][lost] = 1.0
 
 
 def _window(box_solid, box_q, box, nx, ny, margin):

@@ -60,19 +60,20 @@ def node_velocity(shape, velocity, omega, x0, y0, h, w):
 
 
 def _neighbour_sum(field: np.ndarray, wrap: tuple[bool, bool] = (False, False)) -> np.ndarray:
-    """Sum of a (h, w) field over the 8 lattice neighbours: zero outside the window, except
-    across a periodic direction the window spans whole (`wrap`, x and y: periodic_wrap)."""
-    h, w = field.shape
-    pad = np.zeros((h + 2, w + 2), dtype=field.dtype)  # as np.pad: x (wrap or zero), then y, corners included
-    pad[1:-1, 1:-1] = field
+    """Sum of a (h, w) field, or of each of a stack (k, h, w), over the 8 lattice neighbours:
+    zero outside the window, except across a periodic direction the window spans whole
+    (`wrap`, x and y: periodic_wrap)."""
+    h, w = field.shape[-2:]
+    pad = np.zeros(field.shape[:-2] + (h + 2, w + 2), dtype=field.dtype)  # as np.pad: x, then y
+    pad[..., 1:-1, 1:-1] = field
     if wrap[0]:
-        pad[1:-1, 0], pad[1:-1, -1] = field[:, -1], field[:, 0]
+        pad[..., 1:-1, 0], pad[..., 1:-1, -1] = field[..., :, -1], field[..., :, 0]
     if wrap[1]:
-        pad[0], pad[-1] = pad[-2], pad[1]
-    out = np.zeros((h, w), dtype=pad.dtype)
+        pad[..., 0, :], pad[..., -1, :] = pad[..., -2, :], pad[..., 1, :]
+    out = np.zeros(field.shape, dtype=pad.dtype)
     for k in range(1, Q):
         cx, cy = int(C[k, 0]), int(C[k, 1])
-        out += pad[1 + cy:1 + cy + h, 1 + cx:1 + cx + w]
+        out += pad[..., 1 + cy:1 + cy + h, 1 + cx:1 + cx + w]
     return out
 
 
@@ -111,20 +112,24 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
         ux, uy = node_velocity(shape, velocity, omega, x0, y0, h, w)
     else:
         ux = uy = np.zeros((h, w))
+    body_nodes = (new_solid | old_solid).astype(np.float64)
     if uncovered.any():
         rho = f.sum(axis=0)
         donor = ~new_solid & ~uncovered
-        rsum = _neighbour_sum(np.where(donor, rho, 0.0), wrap)
-        cnt = _neighbour_sum(donor.astype(np.float64), wrap)
+        # one stacked neighbour sum: donor densities, donor count, body nodes (the ring below)
+        rsum, cnt, near_body = _neighbour_sum(np.stack([np.where(donor, rho, 0.0), donor.astype(np.float64),
+                                                        body_nodes]), wrap)
         rho_new = np.where(cnt > 0, rsum / np.maximum(cnt, 1), RHO0)[uncovered]
         uxu, uyu = ux[uncovered], uy[uncovered]
         f[:, uncovered] = equilibrium(rho_new, uxu, uyu)
         jx -= float((rho_new * uxu).sum())
         jy -= float((rho_new * uyu).sum())
         lost += RHO0 * int(uncovered.sum()) - float(rho_new.sum())
+    else:
+        near_body = _neighbour_sum(body_nodes, wrap)
     if new_solid.any():
         f[:, new_solid] = equilibrium(np.full(int(new_solid.sum()), RHO0), ux[new_solid], uy[new_solid])
-    ring = ~new_solid & (_neighbour_sum((new_solid | old_solid).astype(np.float64), wrap) > 0)
+    ring = ~new_solid & (near_body > 0)
     if lost != 0.0 and ring.any():
         fr = f[:, ring]
         rho_r = fr.sum(axis=0)

@@ -137,10 +137,9 @@ def node_mask(solid: np.ndarray, q: np.ndarray, box, links=None, window=None) ->
     population as streamed, which wraps there).
     """
     x0, y0, x1, y1 = box
-    mask = solid.astype(np.uint32)
-    for i in range(1, Q):
-        cut = (q[OPP[i]] > 0) & ~solid
-        mask |= cut.astype(np.uint32) << np.uint32(i)
+    cut = (q[OPP[1:]] > 0) & ~solid  # cut[i - 1]: bit i
+    mask = solid.astype(np.uint32) | np.bitwise_or.reduce(
+        cut.astype(np.uint32) << np.arange(1, Q, dtype=np.uint32)[:, None, None], axis=0)
     if links is not None and len(links):
         two = links.b != 0
         ys, xs = links.iy[two] + window[1] - y0, links.ix[two] + window[0] - x0

@@ -33,12 +33,11 @@ def equilibrium(rho, ux, uy):
     ux = np.asarray(ux)
     uy = np.asarray(uy)
     dtype = np.result_type(rho, ux, uy, np.float32)
-    feq = np.empty((Q,) + np.broadcast(rho, ux, uy).shape, dtype=dtype)
+    lead = (Q,) + (1,) * np.broadcast(rho, ux, uy).ndim  # all nine directions at once, each
+    cx, cy, w = C[:, 0].reshape(lead), C[:, 1].reshape(lead), W.reshape(lead)  # as c_i, w_i alone
     usq = 1.5 * (ux * ux + uy * uy)
-    for i in range(Q):
-        cu = 3.0 * (C[i, 0] * ux + C[i, 1] * uy)
-        feq[i] = W[i] * rho * (1.0 + cu + 0.5 * cu * cu - usq)
-    return feq
+    cu = 3.0 * (cx * ux + cy * uy)
+    return (w * rho * (1.0 + cu + 0.5 * cu * cu - usq)).astype(dtype, copy=False)
 
 
 def glsl_constants() -> str:
