@@ -19,4 +19,11 @@ def test_profile_splits_the_wall_time_of_the_moving_tunnel(tmp_path, gl_context,
     # do not overlap: together they stay within the wall time
     assert len(measured) == 3 and all(v > 0 for v in measured.values())
     assert sum(measured.values()) <= data["wall_s"] * 1.01
-    assert "draw calls" in capsys.readouterr().out
+    # the same steps without the profiler, CPU split by thread (Linux: /proc/self/task)
+    threads = data["threads_without_profiler"]
+    assert set(threads) == {"moving tunnel, step(10) calls", "not moved, one call"}
+    for th in threads.values():
+        assert th["steps"] == data["steps"] and th["llvmpipe_cpu_ms_per_step"] > 0
+        assert th["other_cpu_ms_per_step"] > 0 and 0 <= th["cores_idle_fraction"] < 1
+    out = capsys.readouterr().out
+    assert "draw calls" in out and "llvmpipe threads" in out

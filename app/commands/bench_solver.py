@@ -358,6 +358,40 @@ PROFILE_PARTS = {  # (label, function name, file suffix or None for a built-in m
 }
 
 
+def thread_cpu_seconds() -> dict | None:
+    """CPU seconds used so far by this process's threads, split into llvmpipe's rasteriser
+    threads (named "llvmpipe-N") and the rest (the main thread: Python, and Mesa's draw calls,
+    which bin each step's triangles), from /proc/self/task; None where there is no /proc."""
+    try:
+        tick = os.sysconf("SC_CLK_TCK")
+        out = {"llvmpipe": 0.0, "other": 0.0}
+        for tid in os.listdir("/proc/self/task"):
+            with open(f"/proc/self/task/{tid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()  # after "pid (comm)"
+            with open(f"/proc/self/task/{tid}/comm") as f:
+                name = f.read().strip()
+            out["llvmpipe" if name.startswith("llvmpipe") else "other"] += (int(fields[11]) + int(fields[12])) / tick
+        return out
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def thread_split(run: SceneRun, steps: int) -> dict | None:
+    """`steps` of `run` without the profiler: CPU milliseconds per step of llvmpipe's threads
+    and of the rest, and the share of the cores' time (os.cpu_count() x wall) nobody used."""
+    c0, t0 = thread_cpu_seconds(), time.perf_counter()
+    run.advance(steps)
+    wall, c1 = time.perf_counter() - t0, thread_cpu_seconds()
+    if c0 is None or c1 is None:
+        return None
+    used = {k: c1[k] - c0[k] for k in c0}
+    cores = os.cpu_count() or 1
+    return {"steps": steps, "wall_ms_per_step": round(1e3 * wall / steps, 3),
+            "llvmpipe_cpu_ms_per_step": round(1e3 * used["llvmpipe"] / steps, 3),
+            "other_cpu_ms_per_step": round(1e3 * used["other"] / steps, 3),
+            "cores_idle_fraction": round(max(0.0, 1.0 - sum(used.values()) / (cores * wall)), 3)}
+
+
 def run_profile(seconds: float | None):
     """The default moving tunnel (512x256, gl) under cProfile: where its wall time goes.
 
@@ -376,6 +410,11 @@ def run_profile(seconds: float | None):
     run = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx))
     run.advance(200)
     steps = max(MOVE_EVERY, int(round((seconds if seconds is not None else 5.0) * 400 / MOVE_EVERY)) * MOVE_EVERY)
+    threads = {"moving tunnel, step(10) calls": thread_split(run, steps)}
+    fixed = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False, call_steps=None)
+    fixed.advance(200)
+    threads["not moved, one call"] = thread_split(fixed, steps)
+    fixed.solver.close()
     prof = cProfile.Profile()
     t0, c0 = time.perf_counter(), time.process_time()
     prof.enable()
@@ -393,7 +432,8 @@ def run_profile(seconds: float | None):
             "steps": steps, "wall_s": round(wall, 3), "cpu_s": round(cpu, 3),
             "mlups": round(nx * ny * steps / wall / 1e6, 2),
             "parts_s": {k: round(v, 3) for k, v in parts.items()},
-            "parts_fraction": {k: round(v / wall, 3) for k, v in parts.items()}}
+            "parts_fraction": {k: round(v / wall, 3) for k, v in parts.items()},
+            "threads_without_profiler": threads}
 
 
 def _subprocess_tunnel(nx: int, ny: int, seconds: float, env_extra: dict):
@@ -420,6 +460,14 @@ def main(args) -> int:
               f"{result['wall_s']} s wall, {result['cpu_s']} s CPU (all threads), {result['mlups']} MLUPS under the profiler")
         for label, t in result["parts_s"].items():
             print(f"  {label:72s} {t:7.3f} s  {100 * result['parts_fraction'][label]:5.1f} %")
+        print("  CPU per step by thread, the same number of steps without the profiler:")
+        for label, th in result["threads_without_profiler"].items():
+            if th is None:
+                print(f"    {label}: no /proc/self/task here")
+                continue
+            print(f"    {label:32s} wall {th['wall_ms_per_step']:.3f} ms, llvmpipe threads "
+                  f"{th['llvmpipe_cpu_ms_per_step']:.3f} CPU-ms, main thread {th['other_cpu_ms_per_step']:.3f} "
+                  f"CPU-ms, cores idle {100 * th['cores_idle_fraction']:.1f} %")
     elif getattr(args, "variants", False):
         result = run_variants(quick, seconds)
         print(f"gl tuning variants, moving-cylinder tunnel {result['grid']}, {result['renderer']}")
