@@ -572,22 +572,25 @@ class GLSolver(Solver):
         or None)."""
         _, _, (cols, ww, wh) = self._band_copy
         rows, cols_ = np.divmod(np.arange(len(self._band_sums.texels)), ww)  # list entry j in its slot
-        areas = {}
         i = self.body.links.i
         kx, ky = (-2.0 * RHO0 * (W[i, None] * C[i]).sum(axis=0)) if len(i) else (0.0, 0.0)
-        out, bad = [], None
-        for b in range(bands):
-            side, slot = sides[b % 2], b // 2
-            if side not in areas:
-                used = (bands - 1 - b % 2) // 2 + 1  # slots this side holds
-                h = -(-used // cols) * wh
-                data = self._fbo[side].read(viewport=(self._kx, 0, cols * ww, h), components=4, attachment=0, dtype="f4")
-                areas[side] = np.frombuffer(data, dtype="f4").reshape(h, cols * ww, 4)
-            c, r = slot % cols, slot // cols
-            s = areas[side][r * wh + rows, c * ww + cols_].sum(axis=0, dtype=np.float64)
-            if not np.all(np.isfinite(s)):
-                bad = t0 + b
-                break
+        sums = np.empty((bands, 4))
+        for first in (0, 1):  # the steps whose slots side sides[first] holds: first, first + 2, ...
+            band = np.arange(first, bands, 2)
+            if not len(band):
+                continue
+            slot = band // 2
+            h = -(-(int(slot[-1]) + 1) // cols) * wh  # the rows of the band area those slots use
+            data = self._fbo[sides[first]].read(viewport=(self._kx, 0, cols * ww, h), components=4,
+                                                attachment=0, dtype="f4")
+            area = np.frombuffer(data, dtype="f4").reshape(h, cols * ww, 4)
+            texels = area[(slot // cols * wh)[:, None] + rows, (slot % cols * ww)[:, None] + cols_]
+            sums[band] = texels.sum(axis=1, dtype=np.float64)  # (steps, 4), each step's in float64
+        finite = np.isfinite(sums).all(axis=1)
+        good = bands if finite.all() else int(np.argmin(finite))
+        out = []
+        for b in range(good):
+            s = sums[b]
             forces = {}
             if "momentum_exchange" in self._models:
                 forces["momentum_exchange"] = (float(s[0] + s[2] + kx + impulses[b][0]),
@@ -595,7 +598,7 @@ class GLSolver(Solver):
             if "momentum_exchange_classic" in self._models:
                 forces["momentum_exchange_classic"] = (float(s[0] + kx), float(s[1] + ky))
             out.append(forces)
-        return out, bad
+        return out, (None if good == bands else t0 + good)
 
     def _band_windows(self, sides, bands: int) -> list[np.ndarray]:
         """The stored g (9, h, w) of each step's body window from the band areas: step b's
