@@ -84,17 +84,29 @@ class BodyRaster:
 
     def crop(self, box) -> tuple[np.ndarray, np.ndarray]:
         """(solid (h, w) bool, q (9, h, w) float64) over box (x0, y0, x1, y1), zero outside `box`."""
+        solid, (dst, src) = self._crop_solid(box)
         x0, y0, x1, y1 = box
-        solid = np.zeros((y1 - y0, x1 - x0), dtype=bool)
         q = np.zeros((self.box_q.shape[0], y1 - y0, x1 - x0), dtype=np.float64)
-        bx0, by0, bx1, by1 = self.box
-        ox0, oy0, ox1, oy1 = max(x0, bx0), max(y0, by0), min(x1, bx1), min(y1, by1)
-        if ox0 < ox1 and oy0 < oy1:
-            dst = (slice(oy0 - y0, oy1 - y0), slice(ox0 - x0, ox1 - x0))
-            src = (slice(oy0 - by0, oy1 - by0), slice(ox0 - bx0, ox1 - bx0))
-            solid[dst] = self.box_solid[src]
+        if dst is not None:
             q[(slice(None),) + dst] = self.box_q[(slice(None),) + src]
         return solid, q
+
+    def crop_solid(self, box) -> np.ndarray:
+        """The solid mask (h, w) alone over box, as crop(box)[0] (a move's refill needs no q)."""
+        return self._crop_solid(box)[0]
+
+    def _crop_solid(self, box):
+        """(solid over box, (dst, src) slices of the overlap with self.box, or (None, None))."""
+        x0, y0, x1, y1 = box
+        solid = np.zeros((y1 - y0, x1 - x0), dtype=bool)
+        bx0, by0, bx1, by1 = self.box
+        ox0, oy0, ox1, oy1 = max(x0, bx0), max(y0, by0), min(x1, bx1), min(y1, by1)
+        if not (ox0 < ox1 and oy0 < oy1):
+            return solid, (None, None)
+        dst = (slice(oy0 - y0, oy1 - y0), slice(ox0 - x0, ox1 - x0))
+        src = (slice(oy0 - by0, oy1 - by0), slice(ox0 - bx0, ox1 - bx0))
+        solid[dst] = self.box_solid[src]
+        return solid, (dst, src)
 
     def _full_arrays(self):
         if self._full is None:

@@ -154,8 +154,8 @@ def move_body(old, new, config, read_window, write_nodes):
         return 0.0, 0.0
     x0, y0, x1, y1 = expand_box(box, 1, config.nx, config.ny)
     shape = (y1 - y0, x1 - x0)
-    old_solid = old.raster.crop((x0, y0, x1, y1))[0] if old else np.zeros(shape, bool)
-    new_solid = new.raster.crop((x0, y0, x1, y1))[0] if new else np.zeros(shape, bool)
+    old_solid = old.raster.crop_solid((x0, y0, x1, y1)) if old else np.zeros(shape, bool)
+    new_solid = new.raster.crop_solid((x0, y0, x1, y1)) if new else np.zeros(shape, bool)
     motion = new if new is not None else old
     f = read_window(x0, y0, x1, y1)
     impulse, changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0,

@@ -103,6 +103,7 @@ class LinkSums:
     texels: np.ndarray
     layout: tuple
     body: object
+    rows: int = 0  # rows of the slots the rectangles cover (rewritten only when this changes)
 
     def release(self) -> None:
         for obj in (self.vao, self.vbo, self.table):
@@ -554,9 +555,11 @@ class GLSolver(Solver):
         entries[:len(texel), :2] = texel
         entries[:len(texel), 2] = 1.0
         sums.table.write(entries.tobytes(), viewport=(0, 0, ww, rows))
-        slots = [(self._kx + c * ww, r * wh, self._kx + (c + 1) * ww, r * wh + rows)
-                 for r in range(self.ny // wh) for c in range(cols)]
-        sums.vbo.write(_triangles(slots).tobytes())
+        if rows != sums.rows:
+            slots = [(self._kx + c * ww, r * wh, self._kx + (c + 1) * ww, r * wh + rows)
+                     for r in range(self.ny // wh) for c in range(cols)]
+            sums.vbo.write(_triangles(slots).tobytes())
+            sums.rows = rows
         sums.texels, sums.body = texel, self.body
 
     def _sums_forces(self) -> bool:
