@@ -1,5 +1,11 @@
-"""`feelflow bench --variants`: the ratios it takes within each interleaved round
-(app/commands/bench_solver.py `against_numpy`)."""
+"""`feelflow bench`: its alternating rounds, and `--variants`: the ratios it takes within each
+interleaved round (app/commands/bench_solver.py `against_numpy`)."""
+import json
+
+import numpy as np
+import pytest
+
+from app.cli import main as cli_main
 from app.commands.bench_solver import BOX, DEFAULT_TUNNEL, NO_BODY_ONE_CALL, NUMPY_TUNNEL, STAIRCASE, against_numpy
 
 
@@ -37,3 +43,25 @@ def test_cpu_work_cost_is_the_added_time_per_call_within_each_round():
     assert out["after the read"]["samples"][0] == 5.0
     assert out["before the read (GPU busy)"]["samples"] == [0.0, 0.0]  # fully overlapped
     assert cpu_work_cost({DEFAULT_TUNNEL: [50.0]}, nodes) == {}  # runs not there are left out
+
+
+def test_bench_alternates_the_backends_in_rounds_and_takes_the_median_ratio(tmp_path, capsys):
+    """`feelflow bench --rounds N`: every scene and grid on both backends in N alternating rounds;
+    a row is the median of its rounds, a speedup the median of the per-round ratios."""
+    out = tmp_path / "bench.json"
+    assert cli_main(["bench", "--quick", "--rounds", "2", "--seconds", "0.01", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["rounds"] == 2 and len(data["results"]) == 12
+    for row in data["results"]:
+        if "error" in row:  # no EGL context here: the numpy rows stay
+            continue
+        assert len(row["rounds_mlups"]) == 2 and row["mlups"] == pytest.approx(np.median(row["rounds_mlups"]), abs=0.01)
+    for key, per_round in data["speedups_per_round"].items():
+        assert len(per_round) == 2 and data["speedups"][key] == round(float(np.median(per_round)), 2)
+    assert "rounds:" in capsys.readouterr().out
+
+
+def test_bench_refuses_fewer_than_one_round(capsys):
+    assert cli_main(["bench", "--rounds", "0"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["feelflow: --rounds: must be at least 1, got 0"]

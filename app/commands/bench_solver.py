@@ -5,7 +5,9 @@ an empty periodic box and a tunnel with a moving cylinder (moved every 10 steps 
 does per frame, the reference force computed every step), at 256x128, 512x256 and 1024x512.
 For each: MLUPS (million lattice-node updates per second), steps per second and, for gl, the
 renderer; also MLUPS per CPU-second of this process (all its threads, llvmpipe's included),
-which a busy machine disturbs less than the wall clock. It also measures this machine's memory-copy bandwidth (numpy copy, bytes read +
+which a busy machine disturbs less than the wall clock. Each scene runs in `--rounds`
+alternating rounds (numpy, gl, numpy, gl, ...): rows give the medians, speedups the median of
+the per-round ratios. It also measures this machine's memory-copy bandwidth (numpy copy, bytes read +
 written per second) and reports each MLUPS as a fraction of the D2Q9 bound, 72 bytes per node
 and step (9 float32 read + 9 written). GPU work is timed up to `glFinish`.
 
@@ -137,54 +139,78 @@ def _gl_context():
         return None, str(exc)
 
 
-def run_bench(quick: bool, seconds: float | None):
+def run_bench(quick: bool, seconds: float | None, rounds: int | None = None):
+    """Every scene and grid on both backends, in `rounds` alternating rounds (numpy, gl, numpy,
+    gl, ...; default 3, --quick 1), each `seconds` long: a row holds the medians of its rounds
+    and each round's MLUPS, and a speedup is the median of the per-round ratios, so that a slow
+    spell of this shared machine slows both backends of a round alike."""
     from solver.backend import create_solver
 
     seconds = seconds if seconds is not None else (0.3 if quick else 2.0)
+    rounds = rounds if rounds is not None else (1 if quick else 3)
+    if rounds < 1:
+        raise UserError(f"--rounds: must be at least 1, got {rounds}")
     bandwidth = copy_bandwidth(64 if quick else 512)
     bound = bandwidth / BYTES_PER_NODE_STEP / 1e6
     ctx, gl_error = _gl_context()
     renderer = ctx.info.get("GL_RENDERER") if ctx else None
-    rows = []
+    rows, ratios = [], {}
     for scene in SCENES:
         for nx, ny in GRIDS:
+            runs, samples, here = {}, {}, []
             for backend in ("numpy", "gl"):
                 row = {"scene": scene, "backend": backend, "grid": f"{nx}x{ny}", "nx": nx, "ny": ny}
+                here.append(row)
                 if backend == "gl" and ctx is None:
                     row["error"] = gl_error
+                    continue
+                solver = create_solver(backend, scene_config(scene, nx, ny), **({"ctx": ctx} if backend == "gl" else {}))
+                runs[backend] = SceneRun(scene, solver)
+                runs[backend].advance(20)  # shader compile, first draw, caches
+                samples[backend] = []
+            for _ in range(rounds):
+                for backend, run in runs.items():
+                    samples[backend].append(measure(run, seconds, warmup=0))
+            for row in here:
+                if "error" in row:
                     rows.append(row)
                     continue
-                cfg = scene_config(scene, nx, ny)
-                solver = create_solver(backend, cfg, **({"ctx": ctx} if backend == "gl" else {}))
-                row.update(measure(SceneRun(scene, solver), seconds))
+                backend = row["backend"]
+                runs[backend].solver.close()
+                row.update(_median_of_rounds(samples[backend]))
                 row["fraction_of_bound"] = round(row["mlups"] / bound, 4)
                 if backend == "gl":
                     row["renderer"] = renderer
-                solver.close()
                 rows.append(row)
                 print(_format_row(row), flush=True)
+            if len(samples) == 2:
+                ratios[f"{scene} {nx}x{ny}"] = [round(g["mlups"] / n["mlups"], 3)
+                                               for n, g in zip(samples["numpy"], samples["gl"])]
     return {"machine": machine(), "renderer": renderer, "copy_bandwidth_gb_s": round(bandwidth / 1e9, 2),
             "d2q9_bound_mlups": round(bound, 1), "bytes_per_node_step": BYTES_PER_NODE_STEP,
-            "seconds_per_case": seconds, "results": rows, "speedups": _speedups(rows)}
+            "seconds_per_case": seconds, "rounds": rounds, "results": rows,
+            "speedups": {k: round(float(np.median(v)), 2) for k, v in ratios.items()},
+            "speedups_per_round": ratios}
 
 
-def _speedups(rows):
-    out = {}
-    for r in rows:
-        if r["backend"] == "gl" and "mlups" in r:
-            ref = next((x for x in rows if x["backend"] == "numpy" and x["scene"] == r["scene"]
-                        and x["grid"] == r["grid"] and "mlups" in x), None)
-            if ref:
-                out[f"{r['scene']} {r['grid']}"] = round(r["mlups"] / ref["mlups"], 2)
-    return out
+def _median_of_rounds(samples: list[dict]) -> dict:
+    """A row's figures from its rounds (`measure` results): medians, totals, each round's MLUPS."""
+    def median(key):
+        return round(float(np.median([m[key] for m in samples])), 2)
+
+    return {"steps": sum(m["steps"] for m in samples), "seconds": round(sum(m["seconds"] for m in samples), 4),
+            "mlups": median("mlups"), "steps_per_s": round(float(np.median([m["steps_per_s"] for m in samples])), 1),
+            "mlups_per_cpu_s": median("mlups_per_cpu_s"), "rounds_mlups": [m["mlups"] for m in samples]}
 
 
 def _format_row(r) -> str:
     if "error" in r:
         return f"{r['scene']:7s} {r['grid']:>9s} {r['backend']:6s} unavailable: {r['error']}"
+    rounds = r.get("rounds_mlups", [])
+    each = f"  rounds: {' '.join(f'{v:.1f}' for v in rounds)}" if len(rounds) > 1 else ""
     return (f"{r['scene']:7s} {r['grid']:>9s} {r['backend']:6s} {r['mlups']:8.1f} MLUPS "
             f"{r['steps_per_s']:9.1f} steps/s  {100 * r['fraction_of_bound']:5.1f} % of bound  "
-            f"({r['mlups_per_cpu_s']:.1f} MLUPS per CPU-second)")
+            f"({r['mlups_per_cpu_s']:.1f} MLUPS per CPU-second){each}")
 
 
 # --- tuning variants (docs/performance.md) ---------------------------------------------------
@@ -493,12 +519,14 @@ def main(args) -> int:
         m = machine()
         print(f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}, Python {m['python']}, "
               f"numpy {m['numpy']}, LP_NUM_THREADS {m['LP_NUM_THREADS']}")
-        result = run_bench(quick, seconds)
+        result = run_bench(quick, seconds, getattr(args, "rounds", None))
         print(f"renderer: {result['renderer']}")
         print(f"memory copy bandwidth: {result['copy_bandwidth_gb_s']} GB/s (read + write) -> D2Q9 bound "
               f"{result['d2q9_bound_mlups']} MLUPS at {BYTES_PER_NODE_STEP} bytes per node and step")
         for key, ratio in result["speedups"].items():
-            print(f"gl / numpy, {key}: {ratio}x")
+            each = result["speedups_per_round"][key]
+            print(f"gl / numpy, {key}: {ratio}x" + (f" (median of the rounds: {', '.join(f'{v:.2f}' for v in each)})"
+                                                   if len(each) > 1 else ""))
     if getattr(args, "json", None):
         from app.files import write_json_atomic
 
