@@ -67,17 +67,22 @@ def test_steps_ignore_the_host_gl_state(gl_context, request):
     ctx.enable_only(moderngl.NOTHING)
 
 
+def _diverged_step(s, index, value, steps) -> int:
+    """Put `value` into population (i, y, x) = index, run `steps`: the step SolverDiverged names."""
+    f = s.distributions()
+    f[index] = value
+    s.set_distributions(f)
+    with pytest.raises(SolverDiverged) as err:
+        s.step(steps)
+    return err.value.step
+
+
 @pytest.mark.parametrize("check", ["tiles", "discard"])
 def test_divergence_raises_with_the_step(gl_context, check):
     cfg = FlowConfig(nx=40, ny=32, x_boundary="periodic", y_boundary="periodic")
     s = create_solver("gl", cfg, ctx=gl_context, tuning={"divergence": check})
     s.step(5)
-    f = s.distributions()
-    f[3, 10, 37] = np.inf
-    s.set_distributions(f)
-    with pytest.raises(SolverDiverged) as err:
-        s.step(10)
-    assert err.value.step == 6
+    assert _diverged_step(s, (3, 10, 37), np.inf, 10) == 6
 
 
 def test_discard_check_counts_the_body_window_drawn_over_the_interior(gl_context):
@@ -89,12 +94,7 @@ def test_discard_check_counts_the_body_window_drawn_over_the_interior(gl_context
     s.step(12)  # healthy: no false alarm
     s.set_body(Cylinder(6.0, x=20.0, y=16.3), velocity=(0.0, 0.02))
     s.step(12)
-    f = s.distributions()
-    f[2, 16, 40] = np.nan
-    s.set_distributions(f)
-    with pytest.raises(SolverDiverged) as err:
-        s.step(5)
-    assert err.value.step == 25
+    assert _diverged_step(s, (2, 16, 40), np.nan, 5) == 25
 
 
 def test_body_upload_touches_only_the_window(request):
