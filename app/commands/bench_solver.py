@@ -223,7 +223,9 @@ BOX = "empty periodic box (default)"
 FIXED_ONE_CALL = "default, cylinder not moved, one step(n) call a round"
 FIXED_NO_FORCE_ONE_CALL = "default, cylinder not moved, no force model, one step(n) call a round"
 NO_BODY_ONE_CALL = "tunnel without a body (edges and sponge only), one step(n) call a round"
-STAIRCASE = (("free moves and call ends (not moved, one call) / numpy", FIXED_ONE_CALL),
+FIXED_STEP_CALLS = "default, cylinder not moved, step(10) calls"
+STAIRCASE = (("free moves (not moved, step(10) calls) / numpy", FIXED_STEP_CALLS),
+             ("free moves and call ends (not moved, one call) / numpy", FIXED_ONE_CALL),
              ("... and no force model / numpy", FIXED_NO_FORCE_ONE_CALL),
              ("... and no body (edges, sponge) / numpy", NO_BODY_ONE_CALL))
 NUMPY_TUNNEL = "numpy backend, the same moving tunnel (the reference)"
@@ -262,8 +264,9 @@ def against_numpy(wall: dict) -> dict:
     today; only a faster pass or renderer could.
 
     Between the two, where those runs are there (STAIRCASE), the tunnel with parts taken away:
-    the cylinder not moved and all steps in one call (what a design with moves and read-backs
-    that never drain llvmpipe's queue could reach at best), then also without a force model,
+    the cylinder not moved, in the same step(10) calls (what a body path whose moves cost
+    nothing could reach), then with all steps in one call (what a design with moves and
+    read-backs that never drain llvmpipe's queue could reach at best), then also without a force model,
     then without the body: each ratio bounds what the tunnel reaches if what is taken away
     cost nothing, so the steps between them price each part against the target."""
     ref = wall[NUMPY_TUNNEL]
@@ -324,7 +327,7 @@ def run_variants(quick: bool, seconds: float | None):
     no_force = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx))
     no_force.solver.enable_force_models([])
     runs["default, no force model (no window readback)"] = no_force
-    runs["default, cylinder not moved, step(10) calls"] = SceneRun(
+    runs[FIXED_STEP_CALLS] = SceneRun(
         "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False)
     for name, forces, body in ((FIXED_ONE_CALL, True, True), (FIXED_NO_FORCE_ONE_CALL, False, True),
                                (NO_BODY_ONE_CALL, False, False)):
