@@ -332,20 +332,19 @@ class GLSolver(Solver):
         self._fragments_per_step = sum((x1 - x0) * (y1 - y0) for _, rects in regions for x0, y0, x1, y1 in rects)
         w, h = self._tex_size
         draws = []
+        scissor = self.tuning["draw"] == "scissor"
         for key, rects in regions:
-            if self.tuning["draw"] == "scissor":
-                data, scissors = _triangles([(0, 0, 2 * w, 2 * h)])[[0, 1, 5]], rects
-            else:
-                data, scissors = _triangles(rects), None
+            # scissor: one triangle over the texture, the same for every variant and pose
+            data = _triangles([(0, 0, 2 * w, 2 * h)])[[0, 1, 5]] if scissor else _triangles(rects)
             if key not in self._vaos:
                 vbo = self.ctx.buffer(data.tobytes())
                 self._vaos[key] = (self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")]), vbo)
-            vao, vbo = self._vaos[key]
-            if scissors is None:
+            elif not scissor:
+                vao, vbo = self._vaos[key]
                 vbo.orphan(data.nbytes)
                 vbo.write(data.tobytes())
                 vao.vertices = len(data)
-            draws.append((vao, scissors))
+            draws.append((self._vaos[key][0], rects if scissor else None))
         self._draws = draws
 
     def _render_regions(self):

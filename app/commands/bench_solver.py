@@ -195,12 +195,10 @@ def run_bench(quick: bool, seconds: float | None, rounds: int | None = None):
 
 def _median_of_rounds(samples: list[dict]) -> dict:
     """A row's figures from its rounds (`measure` results): medians, totals, each round's MLUPS."""
-    def median(key):
-        return round(float(np.median([m[key] for m in samples])), 2)
-
+    medians = {key: round(float(np.median([m[key] for m in samples])), 2)
+               for key in ("mlups", "steps_per_s", "mlups_per_cpu_s")}
     return {"steps": sum(m["steps"] for m in samples), "seconds": round(sum(m["seconds"] for m in samples), 4),
-            "mlups": median("mlups"), "steps_per_s": round(float(np.median([m["steps_per_s"] for m in samples])), 1),
-            "mlups_per_cpu_s": median("mlups_per_cpu_s"), "rounds_mlups": [m["mlups"] for m in samples]}
+            **medians, "rounds_mlups": [m["mlups"] for m in samples]}
 
 
 def _format_row(r) -> str:
