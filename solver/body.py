@@ -52,11 +52,15 @@ def capped_motion(shape, velocity, omega, max_speed):
     return cap_rigid_motion(velocity, omega, radius, max_speed)
 
 
-def node_velocity(shape, velocity, omega, x0, y0, h, w):
-    """u_body at every node of a window, two (h, w) arrays."""
-    py, px = np.mgrid[y0:y0 + h, x0:x0 + w].astype(np.float64)
-    ux, uy = wall_velocity(px, py, (shape.x, shape.y), velocity, omega)
-    return np.broadcast_to(ux, (h, w)).astype(np.float64), np.broadcast_to(uy, (h, w)).astype(np.float64)
+def node_velocity(shape, velocity, omega, x0, y0, nodes):
+    """u_body at the window nodes where the (h, w) mask `nodes` is True (row by row, as
+    boolean indexing orders them), two 1-D arrays; at rest without a shape."""
+    iy, ix = np.nonzero(nodes)
+    if shape is None:
+        return np.zeros(iy.size), np.zeros(iy.size)
+    ux, uy = wall_velocity((ix + x0).astype(np.float64), (iy + y0).astype(np.float64), (shape.x, shape.y),
+                           velocity, omega)
+    return np.broadcast_to(ux, iy.shape).astype(np.float64), np.broadcast_to(uy, iy.shape).astype(np.float64)
 
 
 def _neighbour_sum(field: np.ndarray, wrap: tuple[bool, bool] = (False, False)) -> np.ndarray:
@@ -92,27 +96,27 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
     `shape` gives u_body: the new body, or the old one when it is removed (None: at rest).
     Returns (impulse (Jx, Jy), changed (h, w) bool mask of written nodes).
     """
-    h, w = new_solid.shape
     covered = new_solid & ~old_solid
     uncovered = old_solid & ~new_solid
     if not (covered.any() or uncovered.any()):
         if new_solid.any():
-            ux, uy = node_velocity(shape, velocity, omega, x0, y0, h, w)
-            f[:, new_solid] = equilibrium(np.full(int(new_solid.sum()), RHO0), ux[new_solid], uy[new_solid])
+            ux, uy = node_velocity(shape, velocity, omega, x0, y0, new_solid)
+            f[:, new_solid] = equilibrium(np.full(ux.size, RHO0), ux, uy)
         return (0.0, 0.0), new_solid.copy()
     cx_, cy_ = C[:, 0].astype(np.float64), C[:, 1].astype(np.float64)
     jx = jy = 0.0
     lost = 0.0   # mass the cover/uncover removes from the grid
     if covered.any():
         fc = f[:, covered]
-        jx += float(cx_ @ fc.sum(axis=1))
-        jy += float(cy_ @ fc.sum(axis=1))
+        fc_i = fc.sum(axis=1)
+        jx += float(cx_ @ fc_i)
+        jy += float(cy_ @ fc_i)
         lost += float(fc.sum()) - RHO0 * int(covered.sum())
-    if shape is not None:
-        ux, uy = node_velocity(shape, velocity, omega, x0, y0, h, w)
-    else:
-        ux = uy = np.zeros((h, w))
     body_nodes = (new_solid | old_solid).astype(np.float64)
+    # the equilibria of the uncovered nodes (rho_new) and of the solid ones (RHO0), in one call
+    written = uncovered | new_solid
+    ux, uy = node_velocity(shape, velocity, omega, x0, y0, written)
+    rho_eq = np.full(ux.size, RHO0)
     if uncovered.any():
         rho = f.sum(axis=0)
         donor = ~new_solid & ~uncovered
@@ -120,15 +124,15 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
         rsum, cnt, near_body = _neighbour_sum(np.stack([np.where(donor, rho, 0.0), donor.astype(np.float64),
                                                         body_nodes]), wrap)
         rho_new = np.where(cnt > 0, rsum / np.maximum(cnt, 1), RHO0)[uncovered]
-        uxu, uyu = ux[uncovered], uy[uncovered]
-        f[:, uncovered] = equilibrium(rho_new, uxu, uyu)
+        is_uncovered = uncovered[written]
+        rho_eq[is_uncovered] = rho_new
+        uxu, uyu = ux[is_uncovered], uy[is_uncovered]
         jx -= float((rho_new * uxu).sum())
         jy -= float((rho_new * uyu).sum())
         lost += RHO0 * int(uncovered.sum()) - float(rho_new.sum())
     else:
         near_body = _neighbour_sum(body_nodes, wrap)
-    if new_solid.any():
-        f[:, new_solid] = equilibrium(np.full(int(new_solid.sum()), RHO0), ux[new_solid], uy[new_solid])
+    f[:, written] = equilibrium(rho_eq, ux, uy)
     ring = ~new_solid & (near_body > 0)
     if lost != 0.0 and ring.any():
         fr = f[:, ring]
@@ -136,8 +140,9 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
         scale = 1.0 + (lost / int(ring.sum())) / rho_r
         added = fr * (scale - 1.0)
         f[:, ring] = fr + added
-        jx -= float(cx_ @ added.sum(axis=1))
-        jy -= float(cy_ @ added.sum(axis=1))
+        added_i = added.sum(axis=1)
+        jx -= float(cx_ @ added_i)
+        jy -= float(cy_ @ added_i)
     return (jx, jy), (new_solid | uncovered | ring)
 
 
