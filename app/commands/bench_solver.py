@@ -388,16 +388,23 @@ PROFILE_PARTS = {  # (label, function name, file suffix or None for a built-in m
 def thread_cpu_seconds() -> dict | None:
     """CPU seconds used so far by this process's threads, split into llvmpipe's rasteriser
     threads (named "llvmpipe-N") and the rest (the main thread: Python, and Mesa's draw calls,
-    which bin each step's triangles), from /proc/self/task; None where there is no /proc."""
+    which bin each step's triangles), from /proc/self/task: each thread's schedstat (nanoseconds
+    on a CPU), or where the kernel has none its stat (utime + stime, in clock ticks of 10 ms,
+    too coarse for a short run); None where there is no /proc."""
     try:
         tick = os.sysconf("SC_CLK_TCK")
         out = {"llvmpipe": 0.0, "other": 0.0}
         for tid in os.listdir("/proc/self/task"):
-            with open(f"/proc/self/task/{tid}/stat") as f:
-                fields = f.read().rsplit(")", 1)[1].split()  # after "pid (comm)"
+            try:
+                with open(f"/proc/self/task/{tid}/schedstat") as f:
+                    seconds = int(f.read().split()[0]) / 1e9
+            except (OSError, ValueError, IndexError):
+                with open(f"/proc/self/task/{tid}/stat") as f:
+                    fields = f.read().rsplit(")", 1)[1].split()  # after "pid (comm)"
+                seconds = (int(fields[11]) + int(fields[12])) / tick
             with open(f"/proc/self/task/{tid}/comm") as f:
                 name = f.read().strip()
-            out["llvmpipe" if name.startswith("llvmpipe") else "other"] += (int(fields[11]) + int(fields[12])) / tick
+            out["llvmpipe" if name.startswith("llvmpipe") else "other"] += seconds
         return out
     except (OSError, ValueError, IndexError):
         return None
