@@ -17,6 +17,11 @@
 //     stream_pair, whose fetches the directions with the same row offset share (12 for two
 //     nodes, 9 per node before), through textureOffset() at normalized coordinates and REPEAT
 //     samplers (a fully periodic grid of even width wraps for free).
+//   BODY with LINK_SUMS 1 / 2 (the body's only force model is the Galilean-invariant / the
+//     classic momentum exchange): while streaming the body's links, the variant also sums the
+//     model's link terms (as shaders/link_sums.glsl: S1 + S2, or S1) and adds them to the running
+//     total of the block's steps in the spare channels zw of texture G4 (sums_keep 0 on a
+//     block's first step restarts it); the backend reads them once per block.
 //   TRT, GUO_FORCE, SPONGE: collision operator, Guo body force, outlet sponge (per-column rates).
 //   X_PERIODIC 0/1; Y_MODE 0 no_slip, 1 free_slip, 2 periodic; NX_ODD: nx is odd.
 //   DIVERGENCE_DISCARD 1: a node with a non-finite density discards its fragment (an
@@ -43,6 +48,11 @@ uniform sampler2D QB;          // q[5..8, x]
 #if EDGES || SPONGE
 uniform sampler2D INFLOW;      // inflow profile(iy) in texel (iy, 0)
 uniform float inflow_ramp;     // ramp(t): u_in(iy, t) = ramp(t) profile(iy)
+#endif
+
+#if BODY && LINK_SUMS
+uniform float sums_keep;       // 0: this step starts the block's running total of link sums; 1: adds to it
+vec4 link_sums = vec4(0.0);    // this texel's (S1.x, S1.y, S2.x, S2.y) of the step (link_sums.glsl)
 #endif
 
 layout(location = 0) out vec4 out0;
@@ -235,8 +245,12 @@ void node_update(ivec2 x, inout float gin[9], float own[9], float west[9]) {
 #if BODY
         if ((m & (1u << uint(i))) != 0u) {  // rule a: Bouzidi with the moving-wall term
             float q = qs[ib];
-            gin[i] = bouzidi_incoming(i, q, (m & (1u << uint(8 + i))) != 0u, own[ib], own[i], plain[ib],
-                                      wall_velocity(vec2(x) + q * vec2(C[ib])));
+            vec2 uw = wall_velocity(vec2(x) + q * vec2(C[ib]));
+            gin[i] = bouzidi_incoming(i, q, (m & (1u << uint(8 + i))) != 0u, own[ib], own[i], plain[ib], uw);
+#if LINK_SUMS  // the momentum exchange's terms of this link (link_sums.glsl, add_node)
+            link_sums.xy -= vec2(ci) * (own[ib] + gin[i]);
+            link_sums.zw -= uw * (own[ib] - gin[i]);
+#endif
             continue;
         }
 #endif
@@ -296,4 +310,9 @@ void main() {
     collide(b, xb);
 #endif
     store_pair(a, b);
+#if BODY && LINK_SUMS
+    // G4's zw (unused by the layout) carry the running total: Galilean-invariant S1 + S2, classic S1
+    vec2 step_sums = LINK_SUMS == 1 ? link_sums.xy + link_sums.zw : link_sums.xy;
+    out4.zw = sums_keep * texelFetch(G4, k, 0).zw + step_sums;
+#endif
 }

@@ -3,7 +3,7 @@
 // stored populations node by node. The layout, defined once in solver/gl_layout.py: two nodes
 // per texel, a = (2k, y) and b = (2k + 1, y) in texel (k, y) of five RGBA32F textures,
 //   G0 (g1a g1b g3a g3b)  G1 (g5a g5b g6a g6b)  G2 (g7a g7b g8a g8b)  G3 (g2a g2b g4a g4b)
-//   G4 (g0a g0b  -   - )
+//   G4 (g0a g0b  -   - )  (zw: zero, except in the body window with lbm_step.glsl's LINK_SUMS)
 // so that the directions sharing a row offset share texels when a fragment streams both nodes
 // (lbm_step.glsl, stream_pair: 12 fetches for 2 nodes instead of 18).
 

@@ -44,10 +44,15 @@ API for the app (a QOpenGLWidget sharing this context):
   every step: `solver.backend.SolverDiverged` names the exact step, as in the reference; a
   non-finite body window raises it with the step of that window.
 - Where the only force models are the momentum exchanges (LINK_SUM_MODELS; tuning
-  forces="gpu", the default), the pass sums their links on the GPU instead of copying the
-  window (`shaders/link_sums.glsl`: one RGBA32F texel of partial sums per state texel with a cut
-  link, from a packed list, `LinkSums`), and a block reads back those texels of one attachment
-  of the band area instead of the window's five; the sums are the
+  forces="gpu", the default), their links are summed on the GPU instead of copying the window.
+  With one exchange, the step's pass sums them as it streams them and keeps the block's running
+  total in G4's two spare channels over the body window (lbm_step.glsl LINK_SUMS,
+  `_read_pass_sums`): a block reads those texels of one attachment, and a step draws no extra
+  pass. With both (four sums a texel), a link-sum pass in the step's scene writes them into the
+  band area (`shaders/link_sums.glsl`: one RGBA32F texel of partial sums per state texel with a
+  cut link, from a packed list, `LinkSums`; tuning forces="pass" takes it for one exchange too),
+  and a block reads back those texels of one attachment of the band area instead of the
+  window's five; the sums are the
   Galilean-invariant and classic momentum exchange of solver/forces/momentum_exchange.py, from
   the same stored populations and the same Bouzidi rule as the step (forces="window": the
   window and the models' own code, as for every other model). (An occlusion query counting
@@ -154,7 +159,10 @@ class GLSolver(Solver):
     """docs/algorithm.md on the GPU (fragment shaders), float32; see the module docstring."""
 
     name = "gl"
-    #: default tuning (docs/performance.md measures each choice)
+    #: default tuning (docs/performance.md measures each choice). forces: "gpu", the momentum
+    #: exchanges' link sums on the GPU (one model: summed by the step's own pass into G4's spare
+    #: channels; both: by the link-sum pass into the band area), "pass" (always that pass) or
+    #: "window" (the body window copied and every model's own code)
     TUNING = {"split": True, "divergence": "tiles", "check_every": CHECK_EVERY, "window": "state",
               "draw": "scissor", "forces": "gpu"}
     #: called once per block of steps after its draws are queued and before its results are
@@ -238,6 +246,8 @@ class GLSolver(Solver):
         self._band_copy = None  # (vao, vbo, slot layout) of the window copy into the band area
         self._band_sums = None  # LinkSums: the link sums' draw (LINK_SUM_MODELS)
         self._block_sums = False  # the block being drawn sums links instead of copying windows
+        self._link_sums = 0  # lbm_step.glsl LINK_SUMS of the body variant: 0, 1 Galilean, 2 classic
+        self._sums_keep = None  # the body programs' sums_keep uniform as last set
         self._pending, self._idle_queries = [], []  # divergence="discard": (step, query)
 
         self._impulse = (0.0, 0.0)
@@ -255,16 +265,18 @@ class GLSolver(Solver):
                 prog[name].value = value
 
     def _program(self, key):
-        """The step variant for region `key` = (body, edges, sponge), compiled on first use."""
-        if key not in self._programs:
-            body, edges, sponge = key
-            defines = {**self._defines, "BODY": body, "EDGES": edges, "SPONGE": sponge}
+        """The step variant for region `key` = (body, edges, sponge), compiled on first use; the
+        body variants with the current link-sum mode (self._link_sums)."""
+        body, edges, sponge = key
+        link = self._link_sums if body else 0
+        if (key, link) not in self._programs:
+            defines = {**self._defines, "BODY": body, "EDGES": edges, "SPONGE": sponge, "LINK_SUMS": link}
             prog = create_program(self.ctx, "rect_vertex.glsl", "lbm_step.glsl", defines)
             self._uniforms(prog, **self._uniform_values)
-            self._programs[key] = prog
+            self._programs[(key, link)] = prog
             if body:
                 self._upload_body_uniforms()
-        return self._programs[key]
+        return self._programs[(key, link)]
 
     def _regions(self, window):
         """{(body, edges, sponge): [rectangles]}: which variant draws which part of the grid.
@@ -333,19 +345,47 @@ class GLSolver(Solver):
         w, h = self._tex_size
         draws = []
         scissor = self.tuning["draw"] == "scissor"
+        self._body_rects = []  # the body variant's rectangles: where LINK_SUMS keeps its totals
         for key, rects in regions:
             # scissor: one triangle over the texture, the same for every variant and pose
             data = _triangles([(0, 0, 2 * w, 2 * h)])[[0, 1, 5]] if scissor else _triangles(rects)
-            if key not in self._vaos:
+            vkey = (key, self._link_sums if key[0] else 0)
+            if vkey not in self._vaos:
                 vbo = self.ctx.buffer(data.tobytes())
-                self._vaos[key] = (self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")]), vbo)
+                self._vaos[vkey] = (self.ctx.vertex_array(self._program(key), [(vbo, "2f", "in_pos")]), vbo)
             elif not scissor:
-                vao, vbo = self._vaos[key]
+                vao, vbo = self._vaos[vkey]
                 vbo.orphan(data.nbytes)
                 vbo.write(data.tobytes())
                 vao.vertices = len(data)
-            draws.append((self._vaos[key][0], rects if scissor else None))
+            draws.append((self._vaos[vkey][0], rects if scissor else None))
+            if key[0]:
+                self._body_rects += rects
         self._draws = draws
+        self._sums_keep = None
+
+    def _link_sum_mode(self) -> int:
+        """lbm_step.glsl's LINK_SUMS for the enabled models: 1 (2) where the Galilean-invariant
+        (classic) momentum exchange is the body's only force model and tuning forces="gpu"; 0 else
+        (both exchanges: the link-sum pass; other models: the window; divergence="discard" keeps
+        no replay to find a bad step's sums)."""
+        if self.tuning["forces"] != "gpu" or self.body is None or self._discard:
+            return 0
+        return {("momentum_exchange",): 1, ("momentum_exchange_classic",): 2}.get(tuple(self._models), 0)
+
+    def _use_link_sum_mode(self, mode: int) -> None:
+        """Switch the body variant's LINK_SUMS (its programs and vertex arrays are kept per mode)."""
+        if mode != self._link_sums:
+            self._link_sums = mode
+            self._draw_regions = None
+            self._set_rects(None if self.body is None else self.body.raster.window)
+
+    def _set_sums_keep(self, keep: float) -> None:
+        if keep != self._sums_keep:
+            for (key, link), prog in self._programs.items():
+                if key[0] and link:
+                    self._uniforms(prog, sums_keep=keep)
+            self._sums_keep = keep
 
     def _render_regions(self):
         for vao, scissors in self._draws:
@@ -362,7 +402,7 @@ class GLSolver(Solver):
         centre = (0.0, 0.0) if b is None else (float(b.shape.x), float(b.shape.y))
         velocity = (0.0, 0.0) if b is None else tuple(float(v) for v in b.velocity)
         omega = 0.0 if b is None else float(b.omega)
-        for key, prog in self._programs.items():
+        for (key, _), prog in self._programs.items():
             if key[0]:
                 self._uniforms(prog, body_velocity=velocity, body_omega=omega, body_centre=centre)
         if self._band_sums is not None:
@@ -383,7 +423,7 @@ class GLSolver(Solver):
         r = float(ramp(t, cfg.inflow_ramp_steps))
         if self._uniform_values.get("inflow_ramp") != r:  # constant once the ramp is over
             self._uniform_values["inflow_ramp"] = r  # also for programs compiled later
-            for key, prog in self._programs.items():
+            for (key, _), prog in self._programs.items():
                 if key[1] or key[2]:  # edges (the inlet), sponge (the absorbing layer's target)
                     self._uniforms(prog, inflow_ramp=r)
 
@@ -444,10 +484,12 @@ class GLSolver(Solver):
         n = int(n)
         sums = {name: [0.0, 0.0] for name in self._models}
         done = 0
+        self._use_link_sum_mode(self._link_sum_mode())
         while done < n:
             with_forces = bool(self._models) and self.body is not None
-            slots = self._band_slots() if with_forces else 0
-            k = min(n - done, self._check_every, self._ensure_atlas(with_forces and not slots))
+            in_pass = with_forces and self._link_sums > 0  # the step's own pass sums the links
+            slots = self._band_slots() if with_forces and not in_pass else 0
+            k = min(n - done, self._check_every, self._ensure_atlas(with_forces and not slots and not in_pass))
             if slots:
                 k = min(k, 2 * slots)
             t0, start, impulses = self.time, self._cur, []
@@ -458,8 +500,10 @@ class GLSolver(Solver):
                 impulses.append(self._impulse)
                 self._impulse = (0.0, 0.0)
                 src = self._cur
+                if in_pass:
+                    self._set_sums_keep(0.0 if band == 0 else 1.0)
                 self._draw_step(others[band % 2], band // 2 if slots else None)
-                if slots:
+                if slots or in_pass:
                     continue
                 if with_forces and self._window_mode == "read":
                     read_now.append(self._window(src, impulses[-1]))
@@ -471,15 +515,18 @@ class GLSolver(Solver):
             if self.before_read is not None:
                 self.before_read()
             try:
-                windows = self._resolve_checks(t0, k, impulses if with_forces and not read_now else None,
-                                               others if slots else None)
+                windows = self._resolve_checks(t0, k, impulses if with_forces and not read_now and not in_pass
+                                               else None, others if slots else None)
                 windows = read_now or windows
+                if in_pass:
+                    windows = [self._pass_sums_forces(k, impulses)]
             except SolverDiverged as exc:
                 if exc.step == self.time and not self._discard:  # only the final state is known bad
-                    self._replay(start, t0, k)
+                    self._replay(start, t0, k, sums=in_pass)
                 raise
-            for win in windows:  # a BodyWindow, or (block_sums) the step's forces already
-                forces = win if self._block_sums else {name: model.compute(win) for name, model in self._models.items()}
+            for win in windows:  # a BodyWindow, or (block_sums, in_pass) forces already
+                forces = (win if self._block_sums or in_pass else
+                          {name: model.compute(win) for name, model in self._models.items()})
                 for name, (fx, fy) in forces.items():
                     sums[name][0] += fx
                     sums[name][1] += fy
@@ -563,8 +610,8 @@ class GLSolver(Solver):
 
     def _sums_forces(self) -> bool:
         """Whether the enabled force models are all link sums the pass computes (LINK_SUM_MODELS)."""
-        return (self.tuning["forces"] == "gpu" and bool(self._models) and set(self._models) <= LINK_SUM_MODELS
-                and self.body is not None)
+        return (self.tuning["forces"] in ("gpu", "pass") and bool(self._models)
+                and set(self._models) <= LINK_SUM_MODELS and self.body is not None)
 
     def _band_link_forces(self, sides, bands: int, impulses, t0: int):
         """Each step's forces {model: (fx, fy)} from its slot of link sums (shaders/link_sums.glsl)
@@ -602,6 +649,32 @@ class GLSolver(Solver):
             out.append(forces)
         return out, (None if good == bands else t0 + good)
 
+    def _read_pass_sums(self) -> np.ndarray:
+        """The running total of link sums (LINK_SUMS) of the current side: channels zw of
+        texture G4 over the body variant's rectangles, summed in float64."""
+        total = np.zeros(2)
+        for x0, y0, x1, y1 in self._body_rects:
+            data = self._fbo[self._cur].read(viewport=(x0, y0, x1 - x0, y1 - y0), components=4,
+                                             attachment=TEXTURES - 1, dtype="f4")
+            total += np.frombuffer(data, dtype="f4").reshape(-1, 4)[:, 2:].sum(axis=0, dtype=np.float64)
+        return total
+
+    def _pass_sums_forces(self, bands: int, impulses) -> dict:
+        """The forces summed over the block's `bands` steps from the step pass's link sums
+        (LINK_SUMS 1: Galilean-invariant S1 + S2 per step, 2: classic S1), plus the links'
+        constant K each step and, Galilean-invariant, each step's cover/uncover impulse (as
+        _band_link_forces). Non-finite sums raise SolverDiverged at the block's end, which the
+        caller replays to find the step."""
+        s = self._read_pass_sums()
+        if not np.all(np.isfinite(s)):
+            raise SolverDiverged(self.time, "non-finite populations around the body")
+        i = self.body.links.i
+        kx, ky = (-2.0 * RHO0 * (W[i, None] * C[i]).sum(axis=0)) if len(i) else (0.0, 0.0)
+        fx, fy = float(s[0] + bands * kx), float(s[1] + bands * ky)
+        if self._link_sums == 2:
+            return {"momentum_exchange_classic": (fx, fy)}
+        return {"momentum_exchange": (fx + sum(j[0] for j in impulses), fy + sum(j[1] for j in impulses))}
+
     def _band_windows(self, sides, bands: int) -> list[np.ndarray]:
         """The stored g (9, h, w) of each step's body window from the band areas: step b's
         window is slot b // 2 of side sides[b % 2]; each side's used rows are read once."""
@@ -621,14 +694,19 @@ class GLSolver(Solver):
             out.append(nodes[:, :, lo:lo + x1 - x0])
         return out
 
-    def _replay(self, start: int, t0: int, k: int):
-        """Rerun the k steps after time t0 from side `start`, checking each state: raises
-        SolverDiverged with the first step whose state is not finite (the GPU is deterministic)."""
+    def _replay(self, start: int, t0: int, k: int, sums: bool = False):
+        """Rerun the k steps after time t0 from side `start`, checking each state (and, `sums`:
+        each step's link sums, LINK_SUMS): raises SolverDiverged with the first step whose
+        state (or body window) is not finite (the GPU is deterministic)."""
         end = self.time
         self._cur, self.time = start, t0
         others = [side for side in range(3) if side != start]
         for band in range(k):
+            if sums:
+                self._set_sums_keep(0.0)
             self._draw_step(others[band % 2])
+            if sums and not np.all(np.isfinite(self._read_pass_sums())):
+                raise SolverDiverged(self.time - 1, "non-finite populations around the body")
             self._queue_checks(0, None, tiles=True)
             if not self._tiles_finite(0):
                 raise SolverDiverged(self.time, "density is no longer finite")

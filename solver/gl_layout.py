@@ -9,7 +9,9 @@ directions of texture t, channels (i_a, i_b, j_a, j_b):
 Directions with the same row offset share a texture, so one fragment streams both of its nodes
 with 12 texel fetches instead of 18 and writes 5 texels instead of 6 (docs/performance.md;
 `shaders/paired_layout.glsl` is the same table for the shaders). An odd nx leaves node b of the
-last texel column unused (kept at zero, rest).
+last texel column unused (kept at zero, rest). G4's channels 2, 3 hold no population: zero,
+except over the body window, where the step's pass keeps the running total of the momentum
+exchange's link sums (shaders/lbm_step.glsl, LINK_SUMS; `unpack` ignores them).
 """
 from __future__ import annotations
 

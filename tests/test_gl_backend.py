@@ -130,10 +130,10 @@ def test_blocks_of_steps_give_the_forces_and_state_of_single_steps(gl_context, w
     moves included, as single steps whose window is read directly. window="state" (default):
     each step's pass copies the window into a slot of its destination's band area (10 slots a
     side here, blocks of 20); "atlas": a separate pass per step (blocks of 32 + 8). The models
-    run on the windows here (forces="window"); the link sums on the GPU are the next test."""
+    run on the windows here (forces="window"); the link sums on the GPU are the next tests."""
     cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)
     runs = []
-    for tuning in ({"window": window, "forces": "window"}, {"check_every": 1, "window": "read"}):
+    for tuning in ({"window": window, "forces": "window"}, {"check_every": 1, "window": "read", "forces": "window"}):
         s = create_solver("gl", cfg, ctx=gl_context, tuning=tuning)
         s.enable_force_models(["momentum_exchange"])
         s.set_body(Cylinder(6.0, x=20.0, y=16.0))
@@ -148,11 +148,12 @@ def test_blocks_of_steps_give_the_forces_and_state_of_single_steps(gl_context, w
 
 
 def test_link_sums_on_the_gpu_give_the_momentum_exchanges_of_the_window(gl_context):
-    """forces="gpu" (the default where only momentum exchanges are enabled): the step's pass sums
-    the links (shaders/link_sums.glsl) instead of copying the window for the models' code. Both
-    forms, on a body moved, turned and spun between blocks (Bouzidi links of both kinds, moving
-    wall, cover/uncover impulses), agree with the models on the window to float32 round-off of
-    the sums (1e-5 of the largest force; measured 2.8e-7), and the state is the same bit for bit."""
+    """forces="gpu" (the default where only momentum exchanges are enabled) with both exchanges:
+    the link-sum pass sums the links (shaders/link_sums.glsl) into the band area instead of
+    copying the window for the models' code. Both forms, on a body moved, turned and spun between
+    blocks (Bouzidi links of both kinds, moving wall, cover/uncover impulses), agree with the
+    models on the window to float32 round-off of the sums (1e-5 of the largest force; measured
+    2.8e-7), and the state is the same bit for bit."""
     from shapes import FlatPlate
 
     cfg = FlowConfig(nx=96, ny=48, inflow_speed=0.05, inflow_ramp_steps=10)
@@ -178,10 +179,48 @@ def test_link_sums_on_the_gpu_give_the_momentum_exchanges_of_the_window(gl_conte
     assert not np.allclose(f_win[:, 0], f_win[:, 1])  # the two forms differ on a moving body
 
 
-@pytest.mark.parametrize("forces", ["gpu", "window"])
+@pytest.mark.parametrize("model", ["momentum_exchange", "momentum_exchange_classic"])
+def test_the_step_pass_sums_the_links_of_a_single_momentum_exchange(gl_context, model):
+    """With one momentum exchange as the only model (the window's and the bench's case), the
+    step's own pass sums its links while it streams them (lbm_step.glsl LINK_SUMS) and keeps the
+    running total of a block's steps in texture G4's spare channels; no link-sum pass, no band
+    area. On a body moved, turned and spun between calls of 7 and 40 steps (blocks of 32 + 8),
+    the forces agree with the model's code on the copied window to float32 round-off (1e-5 of
+    the largest force; measured 2.0e-7), the state is the same bit for bit, and enabling both
+    exchanges switches to the link-sum pass."""
+    from shapes import FlatPlate
+
+    cfg = FlowConfig(nx=96, ny=48, inflow_speed=0.05, inflow_ramp_steps=10)
+    runs = []
+    for forces in ("gpu", "window"):
+        s = create_solver("gl", cfg, ctx=gl_context, tuning={"forces": forces})
+        s.enable_force_models([model])
+        out = []
+        for k in range(8):
+            shape = (Cylinder(10.0, x=30.3 + 0.13 * k, y=24.2 - 0.07 * k) if k < 4 else
+                     FlatPlate(length=12.0, thickness=2.5, x=31.1, y=23.9, angle=0.35 + 0.05 * k))
+            s.set_body(shape, velocity=(0.02, -0.01), omega=0.01 * (k >= 4))
+            s.step(40 if k % 3 == 2 else 7)
+            out.append(s.forces()[model])
+        assert s._link_sums == ({"momentum_exchange": 1, "momentum_exchange_classic": 2}[model]
+                                if forces == "gpu" else 0)
+        assert not s._block_sums and s._band_sums is None  # no link-sum pass was built
+        runs.append((np.array(out), s.distributions(), s))
+    (f_gpu, g_gpu, s_gpu), (f_win, g_win, _) = runs
+    assert np.array_equal(g_gpu, g_win)
+    scale = np.abs(f_win).max()
+    assert scale > 0.01
+    assert np.abs(f_gpu - f_win).max() <= 1e-5 * scale
+    s_gpu.enable_force_models(["momentum_exchange", "momentum_exchange_classic"])
+    s_gpu.step(3)
+    assert s_gpu._link_sums == 0 and s_gpu._block_sums
+
+
+@pytest.mark.parametrize("forces", ["gpu", "pass", "window"])
 def test_a_non_finite_body_window_raises_with_its_step_on_either_force_path(gl_context, forces):
     """A NaN next to the body is reported from the step whose window holds it, the same step
-    and message whether the pass summed the links (forces="gpu") or copied the window."""
+    and message whether the step's pass summed the links (forces="gpu", one model: found by
+    replaying the block), the link-sum pass did (forces="pass") or the window was copied."""
     cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04)
     s = create_solver("gl", cfg, ctx=gl_context, tuning={"forces": forces})
     s.enable_force_models(["momentum_exchange"])
@@ -193,7 +232,8 @@ def test_a_non_finite_body_window_raises_with_its_step_on_either_force_path(gl_c
     with pytest.raises(SolverDiverged) as err:
         s.step(10)
     assert err.value.step == 5 and "around the body" in str(err.value)
-    assert s._block_sums == (forces == "gpu")
+    assert s._block_sums == (forces == "pass")
+    assert s._link_sums == (1 if forces == "gpu" else 0)
 
 
 def test_before_read_runs_once_per_block_while_its_steps_are_still_unread(gl_context):
@@ -225,7 +265,7 @@ def test_window_wider_than_the_band_area_falls_back_to_the_atlas(gl_context):
     cfg = FlowConfig(nx=BAND_WIDTH + 64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)
     plate = FlatPlate(length=BAND_WIDTH + 10.0, thickness=2.0, x=cfg.nx / 2, y=16.0, angle=np.pi / 2)
     runs = []
-    for tuning in ({}, {"check_every": 1, "window": "read"}):
+    for tuning in ({"forces": "window"}, {"check_every": 1, "window": "read", "forces": "window"}):
         s = create_solver("gl", cfg, ctx=gl_context, tuning=tuning)
         s.enable_force_models(["momentum_exchange"])
         s.set_body(plate)

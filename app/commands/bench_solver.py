@@ -213,7 +213,8 @@ def _format_row(r) -> str:
 
 # --- tuning variants (docs/performance.md) ---------------------------------------------------
 #: the runs of `--variants` that `against_numpy` divides
-DEFAULT_TUNNEL = "default: the step's own pass sums the links into a band area"
+DEFAULT_TUNNEL = "default: the step's pass sums the links as it streams them (G4's spare channels)"
+LINK_SUM_PASS_TUNNEL = "a link-sum pass per step sums them into a band area (forces=pass)"
 WINDOW_COPY_TUNNEL = "the step's own pass copies the window to a band area (forces=window)"
 BOX = "empty periodic box (default)"
 #: the tunnel with parts taken away, each run in one step(n) call a round (no call ends):
@@ -240,6 +241,7 @@ VARIANTS = {
     "default, force window read right after each step": {"window": "read"},
     "blocks of 32, a pass per step copies the window to an atlas": {"window": "atlas"},
     WINDOW_COPY_TUNNEL: {"forces": "window"},
+    LINK_SUM_PASS_TUNNEL: {"forces": "pass"},
     DEFAULT_TUNNEL: {},
     "default, regions as two triangles each, not scissored": {"draw": "triangles"},
     "default, divergence by discard + occlusion query": {"divergence": "discard"},
