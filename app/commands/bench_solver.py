@@ -213,7 +213,7 @@ def _format_row(r) -> str:
 
 # --- tuning variants (docs/performance.md) ---------------------------------------------------
 #: the runs of `--variants` that `against_numpy` divides
-DEFAULT_TUNNEL = "default: the step's pass sums the links as it streams them (G4's spare channels)"
+DEFAULT_TUNNEL = "default: the step's own pass sums the links as it streams (G4 zw)"
 LINK_SUM_PASS_TUNNEL = "a link-sum pass per step sums them into a band area (forces=pass)"
 WINDOW_COPY_TUNNEL = "the step's own pass copies the window to a band area (forces=window)"
 BOX = "empty periodic box (default)"
