@@ -34,7 +34,7 @@ RESOLUTIONS = (8, 16, 32, 64)
 QUICK_RESOLUTIONS = (8, 16, 32)
 #: float32 storage (the gl backend) stops at 32 rows: at 64 the body force per step (9.5e-7)
 #: is a few ulp of the stored populations, and float32 round-off moves the steady error by
-#: about 1e-4, half the scheme's own 2.0e-4 (README 'Validation': gl 3.3e-4 at 64 rows with
+#: about 1e-4, half the scheme's own 2.0e-4 (docs/validation.md: gl 3.3e-4 at 64 rows with
 #: `feelflow validate --backend gl --case poiseuille --resolution 64`, numpy float64 2.0e-4)
 RESOLUTIONS_FLOAT32 = QUICK_RESOLUTIONS
 DEFAULT_RESOLUTION = RESOLUTIONS[-1]
