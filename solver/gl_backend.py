@@ -89,6 +89,8 @@ CHECK_EVERY = 32
 BAND_WIDTH = 128
 #: force models whose link sums the step's pass computes on the GPU (shaders/link_sums.glsl)
 LINK_SUM_MODELS = frozenset({"momentum_exchange", "momentum_exchange_classic"})
+#: lbm_step.glsl's LINK_SUMS where one momentum exchange is the only model (the step's pass sums it)
+LINK_SUMS_OF_MODEL = {("momentum_exchange",): 1, ("momentum_exchange_classic",): 2}
 _Y_MODE = {"no_slip": 0, "free_slip": 1, "periodic": 2}
 
 
@@ -371,7 +373,7 @@ class GLSolver(Solver):
         no replay to find a bad step's sums)."""
         if self.tuning["forces"] != "gpu" or self.body is None or self._discard:
             return 0
-        return {("momentum_exchange",): 1, ("momentum_exchange_classic",): 2}.get(tuple(self._models), 0)
+        return LINK_SUMS_OF_MODEL.get(tuple(self._models), 0)
 
     def _use_link_sum_mode(self, mode: int) -> None:
         """Switch the body variant's LINK_SUMS (its programs and vertex arrays are kept per mode)."""
@@ -621,8 +623,7 @@ class GLSolver(Solver):
         or None)."""
         _, _, (cols, ww, wh) = self._band_copy
         rows, cols_ = np.divmod(np.arange(len(self._band_sums.texels)), ww)  # list entry j in its slot
-        i = self.body.links.i
-        kx, ky = (-2.0 * RHO0 * (W[i, None] * C[i]).sum(axis=0)) if len(i) else (0.0, 0.0)
+        kx, ky = self._links_constant()
         sums = np.empty((bands, 4))
         for first in (0, 1):  # the steps whose slots side sides[first] holds: first, first + 2, ...
             band = np.arange(first, bands, 2)
@@ -649,6 +650,12 @@ class GLSolver(Solver):
             out.append(forces)
         return out, (None if good == bands else t0 + good)
 
+    def _links_constant(self):
+        """The links' constant K = -2 RHO0 sum w_i c_i of the body's links, per step (the part of
+        the momentum exchange that the sums of shifted populations leave out)."""
+        i = self.body.links.i
+        return tuple(-2.0 * RHO0 * (W[i, None] * C[i]).sum(axis=0)) if len(i) else (0.0, 0.0)
+
     def _read_pass_sums(self) -> np.ndarray:
         """The running total of link sums (LINK_SUMS) of the current side: channels zw of
         texture G4 over the body variant's rectangles, summed in float64."""
@@ -668,8 +675,7 @@ class GLSolver(Solver):
         s = self._read_pass_sums()
         if not np.all(np.isfinite(s)):
             raise SolverDiverged(self.time, "non-finite populations around the body")
-        i = self.body.links.i
-        kx, ky = (-2.0 * RHO0 * (W[i, None] * C[i]).sum(axis=0)) if len(i) else (0.0, 0.0)
+        kx, ky = self._links_constant()
         fx, fy = float(s[0] + bands * kx), float(s[1] + bands * ky)
         if self._link_sums == 2:
             return {"momentum_exchange_classic": (fx, fy)}
