@@ -175,6 +175,7 @@ def test_link_sums_on_the_gpu_give_the_momentum_exchanges_of_the_window(gl_conte
     assert np.array_equal(g_gpu, g_win)
     scale = np.abs(f_win).max()
     assert scale > 0.01
+    print(f"\n  link sums against the window: {np.abs(f_gpu - f_win).max() / scale:.1e} of the largest force", end="")
     assert np.abs(f_gpu - f_win).max() <= 1e-5 * scale
     assert not np.allclose(f_win[:, 0], f_win[:, 1])  # the two forms differ on a moving body
 
@@ -210,6 +211,7 @@ def test_the_step_pass_sums_the_links_of_a_single_momentum_exchange(gl_context, 
     assert np.array_equal(g_gpu, g_win)
     scale = np.abs(f_win).max()
     assert scale > 0.01
+    print(f"\n  link sums against the window: {np.abs(f_gpu - f_win).max() / scale:.1e} of the largest force", end="")
     assert np.abs(f_gpu - f_win).max() <= 1e-5 * scale
     s_gpu.enable_force_models(["momentum_exchange", "momentum_exchange_classic"])
     s_gpu.step(3)
