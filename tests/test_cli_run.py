@@ -144,6 +144,7 @@ def test_validate_prints_a_table_and_writes_json(tmp_path):
     case = data["cases"][0]
     assert case["name"] == "taylor-green" and case["backend"] == "numpy" and case["resolution"] == 32
     assert case["steps"] > 0 and case["wall_seconds"] > 0 and case["mlups"] > 0
+    assert case["case_seconds"] >= case["wall_seconds"]   # the whole case: set-up and analysis too
     assert abs(case["quantities"]["nu_rel_error"]) < 0.01 and case["passed"] is True
 
 

@@ -66,6 +66,7 @@ def write_json_atomic(path: Path, data) -> None:
 
 def run_case(name: str, factory, resolution, quick: bool, backend: str):
     """One case; a flow that blows up is a failed case (stable = 0), not a traceback."""
+    import time
     import warnings
 
     import numpy as np
@@ -75,16 +76,18 @@ def run_case(name: str, factory, resolution, quick: bool, backend: str):
     from solver.validation.base import CaseResult, Check
 
     module = case_module(name)
+    t0 = time.perf_counter()
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
-            return module.run(factory, resolution=resolution, quick=quick, backend=backend)
+            result = module.run(factory, resolution=resolution, quick=quick, backend=backend)
     except backends.SolverDiverged as exc:
         n = resolution or (module.QUICK_RESOLUTION if quick else module.DEFAULT_RESOLUTION)
         result = CaseResult(name, backend, n, quantities={"stable": 0.0, "diverged_at_step": float(exc.step)},
                             checks=[Check("stable", 1.0, 1.0, "the flow must not blow up")])
         result.notes = str(exc)
-        return result
+    result.case_seconds = time.perf_counter() - t0
+    return result
 
 
 def main(args) -> int:
@@ -111,7 +114,8 @@ def main(args) -> int:
         result = run_case(name, factory, resolution, args.quick, args.backend)
         results.append(result)
         print(f"  {name}: {'targets met' if result.passed else 'TARGETS NOT MET'} "
-              f"({result.steps} steps, {result.wall_seconds:.1f} s)", flush=True)
+              f"({result.steps} steps, {result.wall_seconds:.1f} s stepping, {result.case_seconds:.1f} s in all)",
+              flush=True)
     machine = machine_description()
     print(f"\nFeelFlow validation, backend {args.backend}, on {machine}\n")
     print(format_table(results))

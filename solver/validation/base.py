@@ -46,7 +46,8 @@ class CaseResult:
     checks: list[Check] = field(default_factory=list)
     steps: int = 0
     node_updates: int = 0
-    wall_seconds: float = 0.0
+    wall_seconds: float = 0.0   # in the solver's steps (and the moves of a moving body): MLUPS
+    case_seconds: float = 0.0   # the whole case: also set-up, read-backs and analysis (run_case)
     notes: str = ""
     details: dict = field(default_factory=dict)   # case-specific extra data for the JSON (maps, series)
 
@@ -71,13 +72,14 @@ class CaseResult:
             "targets": {c.quantity: {"low": c.low, "high": c.high, "source": c.source,
                                      "met": self.check_results()[c.quantity]} for c in self.checks},
             "passed": self.passed, "steps": self.steps, "wall_seconds": round(self.wall_seconds, 3),
-            "mlups": clean(round(self.mlups, 3)), "notes": self.notes,
+            "case_seconds": round(self.case_seconds, 3), "mlups": clean(round(self.mlups, 3)), "notes": self.notes,
             **({"details": self.details} if self.details else {}),
         }
 
 
 class Stopwatch:
-    """Counts node updates and wall time spent stepping solvers."""
+    """Counts node updates and wall time spent stepping solvers (with the body's moves where a
+    case moves it between steps: `timed`)."""
 
     def __init__(self):
         self.seconds = 0.0

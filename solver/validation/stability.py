@@ -172,15 +172,18 @@ def _shake(solver, body, steps, point, watch, u_bound):
     sweep = max(2, int(round(body.diameter / v)))          # steps per sweep of one diameter
     state = {"x": body.x, "t": 0}
 
-    def advance(n):
+    def move_and_step():
+        t = state["t"]
+        direction = -1.0 if ((t + sweep // 2) // sweep) % 2 == 0 else 1.0   # first against the stream
+        solver.set_body(body.moved(x=state["x"], y=body.y), velocity=(direction * cap, 0.0),
+                        omega=direction * cap / radius)
+        solver.step(1)
+        state["x"] += direction * v
+        state["t"] = t + 1
+
+    def advance(n):  # the moves count in the stopwatch's time, as the steps they belong to
         for _ in range(n):
-            t = state["t"]
-            direction = -1.0 if ((t + sweep // 2) // sweep) % 2 == 0 else 1.0   # first against the stream
-            solver.set_body(body.moved(x=state["x"], y=body.y), velocity=(direction * cap, 0.0),
-                            omega=direction * cap / radius)
-            watch.step(solver, 1)
-            state["x"] += direction * v
-            state["t"] = t + 1
+            watch.timed(solver.config.nx * solver.config.ny, 1, move_and_step)
 
     _run(solver, steps, point, watch, advance, u_bound)
 
