@@ -146,13 +146,16 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
     return (jx, jy), (new_solid | uncovered | ring)
 
 
-def move_body(old, new, config, read_window, write_nodes):
+def move_body(old, new, config, read_window, write_nodes, step_sets_solid: bool = False):
     """Cover/uncover bookkeeping between two body states (either may be None), for any backend.
 
     read_window(x0, y0, x1, y1) -> (9, y1-y0, x1-x0) float64 full f* of that box;
     write_nodes(x0, y0, f, changed) writes back the nodes where `changed` (the window's (h, w)
     mask) is True. The box is the union of both raster windows grown by one node (the refill's
     neighbours). Returns the impulse (Jx, Jy) to add to the next step's force.
+    `step_sets_solid`: the backend's step gives every solid node f^eq(RHO0, u_body) itself (the
+    gl step pass), so a move that covers and uncovers no node (a sub-cell move, most of a
+    slowly dragged body's) reads and writes nothing: refill would only write those equilibria.
     """
     box = union_box(old.raster.window if old else None, new.raster.window if new else None)
     if box is None:
@@ -161,6 +164,8 @@ def move_body(old, new, config, read_window, write_nodes):
     shape = (y1 - y0, x1 - x0)
     old_solid = old.raster.crop_solid((x0, y0, x1, y1)) if old else np.zeros(shape, bool)
     new_solid = new.raster.crop_solid((x0, y0, x1, y1)) if new else np.zeros(shape, bool)
+    if step_sets_solid and np.array_equal(old_solid, new_solid):
+        return 0.0, 0.0
     motion = new if new is not None else old
     f = read_window(x0, y0, x1, y1)
     impulse, changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0,

@@ -902,7 +902,8 @@ class GLSolver(Solver):
             g[:, changed] = shifted(f[:, changed]).astype("f4")
             self._write_texels(read["texels"], read["kbox"])
 
-        jx, jy = move_body(old, new, cfg, read_window, write_nodes)
+        # lbm_step.glsl's BODY pass gives every solid node f^eq(RHO0, u_body) each step
+        jx, jy = move_body(old, new, cfg, read_window, write_nodes, step_sets_solid=True)
         self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         box = union_box(old.raster.window if old else None, new.raster.window if new else None)
         if box is not None:
