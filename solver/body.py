@@ -3,7 +3,8 @@
 docs/algorithm.md, 'Moving the body'. Refill after Lallemand & Luo, J. Comput. Phys. 184 (2003)
 406: an uncovered node gets f^eq(rho_new, u_body) with rho_new the mean density of its fluid
 neighbours. Shared by both backends: the gl backend reads back the body window, calls `refill`
-on it and writes the changed nodes back.
+on it and writes the changed nodes back (not for a move that covers and uncovers no node: its
+step pass resets the solid nodes itself).
 """
 from __future__ import annotations
 
