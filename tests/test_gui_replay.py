@@ -169,11 +169,25 @@ def test_gl_window_replays_in_its_own_context(qtbot, tmp_path, monkeypatch):
     assert w.start_replay(str(path))
     replay = w.replay
     assert replay.solver.name == "gl" and replay.solver.ctx is w.viewport.ctx
+    split_ends = []   # the session steps at which a row run in parts (longer than a frame) ended
+    driver, step_part = replay.solver, replay.solver.step_part
+
+    def counting_step_part(k, row_steps):
+        done = step_part(k, row_steps)
+        if done:
+            split_ends.append(driver.clock)
+        return done
+    driver.step_part = counting_step_part   # before the first frame: start_replay only queued it
     qtbot.waitUntil(lambda: replay.done, timeout=30000)
     assert w.viewport.field_texture is replay.solver.field_texture()
     values = replayed_values(replay.history, session.models)
-    # same backend, same machine: equal up to the rounding of rows run in parts (longer than a frame)
-    np.testing.assert_allclose(values, session.forces["values"], rtol=1e-12, atol=1e-15)
+    recorded = np.asarray(session.forces["values"])
+    split = np.isin(np.asarray(session.forces["step"]), split_ends)
+    # same backend, same machine: bit for bit, except rows run in parts, whose forces the gl
+    # step pass sums over each part in float32 (lbm_step.glsl LINK_SUMS): equal to that rounding
+    np.testing.assert_allclose(values[~split], recorded[~split], rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(values[split], recorded[split], rtol=1e-6, atol=1e-12)
+    print(f"\n  rows run in parts: {int(split.sum())} of {split.size}", end="")
     w.stop_replay()
     assert w.viewport.field_texture is live_texture
     t = w.sim.solver.time
