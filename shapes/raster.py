@@ -88,7 +88,12 @@ def _polygon_box(shape: PolygonalShape, box):
     jy = (by[:, None, None] + _STENCIL[None, :, None]).repeat(len(_STENCIL), axis=2).ravel()
     edge = np.repeat(edge, len(_STENCIL) ** 2)
     ok = (jx >= 0) & (jx < w) & (jy >= 0) & (jy < h)
-    jx, jy, edge = jx[ok], jy[ok], edge[ok]
+    # a node lies in the stencils of several pieces of the same edge: test each (edge, node) once
+    # (sorted keys, repeats dropped; np.unique takes 12x longer here, numpy 2.4)
+    pair = np.sort((edge[ok] * h + jy[ok]) * w + jx[ok])
+    pair = pair[np.concatenate(([True], pair[1:] != pair[:-1]))]
+    edge, rest = np.divmod(pair, h * w)
+    jy, jx = np.divmod(rest, w)
     px, py = (jx + x0).astype(np.float64), (jy + y0).astype(np.float64)
 
     # boundary points count as inside; only nodes within sqrt(2) of an edge can cut it
