@@ -55,8 +55,8 @@ class Stencil:
 
     def nodes(self) -> np.ndarray:
         """The distinct flat node indices the stencil reads (for gathering only those), sorted.
-        Sorted keys with repeats dropped: np.unique takes 10x longer on these ~8000 indices
-        (numpy 2.4), and this runs at every move of the body."""
+        Sorted keys with repeats dropped: numpy 2.4's np.unique is much slower on such arrays,
+        and this runs at every move of the body."""
         flat = np.sort(self.idx, axis=None)
         first = np.ones(flat.size, dtype=bool)
         first[1:] = flat[1:] != flat[:-1]
