@@ -14,9 +14,9 @@
 //     or outlet is replaced by rules c, d; or an even nx), else node by node with an explicit
 //     wrap (x-periodic with an odd nx);
 //   both 0: the fast path, plain streaming (rule 1f) for the interior: both nodes streamed by
-//     stream_pair, whose fetches the directions with the same row offset share (12 for two
-//     nodes, 9 per node before), through textureOffset() at normalized coordinates and REPEAT
-//     samplers (a fully periodic grid of even width wraps for free).
+//     stream_pair, one fetch for each of the nine texels around the fragment's (9 for two
+//     nodes, 9 per node node by node), through textureOffset() at normalized coordinates and
+//     REPEAT samplers (a fully periodic grid of even width wraps for free).
 //   BODY with LINK_SUMS 1 / 2 (the body's only force model is the Galilean-invariant / the
 //     classic momentum exchange): while streaming the body's links, the variant also sums the
 //     model's link terms (as shaders/link_sums.glsl: S1 + S2, or S1) and adds them to the running
@@ -65,27 +65,24 @@ ivec2 wrap(ivec2 p) {  // node p, periodic wrap
     return ivec2((p.x + N.x) % N.x, (p.y + N.y) % N.y);
 }
 
-// both nodes of this fragment's texel, plain streaming g_i(x - c_i) (rule 1f), the fetches
-// shared between directions with the same row offset (texel offsets -1, 0, +1 in x)
+// both nodes of this fragment's texel, plain streaming g_i(x - c_i) (rule 1f), each of the nine
+// texels around it fetched once (solver/gl_layout.py): G0, G1, G2 at this texel column of rows
+// y, y - 1, y + 1; G3, G4 at the columns k - 1 (what node b there sends east to node a here) and
+// k + 1 (what node a there sends west to node b here)
 void stream_pair(out float a[9], out float b[9]) {
     vec2 p = gl_FragCoord.xy * inv_n;
-    vec4 z = texture(G4, p);
-    a[0] = z.x; b[0] = z.y;
-    vec4 l = textureOffset(G0, p, ivec2(-1, 0));  // row y: g1 (+1, 0), g3 (-1, 0)
-    vec4 m = texture(G0, p);
-    vec4 r = textureOffset(G0, p, ivec2(1, 0));
-    a[1] = l.y; b[1] = m.x; a[3] = m.w; b[3] = r.z;
-    l = textureOffset(G1, p, ivec2(-1, -1));      // row y - 1: g5 (+1, +1), g6 (-1, +1)
-    m = textureOffset(G1, p, ivec2(0, -1));
-    r = textureOffset(G1, p, ivec2(1, -1));
-    a[5] = l.y; b[5] = m.x; a[6] = m.w; b[6] = r.z;
-    l = textureOffset(G2, p, ivec2(-1, 1));       // row y + 1: g7 (-1, -1), g8 (+1, -1)
-    m = textureOffset(G2, p, ivec2(0, 1));
-    r = textureOffset(G2, p, ivec2(1, 1));
-    a[7] = m.y; b[7] = r.x; a[8] = l.w; b[8] = m.z;
-    vec4 s = textureOffset(G3, p, ivec2(0, -1));  // g2 (0, +1) from row y - 1
-    vec4 n = textureOffset(G3, p, ivec2(0, 1));   // g4 (0, -1) from row y + 1
-    a[2] = s.x; b[2] = s.y; a[4] = n.z; b[4] = n.w;
+    vec4 h = texture(G0, p);                          // row y: g0, g1 a -> b, g3 b -> a
+    a[0] = h.x; b[1] = h.y; b[0] = h.z; a[3] = h.w;
+    vec4 n = textureOffset(G1, p, ivec2(0, -1));      // row y - 1: g2, g5 a -> b, g6 b -> a
+    a[2] = n.x; b[5] = n.y; b[2] = n.z; a[6] = n.w;
+    vec4 s = textureOffset(G2, p, ivec2(0, 1));       // row y + 1: g4, g8 a -> b, g7 b -> a
+    a[4] = s.x; b[8] = s.y; b[4] = s.z; a[7] = s.w;
+    a[1] = textureOffset(G3, p, ivec2(-1, 0)).x;      // g1 (+1, 0) of node b of texel k - 1
+    b[3] = textureOffset(G3, p, ivec2(1, 0)).y;       // g3 (-1, 0) of node a of texel k + 1
+    a[5] = textureOffset(G3, p, ivec2(-1, -1)).z;     // g5 (+1, +1)
+    b[6] = textureOffset(G3, p, ivec2(1, -1)).w;      // g6 (-1, +1)
+    a[8] = textureOffset(G4, p, ivec2(-1, 1)).x;      // g8 (+1, -1)
+    b[7] = textureOffset(G4, p, ivec2(1, 1)).y;       // g7 (-1, -1)
 }
 
 #if EDGES && X_PERIODIC && NX_ODD
@@ -104,11 +101,11 @@ float feq_shifted(int i, float drho, float rho, vec2 u) {
 }
 
 void store_pair(float a[9], float b[9]) {
-    out0 = vec4(a[1], b[1], a[3], b[3]);
-    out1 = vec4(a[5], b[5], a[6], b[6]);
-    out2 = vec4(a[7], b[7], a[8], b[8]);
-    out3 = vec4(a[2], b[2], a[4], b[4]);
-    out4 = vec4(a[0], b[0], 0.0, 0.0);
+    out0 = vec4(a[0], a[1], b[0], b[3]);
+    out1 = vec4(a[2], a[5], b[2], b[6]);
+    out2 = vec4(a[4], a[8], b[4], b[7]);
+    out3 = vec4(b[1], a[3], b[5], a[6]);
+    out4 = vec4(b[8], a[7], 0.0, 0.0);
 }
 
 // Collision (algorithm.md steps 2-4) of the incoming shifted populations f at node x, in place,

@@ -2,10 +2,11 @@
 // Included (// @INCLUDE paired_layout.glsl, after // @LATTICE) by the programs that read the
 // stored populations node by node. The layout, defined once in solver/gl_layout.py: two nodes
 // per texel, a = (2k, y) and b = (2k + 1, y) in texel (k, y) of five RGBA32F textures,
-//   G0 (g1a g1b g3a g3b)  G1 (g5a g5b g6a g6b)  G2 (g7a g7b g8a g8b)  G3 (g2a g2b g4a g4b)
-//   G4 (g0a g0b  -   - )  (zw: zero, except in the body window with lbm_step.glsl's LINK_SUMS)
-// so that the directions sharing a row offset share texels when a fragment streams both nodes
-// (lbm_step.glsl, stream_pair: 12 fetches for 2 nodes instead of 18).
+//   G0 (g0a g1a g0b g3b)  G1 (g2a g5a g2b g6b)  G2 (g4a g8a g4b g7b)
+//   G3 (g1b g3a g5b g6a)  G4 (g8b g7a  -   - )  (G4 zw: zero, except in the body window with
+//   lbm_step.glsl's LINK_SUMS)
+// so that a fragment streaming both nodes of its texel fetches each of the nine texels around
+// it once (lbm_step.glsl, stream_pair: 9 fetches for 2 nodes, 18 node by node).
 
 uniform sampler2D G0;
 uniform sampler2D G1;
@@ -13,9 +14,10 @@ uniform sampler2D G2;
 uniform sampler2D G3;
 uniform sampler2D G4;
 
-// SLOT[i] = (texture, channel of node a) of direction i; node b is the next channel
-const ivec2 SLOT[9] = ivec2[9](ivec2(4, 0), ivec2(0, 0), ivec2(3, 0), ivec2(0, 2), ivec2(3, 2),
-                               ivec2(1, 0), ivec2(1, 2), ivec2(2, 0), ivec2(2, 2));
+// SLOT[i] = (texture, channel) of direction i for node a, then for node b
+const ivec4 SLOT[9] = ivec4[9](ivec4(0, 0, 0, 2), ivec4(0, 1, 3, 0), ivec4(1, 0, 1, 2), ivec4(3, 1, 0, 3),
+                               ivec4(2, 0, 2, 2), ivec4(1, 1, 3, 2), ivec4(3, 3, 1, 3), ivec4(4, 1, 2, 3),
+                               ivec4(2, 1, 4, 0));
 
 vec4 layout_texel(int t, ivec2 k) {  // texel k of texture t (t is constant after unrolling)
     if (t == 0) return texelFetch(G0, k, 0);
@@ -26,7 +28,10 @@ vec4 layout_texel(int t, ivec2 k) {  // texel k of texture t (t is constant afte
 }
 
 float pop(int j, ivec2 p) {  // stored g_j at node p (inside the grid)
-    return layout_texel(SLOT[j].x, ivec2(p.x >> 1, p.y))[SLOT[j].y + (p.x & 1)];
+    ivec2 k = ivec2(p.x >> 1, p.y);
+    float a = layout_texel(SLOT[j].x, k)[SLOT[j].y];
+    float b = layout_texel(SLOT[j].z, k)[SLOT[j].w];
+    return (p.x & 1) == 1 ? b : a;
 }
 
 // the stored populations of both nodes of texel k (five fetches)
@@ -35,7 +40,7 @@ void load_pair(ivec2 k, out float a[9], out float b[9]) {
                         texelFetch(G3, k, 0), texelFetch(G4, k, 0));
     for (int i = 0; i < Q; ++i) {
         a[i] = t[SLOT[i].x][SLOT[i].y];
-        b[i] = t[SLOT[i].x][SLOT[i].y + 1];
+        b[i] = t[SLOT[i].z][SLOT[i].w];
     }
 }
 
