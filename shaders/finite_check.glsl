@@ -1,6 +1,6 @@
 #version 330 core
-// Cheap divergence check: each output texel sums texture G0 (g1 and g3 of two nodes,
-// shaders/paired_layout.glsl) over a BLOCK_X x BLOCK_Y tile of texels; a NaN or Inf anywhere
+// Cheap divergence check: each output texel sums texture G0 (g0 of both nodes of a texel,
+// g1 of node a, g3 of node b: shaders/paired_layout.glsl) over a BLOCK_X x BLOCK_Y tile of texels; a NaN or Inf anywhere
 // makes its tile's sum non-finite (NaN spreads to every population of the neighbours within a
 // step, so one texture suffices). The sums of step k go
 // to a band of an atlas whose lower-left texel is `band`; the tiles are shaped so that a band

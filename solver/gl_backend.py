@@ -37,8 +37,8 @@ API for the app (a QOpenGLWidget sharing this context):
   textures are nx + BAND_WIDTH wide for tunnels. One pass a step keeps llvmpipe at one scene a
   step (a separate copy pass into an atlas, which x-periodic grids, whose texture must be nx
   wide for the REPEAT wrap, and windows wider than the band area still use, cost the moving
-  tunnel 25-30 %: docs/performance.md). At the end of the block a pass sums g_0..g_3 of the final state over
-  tiles (`shaders/finite_check.glsl`; NaN reaches every population of the neighbours within a
+  tunnel 25-30 %: docs/performance.md). At the end of the block a pass sums texture G0 (g0 of both nodes of a texel)
+  of the final state over tiles (`shaders/finite_check.glsl`; NaN reaches every population of the neighbours within a
   step, so a NaN never vanishes from the fluid) and the windows and sums are read once. A non-finite sum
   replays the block from its start state, which a third state side keeps, with a check after
   every step: `solver.backend.SolverDiverged` names the exact step, as in the reference; a
