@@ -15,8 +15,8 @@
 //     wrap (x-periodic with an odd nx);
 //   both 0: the fast path, plain streaming (rule 1f) for the interior: both nodes streamed by
 //     stream_pair, one fetch for each of the nine texels around the fragment's (9 for two
-//     nodes, 9 per node node by node), through textureOffset() at normalized coordinates and
-//     REPEAT samplers (a fully periodic grid of even width wraps for free).
+//     nodes; 18 node by node), through textureOffset() at normalized coordinates and REPEAT
+//     samplers (a fully periodic grid of even width wraps for free).
 //   BODY with LINK_SUMS 1 / 2 (the body's only force model is the Galilean-invariant / the
 //     classic momentum exchange): while streaming the body's links, the variant also sums the
 //     model's link terms (as shaders/link_sums.glsl: S1 + S2, or S1) and adds them to the running

@@ -29,9 +29,9 @@ vec4 layout_texel(int t, ivec2 k) {  // texel k of texture t (t is constant afte
 
 float pop(int j, ivec2 p) {  // stored g_j at node p (inside the grid)
     ivec2 k = ivec2(p.x >> 1, p.y);
-    float a = layout_texel(SLOT[j].x, k)[SLOT[j].y];
-    float b = layout_texel(SLOT[j].z, k)[SLOT[j].w];
-    return (p.x & 1) == 1 ? b : a;
+    vec4 ta = layout_texel(SLOT[j].x, k);
+    vec4 tb = SLOT[j].z == SLOT[j].x ? ta : layout_texel(SLOT[j].z, k);  // one fetch where a, b share it
+    return (p.x & 1) == 1 ? tb[SLOT[j].w] : ta[SLOT[j].y];
 }
 
 // the stored populations of both nodes of texel k (five fetches)

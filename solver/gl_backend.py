@@ -37,9 +37,9 @@ API for the app (a QOpenGLWidget sharing this context):
   textures are nx + BAND_WIDTH wide for tunnels. One pass a step keeps llvmpipe at one scene a
   step (a separate copy pass into an atlas, which x-periodic grids, whose texture must be nx
   wide for the REPEAT wrap, and windows wider than the band area still use, cost the moving
-  tunnel 25-30 %: docs/performance.md). At the end of the block a pass sums texture G0 (g0 of both nodes of a texel)
-  of the final state over tiles (`shaders/finite_check.glsl`; NaN reaches every population of the neighbours within a
-  step, so a NaN never vanishes from the fluid) and the windows and sums are read once. A non-finite sum
+  tunnel 25-30 %: docs/performance.md). At the end of the block a pass sums texture G0 (g0 of
+  both nodes of a texel) of the final state over tiles (`shaders/finite_check.glsl`; NaN reaches
+  every population of the neighbours within a step, so a NaN never vanishes from the fluid) and the windows and sums are read once. A non-finite sum
   replays the block from its start state, which a third state side keeps, with a check after
   every step: `solver.backend.SolverDiverged` names the exact step, as in the reference; a
   non-finite body window raises it with the step of that window.
@@ -66,6 +66,7 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
+from shapes.raster import distinct_sorted
 from solver.backend import BackendError, Solver, SolverDiverged
 from solver.body import expand_box, move_body, shifted, union_box, unshifted
 from solver.forces.base import BodyWindow
@@ -574,7 +575,7 @@ class GLSolver(Solver):
         when llvmpipe's queue is empty: a write to a texture a queued step reads would wait)."""
         links = self.body.links
         x0w, y0w = self.body.window[:2]
-        key = np.unique((y0w + links.iy) * self._kx + (x0w + links.ix) // 2)  # sorted by (y, k)
+        key = distinct_sorted((y0w + links.iy) * self._kx + (x0w + links.ix) // 2)  # sorted by (y, k)
         texel = np.stack([key % self._kx, key // self._kx], axis=1)
         layout = self._band_copy[2]
         cols, ww, wh = layout

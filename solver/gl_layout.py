@@ -15,7 +15,7 @@ nine texels it needs, (k - 1 .. k + 1, y - 1 .. y + 1), are each fetched once
 - G3 and G4 hold what crosses into the next texel: node b's east-going populations (fetched
   from texel k - 1) and node a's west-going ones (fetched from texel k + 1); G3 for rows y and
   y - 1, G4 for row y + 1.
-The twelfth session's layout kept each direction's a and b side by side and needed 12 fetches.
+(A layout that kept each direction's a and b side by side needed 12.)
 `shaders/paired_layout.glsl` holds the same table for the shaders (a test compares them). An
 odd nx leaves node b of the last texel column unused (kept at zero, rest). G4's channels 2, 3
 hold no population: zero, except over the body window, where the step's pass keeps the running

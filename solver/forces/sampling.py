@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from shapes.raster import distinct_sorted
 from solver.lattice import C
 
 
@@ -54,13 +55,9 @@ class Stencil:
         return (field_flat[self.idx] * self.coef).sum(axis=1)
 
     def nodes(self) -> np.ndarray:
-        """The distinct flat node indices the stencil reads (for gathering only those), sorted.
-        Sorted keys with repeats dropped: numpy 2.4's np.unique is much slower on such arrays,
-        and this runs at every move of the body."""
-        flat = np.sort(self.idx, axis=None)
-        first = np.ones(flat.size, dtype=bool)
-        first[1:] = flat[1:] != flat[:-1]
-        return flat[first]
+        """The distinct flat node indices the stencil reads (for gathering only those), sorted;
+        once per move of the body."""
+        return distinct_sorted(self.idx)
 
 
 def bilinear_stencil(window, px, py) -> Stencil:
