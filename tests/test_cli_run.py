@@ -200,3 +200,12 @@ def test_run_record_into_missing_directory_is_one_line(tmp_path):
     scene = write(tmp_path, SMALL)
     result = feelflow("run", scene, "--out", tmp_path / "f.csv", "--record", tmp_path / "nope" / "s.ffsession")
     assert_one_line_error(result, "nope")
+
+
+def test_validate_refuses_a_resolution_the_channel_cannot_have():
+    """A Schaefer-Turek resolution whose channel (4.1 D) is not whole cells is one line, exit 2,
+    before anything runs."""
+    result = feelflow("validate", "--case", "schaefer-turek-2d1", "--resolution", "16")
+    assert result.returncode == 2 and result.stdout == ""
+    line, = result.stderr.strip().splitlines()
+    assert "--resolution" in line and "multiple of 10" in line and "got 16" in line

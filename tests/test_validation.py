@@ -83,3 +83,25 @@ def test_schaefer_turek_2d1_coarse_converges_near_the_benchmark(request):
     assert r.quantities["converged"] == 1.0
     assert abs(r.quantities["cd_rel_error"]) < 0.03, r.quantities
     assert abs(r.quantities["dp_rel_error"]) < 0.05, r.quantities
+
+
+@pytest.mark.parametrize("d", [16, 15, 25, 0, -10, 20.0, True])
+def test_schaefer_turek_refuses_a_channel_that_is_not_whole_cells_high(d):
+    """4.1 D must be a whole number of cells (walls half-way between nodes): a resolution that
+    is not a multiple of 10 would change the blockage D / H, so it is refused, naming why."""
+    from solver.validation.schaefer_turek import Geometry
+
+    with pytest.raises(ValueError, match="multiple of 10"):
+        Geometry(d, 20.0)
+
+
+@pytest.mark.parametrize("d", [10, 20, 40, 80])
+def test_schaefer_turek_lengths_keep_the_benchmark_ratios(d):
+    """Channel 4.1 D high between the half-way walls (-1/2 and ny - 1/2) and 22 D long, cylinder
+    2 D from the bottom wall and from the inlet (x = -1/2), 2.1 D from the top wall."""
+    from solver.validation.schaefer_turek import Geometry
+
+    g = Geometry(d, 100.0)
+    assert g.ny == 4.1 * d and g.nx == 22 * d
+    cx, cy = g.centre
+    assert (cx + 0.5, cy + 0.5) == (2 * d, 2 * d) and (g.ny - 0.5) - cy == pytest.approx(2.1 * d)

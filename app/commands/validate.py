@@ -100,6 +100,13 @@ def main(args) -> int:
         if name not in CASES:
             raise UserError(f"--case: unknown case {name!r}; choose from {', '.join(CASES)}")
     resolution = positive_int_option("--resolution", args.resolution) if args.resolution is not None else None
+    for name in names:
+        check = getattr(case_module(name), "check_resolution", None)
+        if resolution is not None and check is not None:
+            try:
+                check(resolution)
+            except ValueError as exc:
+                raise UserError(f"--resolution: {name}: {exc}") from None
     if args.json is not None and Path(args.json).is_dir():
         raise UserError(f"--json: {args.json!r} is a directory")
     if args.json is not None and not (Path(args.json).parent if str(Path(args.json).parent) else Path(".")).is_dir():

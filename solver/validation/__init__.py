@@ -2,7 +2,9 @@
 
 `CASES` is the registry: name -> module. Each module has `NAME`, `DEFAULT_RESOLUTION`,
 `QUICK_RESOLUTION` and `run(make_solver, resolution=None, quick=False) -> CaseResult`
-(solver/validation/base.py).
+(solver/validation/base.py); a case whose geometry allows only some resolutions also has
+`check_resolution(n)`, which raises ValueError naming why, so that `feelflow validate` refuses
+a bad `--resolution` before it runs anything.
 """
 from __future__ import annotations
 

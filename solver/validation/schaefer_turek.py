@@ -4,7 +4,15 @@ Channel 2.2 x 0.41 with D = 0.1 becomes, at D cells per diameter: walls half-way
 and ny - 1/2 (H = 4.1 D cells), inlet at x = -1/2 (parabolic, peak U_m), outlet at
 x = nx - 1/2 (22 D cells), cylinder centre (2D - 1/2, 2D - 1/2) in node coordinates (physical
 (0.2, 0.2): 0.05 D below the centre line, which makes the lift non-zero). Front and back points
-(0.15, 0.2) and (0.25, 0.2) lie on the cylinder surface. Reference values:
+(0.15, 0.2) and (0.25, 0.2) lie on the cylinder surface.
+
+The half-way walls make the channel a whole number of cells high, so D must make 4.1 D one: a
+multiple of 10 cells (`check_resolution`). Other resolutions are refused rather than rounded:
+one row more or less changes the blockage D / H, and with it C_D by about half a percent and
+C_L by tens of percent at 16 - 24 cells, more than the resolution itself changes them; a
+cylinder of a non-whole D that kept H exact would sit off-centre on the lattice, and the lift of
+2D-1 (2 per mille of the drag) then comes out wrong by several times its size (probes,
+docs/validation.md, 'Whole channel heights'). Reference values:
 /work/shared/reference/benchmarks.md (Schaefer & Turek 1996, refined reference values of
 John 2004 for 2D-1).
 """
@@ -25,13 +33,23 @@ REF_2D1 = {"cd": 5.57953523384, "cl": 0.010618948146, "dp": 0.11752016697, "u_me
 INTERVALS_2D2 = {"cd_max": (3.22, 3.24), "cl_max": (0.99, 1.01), "st": (0.295, 0.305)}
 
 
+def check_resolution(d) -> None:
+    """Raise ValueError unless `d` cells per diameter give a whole channel height 4.1 d (module
+    docstring): d must be a positive multiple of 10."""
+    if isinstance(d, bool) or not isinstance(d, int) or d <= 0 or d % 10:
+        raise ValueError(f"the Schaefer-Turek channel is 4.1 diameters high and its walls lie half-way between "
+                         f"nodes, so the cells per diameter must be a multiple of 10 (10, 20, 30, 40, ...), got {d!r}")
+
+
 class Geometry:
-    """The benchmark at `d` cells per diameter, Reynolds number `re` (U_mean D / nu)."""
+    """The benchmark at `d` cells per diameter (a multiple of 10, `check_resolution`), Reynolds
+    number `re` (U_mean D / nu)."""
 
     def __init__(self, d: int, re: float, u_max: float = U_MAX):
+        check_resolution(d)
         self.d = d
         self.nx = 22 * d
-        self.ny = int(round(4.1 * d))
+        self.ny = 41 * d // 10
         self.u_max = u_max
         self.u_mean = 2.0 * u_max / 3.0
         self.re = re

@@ -13,7 +13,8 @@ import math
 
 from solver import units
 from solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
-from solver.validation.schaefer_turek import REF_2D1, U_MAX, Geometry, reference_dp_coefficient
+from solver.validation.schaefer_turek import (REF_2D1, U_MAX, Geometry, check_resolution,  # noqa: F401 (validate's hook)
+                                             reference_dp_coefficient)
 
 NAME = "schaefer-turek-2d1"
 DEFAULT_RESOLUTION = 20

@@ -34,7 +34,7 @@ import numpy as np
 
 from solver import units
 from solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
-from solver.validation.schaefer_turek import INTERVALS_2D2, Geometry
+from solver.validation.schaefer_turek import INTERVALS_2D2, Geometry, check_resolution  # noqa: F401 (validate's hook)
 
 NAME = "schaefer-turek-2d2"
 DEFAULT_RESOLUTION = 40
