@@ -119,6 +119,12 @@ def main() -> None:
     an.add_argument("paths", nargs="+")
     a = p.parse_args()
     if a.cmd == "record":
+        from solver.validation.schaefer_turek import check_resolution
+
+        try:
+            check_resolution(a.d)
+        except ValueError as exc:
+            p.error(f"--d: {exc}")
         record(a)
     else:
         for path in a.paths:
