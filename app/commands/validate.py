@@ -19,7 +19,8 @@ def add_arguments(parser):
     parser.add_argument("--case", action="append", metavar="NAME",
                         help=f"a case to run (repeatable; default: all): {', '.join(CASES)}")
     parser.add_argument("--resolution", default=None, metavar="N",
-                        help="cells per diameter (channel width for poiseuille, grid size for taylor-green); "
+                        help="cells per diameter (a multiple of 10 for the Schaefer-Turek cases, whose channel "
+                             "is 4.1 diameters high; channel width for poiseuille, grid size for taylor-green); "
                              "default: each case's own")
     parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
     parser.add_argument("--json", default=None, metavar="PATH", help="also write the results as JSON")
