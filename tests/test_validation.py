@@ -102,6 +102,6 @@ def test_schaefer_turek_lengths_keep_the_benchmark_ratios(d):
     from solver.validation.schaefer_turek import Geometry
 
     g = Geometry(d, 100.0)
-    assert g.ny == 4.1 * d and g.nx == 22 * d
+    assert 10 * g.ny == 41 * d and g.nx == 22 * d
     cx, cy = g.centre
     assert (cx + 0.5, cy + 0.5) == (2 * d, 2 * d) and (g.ny - 0.5) - cy == pytest.approx(2.1 * d)
