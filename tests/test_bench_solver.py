@@ -62,6 +62,7 @@ def test_bench_alternates_the_backends_in_rounds_and_takes_the_median_ratio(tmp_
 
 
 def test_bench_refuses_fewer_than_one_round(capsys):
+    """One line on stderr, before anything is measured or printed."""
     assert cli_main(["bench", "--rounds", "0"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["feelflow: --rounds: must be at least 1, got 0"]
+    out, err = capsys.readouterr()
+    assert err.strip().splitlines() == ["feelflow: --rounds: must be at least 1, got 0"] and out == ""

@@ -139,6 +139,14 @@ def _gl_context():
         return None, str(exc)
 
 
+def bench_rounds(quick: bool, rounds: int | None) -> int:
+    """`--rounds` as given (default 3, --quick 1); UserError unless it is at least 1."""
+    rounds = rounds if rounds is not None else (1 if quick else 3)
+    if rounds < 1:
+        raise UserError(f"--rounds: must be at least 1, got {rounds}")
+    return rounds
+
+
 def run_bench(quick: bool, seconds: float | None, rounds: int | None = None):
     """Every scene and grid on both backends, in `rounds` alternating rounds (numpy, gl, numpy,
     gl, ...; default 3, --quick 1), each `seconds` long: a row holds the medians of its rounds
@@ -147,9 +155,7 @@ def run_bench(quick: bool, seconds: float | None, rounds: int | None = None):
     from solver.backend import create_solver
 
     seconds = seconds if seconds is not None else (0.3 if quick else 2.0)
-    rounds = rounds if rounds is not None else (1 if quick else 3)
-    if rounds < 1:
-        raise UserError(f"--rounds: must be at least 1, got {rounds}")
+    rounds = bench_rounds(quick, rounds)
     bandwidth = copy_bandwidth(64 if quick else 512)
     bound = bandwidth / BYTES_PER_NODE_STEP / 1e6
     ctx, gl_error = _gl_context()
@@ -526,6 +532,7 @@ def main(args) -> int:
             print(f"    {knob:28s} " + (f"{m['mlups']:8.1f} {m['mlups_per_cpu_s']:8.1f}  {m['renderer']}"
                                          if m is not None else "failed"))
     else:
+        bench_rounds(quick, getattr(args, "rounds", None))  # refused before anything is printed or run
         m = machine()
         print(f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}, Python {m['python']}, "
               f"numpy {m['numpy']}, LP_NUM_THREADS {m['LP_NUM_THREADS']}")
