@@ -50,6 +50,7 @@ def test_cli_sweeps_both_numpy_precisions_and_writes_json(tmp_path, monkeypatch,
     the float64 answer to float32 precision, and the JSON holds the machine and every row."""
     monkeypatch.setattr(bench_accuracy, "QUICK_RESOLUTIONS", (10,))
     monkeypatch.setattr(bench_accuracy, "QUICK_SPEEDS", (0.075,))
+    monkeypatch.setattr(bench_accuracy, "QUICK_TAU_FIXED", ((10, 0.075),))
     out = tmp_path / "acc.json"
     assert cli_main(["bench", "accuracy", "--quick", "--backend", "numpy", "--json", str(out)]) == 0
     data = json.loads(out.read_text())
@@ -58,5 +59,19 @@ def test_cli_sweeps_both_numpy_precisions_and_writes_json(tmp_path, monkeypatch,
     assert r64["grid"] == "220x41" and r64["steps"] > 0 and r64["mlups"] > 0
     assert r32["cd_error"] == pytest.approx(r64["cd_error"], abs=2e-5)
     assert data["variants"]["numpy float64"]["speed"][0] == r64  # the shared point is not run twice
+    assert data["variants"]["numpy float64"]["tau"] == [r64]
     printed = capsys.readouterr().out
     assert "C_D err %" in printed and "numpy float32" in printed
+
+
+def test_cli_runs_only_the_axes_asked_for(tmp_path, monkeypatch, capsys):
+    """`--axis tau`: only the fixed-tau points run (here one, D = 10), the other axes stay empty,
+    and the printed tables leave them out."""
+    monkeypatch.setattr(bench_accuracy, "QUICK_TAU_FIXED", ((10, 0.075),))
+    out = tmp_path / "acc.json"
+    assert cli_main(["bench", "accuracy", "--quick", "--backend", "numpy", "--axis", "tau", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    for v in data["variants"].values():
+        assert v["resolution"] == [] and v["speed"] == [] and [(r["d"], r["u_max"]) for r in v["tau"]] == [(10, 0.075)]
+    printed = capsys.readouterr().out
+    assert "Axis: resolution at fixed tau" in printed and "Axis: time step" not in printed

@@ -25,6 +25,8 @@ def add_arguments(parser):
     parser.add_argument("--quick", action="store_true", help="solver, accuracy: fewer steps or points (smoke test)")
     parser.add_argument("--backend", action="append", choices=("numpy", "gl"),
                         help="accuracy: only this backend (repeatable; default: numpy float64, numpy float32, gl)")
+    parser.add_argument("--axis", action="append", choices=("resolution", "speed", "tau"),
+                        help="accuracy: only this axis (repeatable; default: all three)")
     parser.add_argument("--variants", action="store_true",
                         help="solver: compare the gl backend's tuning variants (docs/performance.md)")
     parser.add_argument("--profile", action="store_true",

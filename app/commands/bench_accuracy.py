@@ -11,7 +11,12 @@ float32, gl float32) along two axes of what a run costs:
   only the resolution changes along the axis and not the blockage D / H;
 - *time step*: the inflow speed U_m in lattice units at a fixed D. At fixed D and Re, a larger
   U_m means fewer steps per unit of physical time (the same grid, a larger time step) but a
-  larger Mach number, whose compressibility error grows like Ma^2.
+  larger Mach number, whose compressibility error grows like Ma^2;
+- *tau fixed* (diffusive scaling): D grows with U_m D held constant, so tau, the collision's
+  and the boundary rules' only parameter, stays that of D = 20 at the validation's U_m, and the
+  Mach number falls like 1 / D. Every error term of a second-order scheme then falls like D^-2,
+  which the resolution axis cannot show: there tau grows with D, and the curved-wall rule's
+  error depends on tau (docs/validation.md, 2D-2 item 9).
 
 Per run it reports the grid, steps, wall and CPU seconds, MLUPS, and the relative errors of
 C_D, C_L and dp against the refined reference values (John 2004,
@@ -31,6 +36,10 @@ SPEED_RESOLUTION = 20  # the window's default body size
 QUICK_RESOLUTIONS = (10, 20)
 QUICK_SPEEDS = (0.05, 0.09)
 QUICK_SPEED_RESOLUTION = 10
+#: (D, U_m) with U_m D constant: tau 0.65 as at D = 20, U_m 0.075; quick: tau 0.59
+TAU_FIXED = ((20, 0.075), (30, 0.05), (40, 0.0375))
+QUICK_TAU_FIXED = ((10, 0.09), (20, 0.045))
+AXES = ("resolution", "speed", "tau")
 #: (label, backend, dtype)
 VARIANTS = (("numpy float64", "numpy", "float64"), ("numpy float32", "numpy", "float32"),
             ("gl float32", "gl", "float32"))
@@ -62,7 +71,7 @@ def run_point(make_solver, d: int, u_max: float) -> dict:
 
 
 def observed_orders(rows) -> list[dict]:
-    """Order of the C_D error between successive resolutions of one backend (same U_m)."""
+    """Order of the C_D error between successive resolutions of one backend along one axis."""
     out = []
     for a, b in zip(rows, rows[1:]):
         ea, eb = abs(a["cd_error"]), abs(b["cd_error"])
@@ -84,11 +93,13 @@ def fitted_order(rows) -> float:
     return round(-sum((x - mx) * (y - my) for x, y in pts) / sxx, 2)
 
 
-def run_sweep(quick: bool, backends=None) -> dict:
+def run_sweep(quick: bool, backends=None, axes=None) -> dict:
     from app.commands.bench_solver import _gl_context, machine
 
-    resolutions = QUICK_RESOLUTIONS if quick else RESOLUTIONS
-    speeds = QUICK_SPEEDS if quick else SPEEDS
+    axes = set(axes or AXES)
+    resolutions = (QUICK_RESOLUTIONS if quick else RESOLUTIONS) if "resolution" in axes else ()
+    speeds = (QUICK_SPEEDS if quick else SPEEDS) if "speed" in axes else ()
+    tau_fixed = (QUICK_TAU_FIXED if quick else TAU_FIXED) if "tau" in axes else ()
     d_speed = QUICK_SPEED_RESOLUTION if quick else SPEED_RESOLUTION
     from solver.validation.schaefer_turek import U_MAX
 
@@ -101,7 +112,8 @@ def run_sweep(quick: bool, backends=None) -> dict:
     renderer = ctx.info.get("GL_RENDERER") if ctx else None
     out = {"machine": machine(), "renderer": renderer, "case": "schaefer-turek-2d1 (Re 20, steady)",
            "resolution_axis": {"u_max": U_MAX, "d": list(resolutions)},
-           "speed_axis": {"d": d_speed, "u_max": list(speeds)}, "variants": {}}
+           "speed_axis": {"d": d_speed, "u_max": list(speeds)},
+           "tau_axis": {"d_u_max": [list(p) for p in tau_fixed]}, "variants": {}}
     for label, backend, dtype in VARIANTS:
         if backends and backend not in backends:
             continue
@@ -110,17 +122,22 @@ def run_sweep(quick: bool, backends=None) -> dict:
             print(f"{label}: skipped ({gl_error})", flush=True)
             continue
         make = _factory(backend, dtype, ctx)
-        by_d, by_u = [], []
-        for d in resolutions:
-            by_d.append(run_point(make, d, U_MAX))
-            print(format_row(label, by_d[-1]), flush=True)
-        for u in speeds:
-            row = next((r for r in by_d if r["d"] == d_speed and r["u_max"] == u), None)
-            by_u.append(row or run_point(make, d_speed, u))
+        done = []  # every run of this variant: a point two axes share runs once
+
+        def point(d, u):
+            row = next((r for r in done if r["d"] == d and r["u_max"] == u), None)
             if row is None:
-                print(format_row(label, by_u[-1]), flush=True)
+                row = run_point(make, d, u)
+                done.append(row)
+                print(format_row(label, row), flush=True)
+            return row
+
+        by_d = [point(d, U_MAX) for d in resolutions]
+        by_u = [point(d_speed, u) for u in speeds]
+        by_tau = [point(d, u) for d, u in tau_fixed]
         out["variants"][label] = {"backend": backend, "dtype": dtype, "resolution": by_d,
-                                  "orders": observed_orders(by_d), "fitted_order": fitted_order(by_d), "speed": by_u}
+                                  "orders": observed_orders(by_d), "fitted_order": fitted_order(by_d), "speed": by_u,
+                                  "tau": by_tau, "tau_orders": observed_orders(by_tau)}
     return out
 
 
@@ -140,7 +157,10 @@ def markdown_tables(result) -> str:
     cols = "| variant | D | U_m | tau | grid | steps | wall s | CPU s | MLUPS | C_D error | C_L error | dp error |"
     rule = "|" + " --- |" * (cols.count("|") - 1)
     out = []
-    for axis, title in (("resolution", "resolution (U_m fixed)"), ("speed", "time step (D fixed)")):
+    for axis, title in (("resolution", "resolution (U_m fixed)"), ("speed", "time step (D fixed)"),
+                        ("tau", "resolution at fixed tau (U_m D fixed)")):
+        if not any(v.get(axis) for v in result["variants"].values()):
+            continue
         out += ["", f"Axis: {title}", "", cols, rule]
         for label, v in result["variants"].items():
             for r in v.get(axis, []):
@@ -157,13 +177,17 @@ def main(args) -> int:
     print(f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}, Python {m['python']}, numpy {m['numpy']}")
     print("Schaefer-Turek 2D-1 (Re 20) to convergence; errors against John 2004's reference values\n")
     print(HEADER, flush=True)
-    result = run_sweep(bool(getattr(args, "quick", False)), getattr(args, "backend", None))
+    result = run_sweep(bool(getattr(args, "quick", False)), getattr(args, "backend", None),
+                       getattr(args, "axis", None))
     if result["renderer"]:
         print(f"renderer: {result['renderer']}")
     for label, v in result["variants"].items():
-        if "orders" in v:
+        if v.get("orders"):
             orders = ", ".join(f"{o['from_d']}->{o['to_d']}: {o['order']}" for o in v["orders"])
             print(f"{label}: observed order of the C_D error {orders}; fitted over all D: {v['fitted_order']}")
+        if v.get("tau_orders"):
+            orders = ", ".join(f"{o['from_d']}->{o['to_d']}: {o['order']}" for o in v["tau_orders"])
+            print(f"{label}: observed order of the C_D error at fixed tau {orders}")
     print(markdown_tables(result))
     if getattr(args, "json", None):
         from app.files import write_json_atomic
