@@ -147,7 +147,7 @@ HEADER = (f"{'variant':14s} {'D':>3s} {'U_m':>6s} {'grid':>9s} {'tau':>6s} {'ste
 
 def format_row(label: str, r: dict) -> str:
     flag = "" if r["converged"] else "  (not converged)"
-    return (f"{label:14s} {r['d']:3d} {r['u_max']:6.3f} {r['grid']:>9s} {r['tau']:6.3f} {r['steps']:7d} "
+    return (f"{label:14s} {r['d']:3d} {r['u_max']:6.4f} {r['grid']:>9s} {r['tau']:6.3f} {r['steps']:7d} "
             f"{r['wall_s']:7.1f} {r['cpu_s']:7.1f} {r['mlups']:6.1f} {100 * r['cd_error']:+10.3f} "
             f"{100 * r['cl_error']:+10.2f} {100 * r['dp_error']:+9.3f}{flag}")
 
