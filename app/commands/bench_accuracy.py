@@ -2,7 +2,7 @@
 
 Runs Schaefer-Turek 2D-1 (steady flow past a cylinder at Re = 20, `solver/validation/
 schaefer_turek_2d1.py`, to its convergence criterion) for each backend (numpy float64, numpy
-float32, gl float32) along two axes of what a run costs:
+float32, gl float32) along three axes of what a run costs and what it tells:
 
 - *resolution*: cells per diameter D at the validation's inflow speed U_m = 0.075: error falls
   like D^-2 (second-order scheme), work rises like D^3 (nodes D^2, steps to the steady state D).
