@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import importlib
 
+from app.commands.bench_accuracy import AXES
+
 TARGETS = {"solver": "app.commands.bench_solver", "accuracy": "app.commands.bench_accuracy",
            "haptics": "app.commands.bench_haptics"}
 
@@ -25,7 +27,7 @@ def add_arguments(parser):
     parser.add_argument("--quick", action="store_true", help="solver, accuracy: fewer steps or points (smoke test)")
     parser.add_argument("--backend", action="append", choices=("numpy", "gl"),
                         help="accuracy: only this backend (repeatable; default: numpy float64, numpy float32, gl)")
-    parser.add_argument("--axis", action="append", choices=("resolution", "speed", "tau"),
+    parser.add_argument("--axis", action="append", choices=AXES,
                         help="accuracy: only this axis (repeatable; default: all three)")
     parser.add_argument("--variants", action="store_true",
                         help="solver: compare the gl backend's tuning variants (docs/performance.md)")

@@ -122,15 +122,13 @@ def run_sweep(quick: bool, backends=None, axes=None) -> dict:
             print(f"{label}: skipped ({gl_error})", flush=True)
             continue
         make = _factory(backend, dtype, ctx)
-        done = []  # every run of this variant: a point two axes share runs once
+        done = {}  # (D, U_m) -> row: a point two axes share runs once
 
         def point(d, u):
-            row = next((r for r in done if r["d"] == d and r["u_max"] == u), None)
-            if row is None:
-                row = run_point(make, d, u)
-                done.append(row)
-                print(format_row(label, row), flush=True)
-            return row
+            if (d, u) not in done:
+                done[d, u] = run_point(make, d, u)
+                print(format_row(label, done[d, u]), flush=True)
+            return done[d, u]
 
         by_d = [point(d, U_MAX) for d in resolutions]
         by_u = [point(d_speed, u) for u in speeds]
