@@ -46,7 +46,7 @@ uniform sampler2D QB;          // q[5..8, x]
 // @INCLUDE body_links.glsl
 #endif
 #if EDGES || SPONGE
-uniform sampler2D INFLOW;      // inflow profile(iy) in texel (iy, 0)
+uniform sampler2D INFLOW;      // texel (iy, 0): r profile(iy), gba rule c's links 1, 5, 8 (inflow.py)
 uniform float inflow_ramp;     // ramp(t): u_in(iy, t) = ramp(t) profile(iy)
 #endif
 
@@ -226,7 +226,8 @@ void node_update(ivec2 x, inout float gin[9], float own[9], float west[9]) {
     float plain[9] = gin;  // plain[ib] = g_ib(x + c_i): the second node of the interpolation
 #endif
 #if EDGES
-    float uin = X_PERIODIC == 0 ? inflow_ramp * texelFetch(INFLOW, ivec2(x.y, 0), 0).r : 0.0;
+    // rule c's wall velocity per inlet link, at the link's midpoint (inlet_wall_profile)
+    vec3 uin = X_PERIODIC == 0 ? inflow_ramp * texelFetch(INFLOW, ivec2(x.y, 0), 0).gba : vec3(0.0);
     // outlet velocity u_b = u(x) + (u(x) - u(x - 1)) / 2 of the stored populations
     // (solver/inflow.py, outlet_incoming; Krueger et al. 2017, eq. 5.53)
     vec2 u_out = vec2(0.0);
@@ -263,7 +264,8 @@ void node_update(ivec2 x, inout float gin[9], float own[9], float west[9]) {
             if (Y_MODE == 0) gin[i] = own[ib];                      // half-way bounce-back
             else gin[i] = pop(reflect_y(i), wrap(s2));              // specular reflection
         } else if (X_PERIODIC == 0 && ci.x > 0 && s.x < 0) {  // rule c: inlet
-            gin[i] = own[ib] + 6.0 * W[i] * RHO0 * (float(ci.x) * uin);
+            float uw = ci.y == 0 ? uin.x : (ci.y > 0 ? uin.y : uin.z);  // links 1, 5, 8
+            gin[i] = own[ib] + 6.0 * W[i] * RHO0 * uw;
         } else if (X_PERIODIC == 0 && ci.x < 0 && s.x >= N.x) {  // rule d: pressure outlet
             float cu = dot(vec2(ci), u_out);
             gin[i] = -own[ib] + 2.0 * W[i] * RHO0 * (4.5 * cu * cu - 1.5 * usq_out);

@@ -72,7 +72,7 @@ from solver.body import expand_box, move_body, shifted, union_box, unshifted
 from solver.forces.base import BodyWindow
 from solver.gl_layout import TEXTURES, pack, texel_box, texels, unpack
 from solver.gl_programs import create_program
-from solver.inflow import profile, ramp
+from solver.inflow import inlet_wall_profile, profile, ramp
 from solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 from solver.numpy_backend import absorb_keep, relaxation_rates
 
@@ -228,7 +228,7 @@ class GLSolver(Solver):
         self._mask_tex.write(np.zeros((ny, nx), "u4"))
         self._qa_tex.write(np.zeros((ny, nx, 4), "f4"))
         self._qb_tex.write(np.zeros((ny, nx, 4), "f4"))
-        self._inflow_tex = tex((ny, 1), 1)
+        self._inflow_tex = tex((ny, 1), 4)  # row profile, rule c's three inlet links
         self._omega_tex = tex((nx, 1), 3)
         keep = absorb_keep(cfg)
         rates = np.stack(np.broadcast_arrays(np.asarray(op, float) * np.ones(nx), np.asarray(om, float),
@@ -415,14 +415,17 @@ class GLSolver(Solver):
 
     def _update_inflow(self, t):
         """u_in(iy, t) = ramp(t) profile(iy) (solver/inflow.py): the ramp as a uniform each
-        step, the profile texture rewritten only when the speed changes (a texture write while
+        step, the profile texture (r: the row, gba: rule c's links 1, 5, 8, inlet_wall_profile)
+        rewritten only when the speed changes (a texture write while
         a queued step reads it would stall the pipeline)."""
         cfg = self.config
         if cfg.x_boundary != "tunnel":
             return
         if self._inflow_key != self.inflow_speed:
             self._inflow_key = self.inflow_speed
-            self._inflow_tex.write(profile(cfg.ny, self.inflow_speed, cfg.inflow_profile).astype("f4").tobytes())
+            rows = profile(cfg.ny, self.inflow_speed, cfg.inflow_profile)
+            links = inlet_wall_profile(cfg.ny, self.inflow_speed, cfg.inflow_profile)
+            self._inflow_tex.write(np.stack([rows, *links], -1).astype("f4").tobytes())
         r = float(ramp(t, cfg.inflow_ramp_steps))
         if self._uniform_values.get("inflow_ramp") != r:  # constant once the ramp is over
             self._uniform_values["inflow_ramp"] = r  # also for programs compiled later

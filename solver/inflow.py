@@ -1,9 +1,10 @@
 """Tunnel ends: inlet velocity (smooth ramp-up times a profile) and the pressure outlet.
 
-docs/algorithm.md, rules c and d and 'Inflow'. One definition for both backends: `ramp` and
-`profile` (the numpy backend multiplies them each step with the profile cached, the gl backend
-uploads the profile as a texture and the ramp as a uniform); `inflow_velocity` is their product,
-the definition the tests check; the gl backend implements `outlet_incoming` in GLSL.
+docs/algorithm.md, rules c and d and 'Inflow'. One definition for both backends: `ramp`,
+`profile` (per row) and `inlet_wall_profile` (per inlet link: rule c) (the numpy backend
+multiplies them each step with the profiles cached, the gl backend uploads the profiles as a
+texture and the ramp as a uniform); `inflow_velocity` is the row's product, the definition the
+tests check; the gl backend implements `outlet_incoming` in GLSL.
 """
 from __future__ import annotations
 
@@ -13,6 +14,8 @@ import numpy as np
 
 from solver.lattice import C, OPP, RHO0, W
 
+#: the populations the inlet supplies (c_x = +1)
+INLET_DIRECTIONS = (1, 5, 8)
 #: the populations the outlet supplies (c_x = -1)
 OUTLET_DIRECTIONS = (3, 6, 7)
 
@@ -24,18 +27,39 @@ def ramp(t: int, ramp_steps: int) -> float:
     return 0.5 * (1.0 - math.cos(math.pi * t / ramp_steps))
 
 
-def profile(ny: int, speed: float, kind: str) -> np.ndarray:
-    """Inlet x-velocity per row iy, (ny,) float64.
+def profile_at(s, ny: int, speed: float, kind: str) -> np.ndarray:
+    """Inlet x-velocity at heights `s` above the lower wall (cells; walls at s = 0 and s = ny,
+    i.e. y = -1/2 and ny - 1/2), float64 array shaped like `s`.
 
-    uniform: U everywhere. parabolic: Poiseuille profile between walls at -1/2 and ny - 1/2,
-    4 U s (H - s) / H^2 with s = iy + 1/2, H = ny, so U is the centre-line (peak) speed.
+    uniform: U everywhere. parabolic: the Poiseuille profile 4 U s (H - s) / H^2 with H = ny, so
+    U is the centre-line (peak) speed.
     """
+    s = np.asarray(s, dtype=np.float64)
     if kind == "uniform":
-        return np.full(ny, float(speed))
+        return np.full(s.shape, float(speed))
     if kind == "parabolic":
-        s = np.arange(ny, dtype=np.float64) + 0.5
         return 4.0 * speed * s * (ny - s) / float(ny) ** 2
     raise ValueError(f"unknown inflow profile {kind!r}")
+
+
+def profile(ny: int, speed: float, kind: str) -> np.ndarray:
+    """Inlet x-velocity per row iy (at the row's height s = iy + 1/2), (ny,) float64."""
+    return profile_at(np.arange(ny) + 0.5, ny, speed, kind)
+
+
+def inlet_wall_profile(ny: int, speed: float, kind: str) -> np.ndarray:
+    """Rule c's wall velocity per link, (3, ny) float64 ordered as INLET_DIRECTIONS.
+
+    The population i of row iy enters from the ghost node (-1, iy - c_iy); half-way bounce-back
+    reflects it at the link's midpoint (-1/2, iy - c_iy / 2), so the moving-wall term takes the
+    inflow there (Ladd 1994: the wall velocity at the point where the link meets the wall), at
+    s = iy + 1/2 - c_iy / 2: the row's own height for i = 1, half a cell below for i = 5, half a
+    cell above for i = 8. The row's own velocity for the diagonals is off by half a cell's change
+    of the profile, a first-order error that shears the flow at the inlet (docs/validation.md,
+    2D-2 item 10).
+    """
+    s = np.arange(ny) + 0.5
+    return np.stack([profile_at(s - 0.5 * C[i, 1], ny, speed, kind) for i in INLET_DIRECTIONS])
 
 
 def inflow_velocity(config, t: int, speed: float | None = None) -> np.ndarray:

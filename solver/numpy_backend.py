@@ -16,7 +16,7 @@ from solver.bouzidi import incoming
 from solver.collision import Collider
 from solver.config import FlowConfig
 from solver.forces.base import BodyWindow
-from solver.inflow import OUTLET_DIRECTIONS, outlet_incoming, profile, ramp
+from solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS, inlet_wall_profile, outlet_incoming, profile, ramp
 from solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 
 #: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall
@@ -103,7 +103,7 @@ class NumpySolver(Solver):
         self._solid_idx = None
         self._solid_g = None
         self._impulse = (0.0, 0.0)
-        self._inflow_key = self._inflow_profile = None
+        self._inflow_key = self._inflow_profile = self._inlet_wall_profile = None
 
     # --- body -----------------------------------------------------------------
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
@@ -174,10 +174,12 @@ class NumpySolver(Solver):
         if cfg.x_boundary == "tunnel":
             # d: outlet, anti-bounce-back at x = nx - 1/2 with rho = RHO0 (pressure outlet)
             gin[OUTLET_DIRECTIONS, :, nx - 1] = outlet_incoming(g[:, :, nx - 2:])
-            # c: inlet, moving-wall half-way bounce-back at x = -1/2
+            # c: inlet, moving-wall half-way bounce-back at x = -1/2, each link with the inflow
+            # at its own midpoint (solver.inflow.inlet_wall_profile)
             u_in = self._inflow_velocity(t)
-            for i in (1, 5, 8):
-                gin[i, :, 0] = g[OPP[i], :, 0] + (6.0 * W[i] * RHO0) * u_in
+            r = ramp(t, cfg.inflow_ramp_steps)
+            for k, i in enumerate(INLET_DIRECTIONS):
+                gin[i, :, 0] = g[OPP[i], :, 0] + (6.0 * W[i] * RHO0 * r) * self._inlet_wall_profile[k]
         if cfg.y_boundary != "periodic":
             self._walls(g, gin)
         b = self.body
@@ -195,12 +197,13 @@ class NumpySolver(Solver):
 
     def _inflow_velocity(self, t: int) -> np.ndarray:
         """u_in(iy, t) = ramp(t) profile(iy), as solver.inflow.inflow_velocity computes it, with
-        the profile rebuilt only when the speed changes (the config is fixed for a solver's life),
+        the profiles (per row, and rule c's per inlet link) rebuilt only when the speed changes (the config is fixed for a solver's life),
         as the gl backend does with its profile texture."""
         cfg = self.config
         if self._inflow_key != self.inflow_speed:
             self._inflow_key = self.inflow_speed
             self._inflow_profile = profile(cfg.ny, self.inflow_speed, cfg.inflow_profile)
+            self._inlet_wall_profile = inlet_wall_profile(cfg.ny, self.inflow_speed, cfg.inflow_profile)
         return ramp(t, cfg.inflow_ramp_steps) * self._inflow_profile
 
     def _walls(self, g, gin) -> None:
