@@ -176,8 +176,8 @@ class NumpySolver(Solver):
             gin[OUTLET_DIRECTIONS, :, nx - 1] = outlet_incoming(g[:, :, nx - 2:])
             # c: inlet, moving-wall half-way bounce-back at x = -1/2, each link with the inflow
             # at its own midpoint (solver.inflow.inlet_wall_profile)
-            u_in = self._inflow_velocity(t)
-            r = ramp(t, cfg.inflow_ramp_steps)
+            r = self._inflow_ramp(t)
+            u_in = r * self._inflow_profile  # u_in(iy, t), as solver.inflow.inflow_velocity
             for k, i in enumerate(INLET_DIRECTIONS):
                 gin[i, :, 0] = g[OPP[i], :, 0] + (6.0 * W[i] * RHO0 * r) * self._inlet_wall_profile[k]
         if cfg.y_boundary != "periodic":
@@ -195,16 +195,16 @@ class NumpySolver(Solver):
         if not np.isfinite(total):
             raise SolverDiverged(t + 1, "density is no longer finite")
 
-    def _inflow_velocity(self, t: int) -> np.ndarray:
-        """u_in(iy, t) = ramp(t) profile(iy), as solver.inflow.inflow_velocity computes it, with
-        the profiles (per row, and rule c's per inlet link) rebuilt only when the speed changes (the config is fixed for a solver's life),
-        as the gl backend does with its profile texture."""
+    def _inflow_ramp(self, t: int) -> float:
+        """ramp(t), with the cached profiles (per row, and rule c's per inlet link) rebuilt only
+        when the speed changes (the config is fixed for a solver's life), as the gl backend does
+        with its profile texture."""
         cfg = self.config
         if self._inflow_key != self.inflow_speed:
             self._inflow_key = self.inflow_speed
             self._inflow_profile = profile(cfg.ny, self.inflow_speed, cfg.inflow_profile)
             self._inlet_wall_profile = inlet_wall_profile(cfg.ny, self.inflow_speed, cfg.inflow_profile)
-        return ramp(t, cfg.inflow_ramp_steps) * self._inflow_profile
+        return ramp(t, cfg.inflow_ramp_steps)
 
     def _walls(self, g, gin) -> None:
         """Rule b: half-way bounce-back (no_slip) or specular reflection (free_slip) at

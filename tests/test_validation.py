@@ -96,10 +96,13 @@ def test_schaefer_turek_2d1_drag_converges_at_second_order_with_tau_held(request
     item 10)."""
     import math
 
+    from app.commands.bench_accuracy import TAU_FIXED
+
     st = case_module("schaefer-turek-2d1")
+    points = TAU_FIXED[:2]  # (20, 0.075), (30, 0.05)
     errors = [abs(st.run(factory("numpy", request), resolution=d, u_max=u)
-                  .quantities["cd_rel_error"]) for d, u in ((20, 0.075), (30, 0.05))]
-    order = math.log(errors[0] / errors[1]) / math.log(30 / 20)
+                  .quantities["cd_rel_error"]) for d, u in points]
+    order = math.log(errors[0] / errors[1]) / math.log(points[1][0] / points[0][0])
     assert order > 1.8, (errors, order)
 
 
