@@ -15,13 +15,13 @@ from app.cli import UserError
 from solver.motion import MOVES, MotionScript, Phase, phase_velocity
 from solver import units
 from solver.backend import BACKENDS
-from solver.config import COLLISIONS, DTYPES, PROFILES, X_BOUNDARIES, Y_BOUNDARIES, ConfigError, FlowConfig
+from solver.config import COLLISIONS, DTYPES, EQUILIBRIA, PROFILES, X_BOUNDARIES, Y_BOUNDARIES, ConfigError, FlowConfig
 from solver.forces import MODELS
 
 #: FlowConfig field -> scene key (for messages from FlowConfig.validate)
 CONFIG_KEYS = {
     "nx": "grid.nx", "ny": "grid.ny", "nu": "flow.nu", "collision": "flow.collision",
-    "trt_magic": "flow.trt_magic", "dtype": "flow.dtype", "x_boundary": "flow.x_boundary",
+    "trt_magic": "flow.trt_magic", "equilibrium": "flow.equilibrium", "dtype": "flow.dtype", "x_boundary": "flow.x_boundary",
     "y_boundary": "flow.walls", "inflow_speed": "flow.inflow_speed",
     "inflow_profile": "flow.inflow_profile", "inflow_ramp_steps": "flow.inflow_ramp_steps",
     "body_force": "flow.body_force", "sponge_cells": "flow.sponge_cells",
@@ -188,6 +188,7 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
     flow = top.table("flow")
     collision = flow.choice("collision", COLLISIONS, "trt")
     trt_magic = flow.number("trt_magic", 3.0 / 16.0, positive=True)
+    equilibrium = flow.choice("equilibrium", EQUILIBRIA, "compressible")
     dtype = flow.choice("dtype", DTYPES, "float64")
     x_boundary = flow.choice("x_boundary", X_BOUNDARIES, "tunnel")
     walls = flow.choice("walls", Y_BOUNDARIES, "no_slip")
@@ -245,7 +246,7 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
 
     try:
         config = FlowConfig(
-            nx=nx, ny=ny, nu=nu, collision=collision, trt_magic=trt_magic, dtype=dtype,
+            nx=nx, ny=ny, nu=nu, collision=collision, trt_magic=trt_magic, equilibrium=equilibrium, dtype=dtype,
             x_boundary=x_boundary, y_boundary=walls, inflow_speed=inflow_speed,
             inflow_profile=inflow_profile, inflow_ramp_steps=ramp, body_force=body_force,
             sponge_cells=sponge_cells, sponge_strength=sponge_strength, sponge_absorb=sponge_absorb,

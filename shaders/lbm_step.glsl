@@ -120,7 +120,11 @@ void collide(inout float f[9], ivec2 x) {
     // occlusion query (measured alternative to shaders/finite_check.glsl; the state is lost anyway)
     if (!(abs(drho) < 3.0e38)) discard;
 #endif
+#if INCOMPRESSIBLE
+    float rho = RHO0;  // He & Luo (1997): the velocity terms and u = j / rho take RHO0
+#else
     float rho = drho + RHO0;
+#endif
     float jx = 0.0;
     float jy = 0.0;
     for (int i = 1; i < Q; ++i) {

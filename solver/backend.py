@@ -128,7 +128,8 @@ class Solver(ABC):
         summed on the shifted storage in float64 (no cancellation against RHO0).
 
         With a body force F (Guo et al. 2002) the collision adds F to the momentum, so the
-        fluid velocity of the step is u = (sum_i c_i f*_i - F/2) / rho (sum_i c_i w_i = 0)."""
+        fluid velocity of the step is u = (sum_i c_i f*_i - F/2) / rho (sum_i c_i w_i = 0).
+        With the incompressible equilibrium (He & Luo 1997) the velocity is j / RHO0."""
         from solver.lattice import C, RHO0
 
         g = self.shifted_distributions()
@@ -136,7 +137,8 @@ class Solver(ABC):
         fx, fy = self.config.body_force
         jx = np.tensordot(C[:, 0].astype(np.float64), g, axes=1) - 0.5 * fx
         jy = np.tensordot(C[:, 1].astype(np.float64), g, axes=1) - 0.5 * fy
-        return rho, jx / rho, jy / rho
+        per = RHO0 if self.config.equilibrium == "incompressible" else rho
+        return rho, jx / per, jy / per
 
     def total_mass(self) -> float:
         """sum f over the grid, accumulated in float64 on the shifted storage."""

@@ -5,6 +5,9 @@ Guo, Zheng & Shi (2002) forcing. Populations are g_i = f_i - w_i RHO0; with drho
 equilibrium is f^eq_i - w_i RHO0 = w_i (drho + rho (3 c.u + 9/2 (c.u)^2 - 3/2 u^2)), split over
 each opposite pair (i, ib) into an even part w_i sym and an odd part w_i anti:
     sym = drho + rho/2 ((3 c.u)^2 - 3 u^2),  anti = rho (3 c.u).
+With `incompressible` (He & Luo 1997, J. Stat. Phys. 88, 927) the velocity terms take RHO0 in
+place of rho and u = j / RHO0: the density fluctuation then enters the equilibrium only through
+drho, which removes the O(Ma^2) compressibility terms rho u u of the momentum flux.
 The grid is processed in blocks of rows so the ~15 work arrays stay in cache; every operation
 writes into preallocated scratch (no temporaries).
 """
@@ -12,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver.lattice import C, W
+from solver.lattice import C, RHO0, W
 
 #: opposite pairs (i, ib); the loop computes c_i . u for i
 PAIRS = ((1, 3), (2, 4), (5, 7), (6, 8))
@@ -28,14 +31,16 @@ class Collider:
     the equilibria use the density fluctuation drho * keep and the velocity
     keep u + (1 - keep) u_target, so each collision relaxes the node towards (RHO0, u_target) at
     omega+ (1 - keep); u_target = (target(iy), 0), `target` passed per call.
+    incompressible: He & Luo's equilibrium (module docstring): rho -> RHO0 in the velocity terms.
     """
 
     def __init__(self, ny: int, nx: int, dtype, omega_p, omega_m, trt: bool, force=(0.0, 0.0),
-                 block_nodes: int = BLOCK_NODES, keep=None):
+                 block_nodes: int = BLOCK_NODES, keep=None, incompressible: bool = False):
         self.nx, self.ny = nx, ny
         self.rows = max(1, min(ny, block_nodes // nx))
         self.dtype = np.dtype(dtype)
         self.trt = bool(trt)
+        self.incompressible = bool(incompressible)
         self.force = (float(force[0]), float(force[1]))
         self.has_force = self.force != (0.0, 0.0)
         dt = self.dtype
@@ -80,7 +85,10 @@ class Collider:
         add(f0, f1, out=drho)
         for k in (f2, f3, f4, f5, f6, f7, f8):
             drho += k
-        add(drho, 1.0, out=rho)
+        if self.incompressible:
+            rho.fill(RHO0)             # He & Luo: the velocity terms and u = j / rho take RHO0
+        else:
+            add(drho, RHO0, out=rho)
         if self.keep is None:
             deq = drho                 # the equilibria's density fluctuation
         else:

@@ -12,6 +12,9 @@ from solver.lattice import CS2
 X_BOUNDARIES = ("tunnel", "periodic")
 Y_BOUNDARIES = ("no_slip", "free_slip", "periodic")
 COLLISIONS = ("bgk", "trt")
+#: the equilibrium's velocity terms: rho u (compressible, the seed's eq. 9) or RHO0 u with
+#: u = j / RHO0 (incompressible, He & Luo 1997, J. Stat. Phys. 88, 927)
+EQUILIBRIA = ("compressible", "incompressible")
 PROFILES = ("uniform", "parabolic")
 DTYPES = ("float64", "float32")
 
@@ -31,6 +34,7 @@ class FlowConfig:
     nu: float = 0.02
     collision: str = "trt"
     trt_magic: float = 3.0 / 16.0
+    equilibrium: str = "compressible"
     dtype: str = "float64"
     x_boundary: str = "tunnel"
     y_boundary: str = "no_slip"
@@ -67,6 +71,7 @@ class FlowConfig:
         need(self.tau > 0.5 + 1e-6, "nu", "too small: tau = 3 nu + 1/2 must exceed 1/2")
         need(self.tau < 10, "nu", f"too large (tau = {self.tau:.2f} > 10): lower the viscosity or raise the resolution")
         need(self.collision in COLLISIONS, "collision", f"must be one of {COLLISIONS}, got {self.collision!r}")
+        need(self.equilibrium in EQUILIBRIA, "equilibrium", f"must be one of {EQUILIBRIA}, got {self.equilibrium!r}")
         need(0 < self.trt_magic < 10, "trt_magic", f"must be in (0, 10), got {self.trt_magic!r}")
         need(self.dtype in DTYPES, "dtype", f"must be one of {DTYPES}, got {self.dtype!r}")
         need(self.x_boundary in X_BOUNDARIES, "x_boundary", f"must be one of {X_BOUNDARIES}, got {self.x_boundary!r}")

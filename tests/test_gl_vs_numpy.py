@@ -200,3 +200,19 @@ def test_tunnel_sponge_with_absorbing_layer(nx, request):
                      inflow_ramp_steps=20, sponge_cells=12, sponge_absorb=0.3)
     solvers, _ = _run_pair(cfg, request)
     _check_fields(solvers)
+
+
+@pytest.mark.parametrize("collision", ["bgk", "trt"])
+def test_incompressible_equilibrium_tunnel_and_moving_cylinder(collision, request):
+    """He & Luo's equilibrium (FlowConfig.equilibrium = "incompressible", the INCOMPRESSIBLE
+    define in GLSL) on both backends: a parabolic tunnel with the absorbing sponge and a cylinder
+    moved every step, every force model."""
+    cfg = FlowConfig(nx=64, ny=32, dtype="float32", collision=collision, inflow_profile="parabolic",
+                     inflow_ramp_steps=20, sponge_cells=12, sponge_absorb=0.3, equilibrium="incompressible")
+
+    def move(s, k):
+        s.set_body(Cylinder(8.3, x=20.4 + 0.05 * k, y=15.7 + 0.02 * k), velocity=(0.05, 0.02), omega=0.002)
+
+    solvers, forces = _run_pair(cfg, request, motion=move, models=list(MODELS))
+    _check_fields(solvers)
+    _check_forces(forces, MODELS)

@@ -2,7 +2,8 @@
 
     python -m solver.validation.st2d2_diagnose record --d 20 [--u 0.075] [--ramp-periods 2 | --impulsive]
         [--sponge CELLS [--absorb A]] [--length-d 22] [--conv-times 60] [--sample 2]
-        [--collision trt|bgk] [--magic 0.1875] [--stress] [--backend numpy|gl] --out series.npz
+        [--collision trt|bgk] [--magic 0.1875] [--equilibrium compressible|incompressible] [--stress]
+        [--backend numpy|gl] --out series.npz
     python -m solver.validation.st2d2_diagnose analyse series.npz [...]
 
 `analyse` folds the last three shedding periods (upward zero crossings of C_L) into a
@@ -24,6 +25,7 @@ import argparse
 
 import numpy as np
 
+from solver.config import EQUILIBRIA
 from solver.validation.schaefer_turek import Geometry
 from solver.validation.schaefer_turek_2d2 import RE, upward_zero_crossings
 
@@ -36,7 +38,7 @@ def record(a) -> None:
     geo = Geometry(a.d, RE, u_max=a.u)
     geo.nx = int(round(a.length_d * a.d))
     over = dict(sponge_cells=a.sponge, sponge_strength=10.0, sponge_absorb=a.absorb) if a.sponge else {}
-    over.update(collision=a.collision, trt_magic=a.magic)
+    over.update(collision=a.collision, trt_magic=a.magic, equilibrium=a.equilibrium)
     if a.backend == "gl":  # a diagnostic: the CLI's one-line EGL error handling is app's (solver may not import it)
         import moderngl
 
@@ -111,6 +113,8 @@ def main() -> None:
     r.add_argument("--sample", type=int, default=2)
     r.add_argument("--collision", choices=("trt", "bgk"), default="trt")
     r.add_argument("--magic", type=float, default=3.0 / 16.0, help="TRT magic parameter Lambda")
+    r.add_argument("--equilibrium", choices=EQUILIBRIA, default="compressible",
+                   help="FlowConfig.equilibrium: incompressible is He & Luo 1997")
     r.add_argument("--stress", action="store_true",
                    help="also record C_D from pressure + viscous stress integration (slower)")
     r.add_argument("--backend", choices=("numpy", "gl"), default="numpy")
