@@ -51,7 +51,7 @@ def record(a) -> None:
     else:
         solver = geo.start_from_rest(factory, round(a.ramp_periods * geo.acoustic_period()), **over)
     steps = int(a.conv_times * a.d / geo.u_mean)
-    t, cd, cl, cd_stress, n = [], [], [], [], 0
+    t, cd, cl, cd_stress, cl_stress, n = [], [], [], [], [], 0
     pressure = create_model("pressure") if a.stress else None
     while n < steps:
         solver.step(a.sample)
@@ -62,10 +62,12 @@ def record(a) -> None:
         cl.append(c[1])
         if pressure is not None:
             window = solver.body_window()
-            fx = pressure.compute(window)[0] + viscous_force(window)[0]
-            cd_stress.append(geo.coefficients((fx, 0.0))[0])
+            p_, v_ = pressure.compute(window), viscous_force(window)
+            c_stress = geo.coefficients((p_[0] + v_[0], p_[1] + v_[1]))
+            cd_stress.append(c_stress[0])
+            cl_stress.append(c_stress[1])
     solver.close()
-    extra = {"cd_stress": np.array(cd_stress)} if a.stress else {}
+    extra = {"cd_stress": np.array(cd_stress), "cl_stress": np.array(cl_stress)} if a.stress else {}
     np.savez(a.out, t=np.array(t), cd=np.array(cd), cl=np.array(cl), d=a.d, u_mean=geo.u_mean, **extra)
 
 
@@ -86,6 +88,9 @@ def analyse(path: str, periods: int = 3) -> None:
     if "cd_stress" in z:
         print(f"  mean C_D from pressure + viscous stress integration {z['cd_stress'][w].mean():.4f} "
               f"(momentum exchange {cd[w].mean():.4f})")
+    if "cl_stress" in z:
+        print(f"  C_D,max / C_L,max from pressure + viscous stress {z['cd_stress'][w].max():.4f} / "
+              f"{z['cl_stress'][w].max():.4f} (sampled at block ends)")
     print(f"  raw: C_D,max {cd[w].max():.4f} C_L,max {cl[w].max():.4f}; period-averaged: "
           f"C_D,max {fold_cd.max():.4f} C_L,max {fold_cl.max():.4f}; rms of C_D around it {resid.std():.4f}")
     k0 = max(0, len(ups) - 9)  # spectrum over up to 8 periods
