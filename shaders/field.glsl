@@ -19,7 +19,11 @@ vec3 moments(ivec2 p) {  // (rho, ux, uy) at node p
         rho += g[i];
         j += vec2(C[i]) * g[i];
     }
+#if INCOMPRESSIBLE
+    return vec3(rho, (j - 0.5 * body_force) / RHO0);  // He & Luo's velocity (algorithm.md, step 3)
+#else
     return vec3(rho, (j - 0.5 * body_force) / rho);
+#endif
 }
 
 void main() {

@@ -998,7 +998,8 @@ class GLSolver(Solver):
     def field_texture(self):
         """(rho, ux, uy, vorticity) as an nx x ny RGBA32F texture, computed now by one pass."""
         if self._field is None:
-            self._field = self._aux_pass("field.glsl", (self.nx, self.ny))
+            self._field = self._aux_pass("field.glsl", (self.nx, self.ny),
+                                         {"INCOMPRESSIBLE": self._defines["INCOMPRESSIBLE"]})
         prog, tex, fbo, vao = self._field
         self._begin_pass(fbo, tex.size)
         for unit, texture in zip(UNIT_G, self._g[self._cur]):

@@ -24,10 +24,11 @@ CS2 = 1.0 / 3.0
 RHO0 = 1.0
 
 
-def equilibrium(rho, ux, uy):
+def equilibrium(rho, ux, uy, incompressible: bool = False):
     """Second-order equilibrium f_i^eq (seed eq. 9), shape (9, *rho.shape).
 
-    f_i^eq = w_i rho (1 + 3 c.u + 9/2 (c.u)^2 - 3/2 u.u)
+    f_i^eq = w_i rho (1 + 3 c.u + 9/2 (c.u)^2 - 3/2 u.u); with `incompressible` He & Luo's
+    (1997) f_i^eq = w_i (rho + RHO0 (3 c.u + 9/2 (c.u)^2 - 3/2 u.u)) (docs/algorithm.md, step 3).
     """
     rho = np.asarray(rho)
     ux = np.asarray(ux)
@@ -37,6 +38,8 @@ def equilibrium(rho, ux, uy):
     cx, cy, w = C[:, 0].reshape(lead), C[:, 1].reshape(lead), W.reshape(lead)  # as c_i, w_i alone
     usq = 1.5 * (ux * ux + uy * uy)
     cu = 3.0 * (cx * ux + cy * uy)
+    if incompressible:
+        return (w * (rho + RHO0 * (cu + 0.5 * cu * cu - usq))).astype(dtype, copy=False)
     return (w * rho * (1.0 + cu + 0.5 * cu * cu - usq)).astype(dtype, copy=False)
 
 

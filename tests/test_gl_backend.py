@@ -26,8 +26,10 @@ def test_needs_a_context():
         create_solver("gl", FlowConfig(nx=16, ny=16))
 
 
-def test_field_texture_holds_moments_and_vorticity(request):
-    cfg = FlowConfig(nx=40, ny=24, x_boundary="periodic", y_boundary="periodic", body_force=(1e-5, 0.0))
+@pytest.mark.parametrize("equilibrium", ["compressible", "incompressible"])  # u = j / rho or j / RHO0
+def test_field_texture_holds_moments_and_vorticity(equilibrium, request):
+    cfg = FlowConfig(nx=40, ny=24, x_boundary="periodic", y_boundary="periodic", body_force=(1e-5, 0.0),
+                     equilibrium=equilibrium)
     s = make_solver("gl", cfg, request)
     s.set_distributions(_disturbed(40, 24))
     s.step(5)

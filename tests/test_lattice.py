@@ -34,3 +34,17 @@ def test_equilibrium_moments():
     assert np.allclose(np.tensordot(C[:, 1], feq, 1), rho * uy)
     pxx = np.tensordot(C[:, 0] ** 2, feq, 1)
     assert np.allclose(pxx, rho * CS2 + rho * ux * ux)
+
+
+def test_incompressible_equilibrium_moments():
+    """He & Luo (1997): sum f = rho, sum c f = RHO0 u, sum c c f = rho c_s^2 I + RHO0 u u, so the
+    density fluctuation enters only the pressure."""
+    from solver.lattice import RHO0
+
+    rho, ux, uy = 1.013, 0.04, -0.03
+    f = equilibrium(np.array(rho), np.array(ux), np.array(uy), incompressible=True)
+    c = C.astype(float)
+    u = np.array([ux, uy])
+    assert np.isclose(f.sum(), rho)
+    assert np.allclose(c.T @ f, RHO0 * u)
+    assert np.allclose(np.einsum("ia,ib,i->ab", c, c, f), rho * CS2 * np.eye(2) + RHO0 * np.outer(u, u))
