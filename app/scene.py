@@ -21,7 +21,8 @@ from solver.forces import MODELS
 #: FlowConfig field -> scene key (for messages from FlowConfig.validate)
 CONFIG_KEYS = {
     "nx": "grid.nx", "ny": "grid.ny", "nu": "flow.nu", "collision": "flow.collision",
-    "trt_magic": "flow.trt_magic", "equilibrium": "flow.equilibrium", "dtype": "flow.dtype", "x_boundary": "flow.x_boundary",
+    "trt_magic": "flow.trt_magic", "equilibrium": "flow.equilibrium", "dtype": "flow.dtype",
+    "x_boundary": "flow.x_boundary",
     "y_boundary": "flow.walls", "inflow_speed": "flow.inflow_speed",
     "inflow_profile": "flow.inflow_profile", "inflow_ramp_steps": "flow.inflow_ramp_steps",
     "body_force": "flow.body_force", "sponge_cells": "flow.sponge_cells",
@@ -246,7 +247,8 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
 
     try:
         config = FlowConfig(
-            nx=nx, ny=ny, nu=nu, collision=collision, trt_magic=trt_magic, equilibrium=equilibrium, dtype=dtype,
+            nx=nx, ny=ny, nu=nu, collision=collision, trt_magic=trt_magic, equilibrium=equilibrium,
+            dtype=dtype,
             x_boundary=x_boundary, y_boundary=walls, inflow_speed=inflow_speed,
             inflow_profile=inflow_profile, inflow_ramp_steps=ramp, body_force=body_force,
             sponge_cells=sponge_cells, sponge_strength=sponge_strength, sponge_absorb=sponge_absorb,

@@ -94,6 +94,7 @@ BAD = [
     ({"flow": {"inflow_speed": 0.5}}, "flow.inflow_speed: 0.5 exceeds the Mach limit"),
     ({"flow": {"walls": "sticky"}}, "flow.walls: must be one of no_slip, free_slip, periodic"),
     ({"flow": {"collision": "mrt"}}, "flow.collision: must be one of bgk, trt"),
+    ({"flow": {"equilibrium": "ideal_gas"}}, "flow.equilibrium: must be one of compressible, incompressible"),
     ({"flow": {"inflow_profile": "plug"}}, "flow.inflow_profile"),
     ({"flow": {"sponge_cells": 150}}, "flow.sponge_cells"),
     ({"flow": {"sponge_cells": 20, "sponge_absorb": 0.9}}, "flow.sponge_absorb: must be in 0..0.5, got 0.9"),
@@ -131,3 +132,9 @@ def test_missing_and_malformed_files(tmp_path):
     bad.write_text("[grid\nnx = 3\n")
     with pytest.raises(UserError, match="bad.toml: not valid TOML"):
         load_scene(bad)
+
+
+def test_equilibrium_key_reaches_the_solver_config():
+    scene = scene_from_dict(minimal(flow={"equilibrium": "incompressible"}), "scene.toml")
+    assert scene.config.equilibrium == "incompressible"
+    assert scene_from_dict(minimal(), "scene.toml").config.equilibrium == "compressible"

@@ -1,5 +1,9 @@
-"""Throwaway probe (nineteenth session, docs/validation.md 2D-2 item 11; not product code, nothing imports it): Bouzidi's quadratic interpolated bounce-back (BFL 2001) in place of the linear
-rule, numpy backend, for one 2D-2 or 2D-1 run. Not product code."""
+"""Throwaway probe (nineteenth session, docs/validation.md 2D-2 item 11; not product code,
+nothing imports it): Bouzidi's quadratic interpolated bounce-back (Bouzidi, Firdaouss &
+Lallemand 2001) in place of the linear rule, numpy backend, patched in for one 2D-2 or 2D-1 run.
+
+    python docs/bench/s19/probe_quadratic_bouzidi.py 2d2 40     (or: 2d1 20)
+"""
 import sys, time, json
 import numpy as np
 import solver.bouzidi as bz
