@@ -137,7 +137,7 @@ class Solver(ABC):
         fx, fy = self.config.body_force
         jx = np.tensordot(C[:, 0].astype(np.float64), g, axes=1) - 0.5 * fx
         jy = np.tensordot(C[:, 1].astype(np.float64), g, axes=1) - 0.5 * fy
-        per = RHO0 if self.config.equilibrium == "incompressible" else rho
+        per = self.config.velocity_divisor(rho)
         return rho, jx / per, jy / per
 
     def total_mass(self) -> float:

@@ -63,6 +63,8 @@ class Collider:
         self.release = None if keep is None else np.asarray(1.0 - np.asarray(keep, np.float64), dtype=dt)
         names = ("drho", "deq", "rho", "hrho", "ux", "uy", "q2", "cu", "sym", "anti", "t1", "t2", "uF")
         self._s = {n: np.empty(shape, dtype=dt) for n in names}
+        if self.incompressible:
+            self._s["rho"].fill(RHO0)  # He & Luo: the velocity terms and u = j / rho take RHO0
 
     def __call__(self, f: np.ndarray, target=None) -> float:
         """Collide f (9, ny, nx) in place; return sum of drho (for the divergence check).
@@ -85,9 +87,7 @@ class Collider:
         add(f0, f1, out=drho)
         for k in (f2, f3, f4, f5, f6, f7, f8):
             drho += k
-        if self.incompressible:
-            rho.fill(RHO0)             # He & Luo: the velocity terms and u = j / rho take RHO0
-        else:
+        if not self.incompressible:    # (incompressible: rho holds RHO0 from __init__)
             add(drho, RHO0, out=rho)
         if self.keep is None:
             deq = drho                 # the equilibria's density fluctuation

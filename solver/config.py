@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from solver.lattice import CS2
+from solver.lattice import CS2, RHO0
 
 X_BOUNDARIES = ("tunnel", "periodic")
 Y_BOUNDARIES = ("no_slip", "free_slip", "periodic")
@@ -53,6 +53,15 @@ class FlowConfig:
     def tau(self) -> float:
         """BGK relaxation time, nu = (tau - 1/2) c_s^2 (seed eq. 5)."""
         return self.nu / CS2 + 0.5
+
+    @property
+    def incompressible(self) -> bool:
+        """He & Luo's equilibrium (EQUILIBRIA): the velocity is j / RHO0, not j / rho."""
+        return self.equilibrium == "incompressible"
+
+    def velocity_divisor(self, rho):
+        """What the momentum j is divided by to give the velocity: RHO0 or rho."""
+        return RHO0 if self.incompressible else rho
 
     @property
     def max_speed(self) -> float:

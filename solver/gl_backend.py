@@ -186,7 +186,7 @@ class GLSolver(Solver):
         sponge = cfg.x_boundary == "tunnel" and cfg.sponge_cells > 0
         defines = {
             "TRT": cfg.collision == "trt",
-            "INCOMPRESSIBLE": cfg.equilibrium == "incompressible",
+            "INCOMPRESSIBLE": cfg.incompressible,
             "GUO_FORCE": any(c != 0.0 for c in cfg.body_force),
             "X_PERIODIC": cfg.x_boundary == "periodic",
             "Y_MODE": _Y_MODE[cfg.y_boundary],

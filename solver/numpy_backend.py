@@ -94,7 +94,7 @@ class NumpySolver(Solver):
         self._w = W.astype(self.dtype)
         op, om = relaxation_rates(cfg)
         self._collide = Collider(ny, nx, self.dtype, op, om, cfg.collision == "trt", cfg.body_force,
-                                 keep=absorb_keep(cfg), incompressible=cfg.equilibrium == "incompressible")
+                                 keep=absorb_keep(cfg), incompressible=cfg.incompressible)
         self._roll = []
         for i in range(Q):
             cx, cy = int(C[i, 0]), int(C[i, 1])

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from shapes.raster import distinct_sorted
-from solver.lattice import C, RHO0
+from solver.lattice import C
 
 
 def moments(window):
@@ -28,15 +28,10 @@ def moments(window):
     """
     f = np.asarray(window.f, dtype=np.float64)
     rho = f.sum(axis=0)
-    per = velocity_divisor(window, rho)
+    per = window.config.velocity_divisor(rho)
     ux = np.tensordot(C[:, 0].astype(np.float64), f, axes=1) / per
     uy = np.tensordot(C[:, 1].astype(np.float64), f, axes=1) / per
     return rho, ux, uy
-
-
-def velocity_divisor(window, rho):
-    """u = j / rho, or j / RHO0 with the incompressible equilibrium (He & Luo 1997; algorithm.md step 3)."""
-    return RHO0 if window.config.equilibrium == "incompressible" else rho
 
 
 def _inside(window, ix, iy):
@@ -151,7 +146,7 @@ def moments_at(window, nodes: np.ndarray):
     uy = np.zeros(h * w)
     r = f.sum(axis=0)
     rho[nodes] = r
-    per = velocity_divisor(window, r)
+    per = window.config.velocity_divisor(r)
     ux[nodes] = C[:, 0].astype(np.float64) @ f / per
     uy[nodes] = C[:, 1].astype(np.float64) @ f / per
     return rho, ux, uy

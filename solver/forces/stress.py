@@ -28,7 +28,7 @@ def viscous_stress(window: BodyWindow):
         raise ValueError("viscous stress cannot be read from post-collision populations at tau = 1")
     f = np.asarray(window.f, dtype=np.float64)
     rho, ux, uy = moments(window)
-    fneq = f - equilibrium(rho, ux, uy, incompressible=window.config.equilibrium == "incompressible")
+    fneq = f - equilibrium(rho, ux, uy, incompressible=window.config.incompressible)
     cx = C[:, 0].astype(np.float64)
     cy = C[:, 1].astype(np.float64)
     factor = -(1.0 - omega / 2.0) / (1.0 - omega)
