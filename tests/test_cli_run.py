@@ -98,6 +98,14 @@ def test_validate_rejects_unknown_case_and_bad_resolution():
                           "--resolution: must be a positive integer")
 
 
+def test_validate_refine_names_what_it_cannot_refine():
+    """`--refine` is the numpy reference's patch around a body (solver/refinement.py)."""
+    assert_one_line_error(feelflow("validate", "--refine", "--backend", "gl"),
+                          "--refine: the refined patch runs on the numpy backend only, not 'gl'")
+    assert_one_line_error(feelflow("validate", "--refine", "--case", "poiseuille"),
+                          "--refine: case 'poiseuille' has no body to refine around")
+
+
 def test_run_writes_the_documented_csv(tmp_path):
     scene = write(tmp_path, SMALL)
     out = tmp_path / "forces.csv"

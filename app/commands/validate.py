@@ -25,6 +25,9 @@ def add_arguments(parser):
     parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
     parser.add_argument("--json", default=None, metavar="PATH", help="also write the results as JSON")
     parser.add_argument("--quick", action="store_true", help="small grids and short runs (the test-suite versions)")
+    parser.add_argument("--refine", action="store_true",
+                        help="the Schaefer-Turek cases with the cylinder and its near wake in a patch of twice the "
+                             "resolution (numpy only; solver/refinement.py); default cases: those two")
 
 
 def machine_description() -> str:
@@ -65,7 +68,16 @@ def write_json_atomic(path: Path, data) -> None:
     files.write_json_atomic(path, data)
 
 
-def run_case(name: str, factory, resolution, quick: bool, backend: str):
+def refinable(name: str) -> bool:
+    """Whether a case's `run` takes `refine` (it has a body to refine around)."""
+    import inspect
+
+    from solver.validation import case_module
+
+    return "refine" in inspect.signature(case_module(name).run).parameters
+
+
+def run_case(name: str, factory, resolution, quick: bool, backend: str, refine: bool = False):
     """One case; a flow that blows up is a failed case (stable = 0), not a traceback."""
     import time
     import warnings
@@ -81,7 +93,8 @@ def run_case(name: str, factory, resolution, quick: bool, backend: str):
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
-            result = module.run(factory, resolution=resolution, quick=quick, backend=backend)
+            extra = {"refine": True} if refine else {}
+            result = module.run(factory, resolution=resolution, quick=quick, backend=backend, **extra)
     except backends.SolverDiverged as exc:
         n = resolution or (module.QUICK_RESOLUTION if quick else module.DEFAULT_RESOLUTION)
         result = CaseResult(name, backend, n, quantities={"stable": 0.0, "diverged_at_step": float(exc.step)},
@@ -96,10 +109,18 @@ def main(args) -> int:
     from app.headless import make_solver
     from solver.validation import CASES, case_module
 
-    names = args.case or list(CASES)
-    for name in names:
+    refine = bool(getattr(args, "refine", False))
+    for name in args.case or []:
         if name not in CASES:
             raise UserError(f"--case: unknown case {name!r}; choose from {', '.join(CASES)}")
+    names = args.case or [name for name in CASES if refinable(name) or not refine]
+    if refine:
+        if args.backend != "numpy":
+            raise UserError(f"--refine: the refined patch runs on the numpy backend only, not {args.backend!r}")
+        for name in names:
+            if not refinable(name):
+                raise UserError(f"--refine: case {name!r} has no body to refine around; "
+                                f"choose from {', '.join(n for n in CASES if refinable(n))}")
     resolution = positive_int_option("--resolution", args.resolution) if args.resolution is not None else None
     for name in names:
         check = getattr(case_module(name), "check_resolution", None)
@@ -119,13 +140,13 @@ def main(args) -> int:
     results = []
     for name in names:
         print(f"running {name} ...", flush=True)
-        result = run_case(name, factory, resolution, args.quick, args.backend)
+        result = run_case(name, factory, resolution, args.quick, args.backend, refine)
         results.append(result)
         print(f"  {name}: {'targets met' if result.passed else 'TARGETS NOT MET'} "
               f"({result.steps} steps, {result.wall_seconds:.1f} s stepping, {result.case_seconds:.1f} s in all)",
               flush=True)
     machine = machine_description()
-    print(f"\nFeelFlow validation, backend {args.backend}, on {machine}\n")
+    print(f"\nFeelFlow validation, backend {args.backend}{', refined patch' if refine else ''}, on {machine}\n")
     print(format_table(results))
     for r in results:   # a case may add its own tables (e.g. the stability map)
         details = getattr(case_module(r.name), "format_details", None)
@@ -135,6 +156,6 @@ def main(args) -> int:
     print(f"\n{len(results) - len(failed)} of {len(results)} cases meet their targets"
           + (f"; not met: {', '.join(failed)}" if failed else ""))
     if args.json:
-        write_json_atomic(Path(args.json), {"machine": machine, "backend": args.backend,
+        write_json_atomic(Path(args.json), {"machine": machine, "backend": args.backend, "refine": refine,
                                             "cases": [r.to_dict() for r in results]})
     return 0 if not failed else 1

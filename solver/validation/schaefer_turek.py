@@ -80,9 +80,24 @@ class Geometry:
         ux = np.repeat(self.profile()[:, None], self.nx, axis=1)
         return equilibrium(np.ones_like(ux), ux, np.zeros_like(ux))
 
-    def start(self, make_solver, **config_overrides):
+    def refined_patch(self) -> tuple[int, int, int, int]:
+        """The coarse nodes (x0, y0, x1, y1) of a refined patch around the cylinder and its near
+        wake (solver/refinement.py): 1 D ahead of the centre, 3 D behind it, 1 D to each side."""
+        cx, cy = self.centre
+        return (math.floor(cx - self.d), math.floor(cy - self.d), math.ceil(cx + 3 * self.d), math.ceil(cy + self.d))
+
+    def solver_factory(self, make_solver, refine: bool):
+        """`make_solver`, or with `refine` the numpy reference with `refined_patch` at twice the
+        resolution (the cylinder then has 2 d cells per diameter)."""
+        if not refine:
+            return make_solver
+        from solver.refinement import RefinedSolver
+
+        return lambda config: RefinedSolver(config, self.refined_patch())
+
+    def start(self, make_solver, refine: bool = False, **config_overrides):
         """A solver with the channel flow developed and the cylinder in place."""
-        solver = make_solver(self.config(**config_overrides))
+        solver = self.solver_factory(make_solver, refine)(self.config(**config_overrides))
         solver.set_distributions(self.initial_populations())
         solver.set_body(self.cylinder())
         solver.enable_force_models(["momentum_exchange"])
@@ -93,11 +108,12 @@ class Geometry:
         sound) and the pressure outlet (an open end) make a quarter-wave resonator, 4 nx / c_s."""
         return 4.0 * self.nx / math.sqrt(CS2)
 
-    def start_from_rest(self, make_solver, ramp_steps: int, **config_overrides):
+    def start_from_rest(self, make_solver, ramp_steps: int, refine: bool = False, **config_overrides):
         """A solver with the fluid at rest and the cylinder in place; the inflow rises over
         `ramp_steps` ((1 - cos)/2, docs/algorithm.md 'Inflow'). Slow against
         `acoustic_period()`, this excites the tunnel's sound modes far less than `start`."""
-        solver = make_solver(self.config(inflow_ramp_steps=int(ramp_steps), **config_overrides))
+        solver = self.solver_factory(make_solver, refine)(self.config(inflow_ramp_steps=int(ramp_steps),
+                                                                      **config_overrides))
         rest = np.zeros((self.ny, self.nx))
         solver.set_distributions(equilibrium(np.ones_like(rest), rest, rest))
         solver.set_body(self.cylinder())
@@ -110,16 +126,23 @@ class Geometry:
 
     def pressure_difference(self, solver) -> float:
         """dp / (rho U_mean^2) between the front and back points (to compare with the benchmark
-        value divided by U_mean^2)."""
-        rho, _, _ = solver.macroscopic()
-        solid = self._solid(rho.shape)
-        p_front = units.pressure(surface_value(rho, solid, self.front, -1))
-        p_back = units.pressure(surface_value(rho, solid, self.back, +1))
-        return units.pressure_difference_coefficient(p_front - p_back, self.u_mean)
+        value divided by U_mean^2). On a refined solver, from its fine lattice."""
+        fine = getattr(solver, "fine", None)
+        if fine is None:
+            rho, _, _ = solver.macroscopic()
+            shape, front, back = self.cylinder(), self.front, self.back
+        else:
+            from solver.refinement import fine_shape
 
-    def _solid(self, shape):
-        y, x = np.mgrid[0:shape[0], 0:shape[1]].astype(np.float64)
-        return self.cylinder().contains(x, y)
+            x0, y0 = solver.patch[:2]
+            rho, _, _ = fine.macroscopic()
+            shape = fine_shape(self.cylinder(), x0, y0)
+            front, back = ((2 * (x - x0), 2 * (y - y0)) for x, y in (self.front, self.back))
+        y, x = np.mgrid[0:rho.shape[0], 0:rho.shape[1]].astype(np.float64)
+        solid = shape.contains(x, y)
+        p_front = units.pressure(surface_value(rho, solid, front, -1))
+        p_back = units.pressure(surface_value(rho, solid, back, +1))
+        return units.pressure_difference_coefficient(p_front - p_back, self.u_mean)
 
 
 def reference_dp_coefficient() -> float:

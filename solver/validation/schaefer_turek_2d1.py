@@ -35,16 +35,18 @@ def targets(d: int) -> dict[str, float]:
 
 
 def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool = False,
-        backend: str = "numpy", max_convective_times: float = 400.0, u_max: float = U_MAX) -> CaseResult:
+        backend: str = "numpy", max_convective_times: float = 400.0, u_max: float = U_MAX,
+        refine: bool = False) -> CaseResult:
     """`u_max`: peak inflow speed in lattice units (the validation keeps U_MAX; `feelflow bench
-    accuracy` varies it to measure the time step's share of the error)."""
+    accuracy` varies it to measure the time step's share of the error). `refine`: the cylinder
+    in a patch of twice the resolution (`Geometry.refined_patch`, numpy only)."""
     d = resolution or (QUICK_RESOLUTION if quick else DEFAULT_RESOLUTION)
     geo = Geometry(d, RE, u_max=u_max)
     block = int(math.ceil(2 * geo.nx / units.CS))
     sub = int(math.ceil(block / SAMPLES))
     block = sub * SAMPLES
     max_steps = int(max_convective_times * d / geo.u_mean)
-    solver = geo.start(make_solver)
+    solver = geo.start(make_solver, refine=refine)
     watch = Stopwatch()
     converged = False
     try:
@@ -75,4 +77,7 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
         result.checks.append(Check(f"{quantity}_rel_error", -rel, rel, SOURCE))
     result.checks.append(Check("converged", 1.0, 1.0, f"steady within {TOL:g} per {block} steps"))
     result.notes = f"U_m = {geo.u_max} (Ma {geo.u_max * 3 ** 0.5:.3f}), TRT, {geo.nx} x {geo.ny}"
+    if refine:
+        result.quantities["cells_per_d_at_body"] = 2.0 * d
+        result.notes += f", refined patch {geo.refined_patch()} at {2 * d} cells per diameter"
     return watch.fill(result)

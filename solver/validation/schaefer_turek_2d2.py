@@ -56,13 +56,15 @@ def upward_zero_crossings(t: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool = False,
-        backend: str = "numpy", max_convective_times: float = 300.0) -> CaseResult:
+        backend: str = "numpy", max_convective_times: float = 300.0, refine: bool = False) -> CaseResult:
+    """`refine`: the cylinder in a patch of twice the resolution (`Geometry.refined_patch`, numpy
+    only); the forces are then the fine lattice's."""
     d = resolution or (QUICK_RESOLUTION if quick else DEFAULT_RESOLUTION)
     geo = Geometry(d, RE)
     sample = max(1, d // 4)  # about 130 samples per shedding period
     max_steps = int(max_convective_times * d / geo.u_mean)
     solver = geo.start_from_rest(make_solver, round(RAMP_ACOUSTIC_PERIODS * geo.acoustic_period()),
-                                 sponge_cells=SPONGE_D * d, sponge_absorb=SPONGE_ABSORB)
+                                 refine=refine, sponge_cells=SPONGE_D * d, sponge_absorb=SPONGE_ABSORB)
     watch = Stopwatch()
     times, cds, cls = [], [], []
     periodic = False
@@ -90,20 +92,25 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
     t, y, c = np.array(times, float), np.array(cls), np.array(cds)
     ups = upward_zero_crossings(t, y)
     quantities = {"re": RE, "u_max_lattice": geo.u_max, "periodic": float(periodic)}
+    if refine:
+        quantities["cells_per_d_at_body"] = 2.0 * d
     if len(ups) >= 2:
         k = min(MEASURE_PERIODS, len(ups) - 1)
         window = (t >= ups[-k - 1]) & (t < ups[-1])
         period = (ups[-1] - ups[-k - 1]) / k
         quantities.update(cd_max=float(c[window].max()), cl_max=float(y[window].max()),
-                          cd_mean=float(c[window].mean()),
+                          cd_mean=float(c[window].mean()), cl_min=float(y[window].min()),
                           st=units.strouhal(1.0 / period, d, geo.u_mean))
     else:  # no shedding (too coarse or too short)
-        quantities.update(cd_max=float("nan"), cl_max=float("nan"), cd_mean=float("nan"), st=float("nan"))
+        quantities.update(cd_max=float("nan"), cl_max=float("nan"), cd_mean=float("nan"), cl_min=float("nan"),
+                          st=float("nan"))
     result = CaseResult(NAME, backend, d, quantities=quantities)
-    if d >= 40:
+    if (2 * d if refine else d) >= 40:  # the cylinder's own resolution
         for q, (lo, hi) in INTERVALS_2D2.items():
             result.checks.append(Check(q, lo, hi, SOURCE))
     result.checks.append(Check("periodic", 1.0, 1.0, f"periods and amplitudes within {PERIODIC_TOL:.1%}"))
     result.notes = (f"U_m = {geo.u_max}, TRT, {geo.nx} x {geo.ny}, absorbing sponge {SPONGE_D} D, from rest, inflow ramp "
                     f"{RAMP_ACOUSTIC_PERIODS:g} acoustic periods, sampled every {sample} steps")
+    if refine:
+        result.notes += f", refined patch {geo.refined_patch()} at {2 * d} cells per diameter"
     return watch.fill(result)
