@@ -127,6 +127,11 @@ class RefinedSolver(Solver):
         self._to_coarse = (1.0 / self._to_fine[0], 1.0 / self._to_fine[1])
         self._sync_fine_from_coarse()
 
+    @property
+    def nodes_per_step(self) -> int:
+        """Node updates per coarse step: the coarse lattice and two steps of the fine one."""
+        return self.config.nx * self.config.ny + 2 * self.fine.config.nx * self.fine.config.ny
+
     # --- the two levels ---------------------------------------------------------
     def _rescaled(self, f, ratios):
         return rescale(f, ratios[0], ratios[1], self.config.incompressible)

@@ -99,6 +99,7 @@ def test_a_developed_channel_flow_crosses_the_patch():
     geo, cfg = _channel()
     x0, y0, x1, y1 = 40, 10, 100, 30
     plain, refined = NumpySolver(cfg), RefinedSolver(cfg, (x0, y0, x1, y1))
+    assert refined.nodes_per_step == 220 * 41 + 2 * 121 * 41  # what validation's MLUPS count
     for s in (plain, refined):
         s.set_distributions(geo.initial_populations())
         s.step(3000)
