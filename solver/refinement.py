@@ -11,7 +11,8 @@ part with tau-).
   the fine lattice has (2 (x1 - x0) + 1) x (2 (y1 - y0) + 1) nodes, fine node (I, J) at the
   coarse position (x0 + I / 2, y0 + J / 2), and nu_f = 2 nu (nu dx^2 / dt is the physical
   viscosity), tau+_f - 1/2 = 2 (tau+ - 1/2), the same TRT Lambda.
-- The body lives on the fine lattice only (at twice its size); the coarse lattice has none.
+- The body, a fixed one, lives on the fine lattice only (at twice its size); the coarse lattice
+  has none.
 - Per coarse step t -> t + 1: the coarse lattice steps; the fine lattice takes two steps, its
   outermost ring of nodes (on the coarse border lines) first set from the coarse lattice at t,
   then at t + 1/2 (linear in time), cubic (4-point) in space between coarse nodes; then the
@@ -171,6 +172,9 @@ class RefinedSolver(Solver):
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
         if raster is not None:
             raise ConfigError("refine", "a refined solver rasterises its body itself")
+        if tuple(velocity) != (0.0, 0.0) or omega != 0.0:
+            raise ConfigError("refine", "the refined patch holds a fixed body (validation); "
+                                        "a moving one would leave the patch")
         if shape is not None:
             x0, y0, x1, y1 = self.patch
             bx0, by0, bx1, by1 = shape.bounding_box()
@@ -179,7 +183,7 @@ class RefinedSolver(Solver):
                 raise ConfigError("refine", f"the body ({bx0:.1f}, {by0:.1f}) - ({bx1:.1f}, {by1:.1f}) must stay "
                                             f"{BODY_MARGIN} cells inside the refined patch {self.patch}")
             shape = fine_shape(shape, x0, y0)
-        self.fine.set_body(shape, velocity, 0.5 * omega)  # rad per step: a fine step is half as long
+        self.fine.set_body(shape)
         self.body = self.fine.body
         self.speed_capped = self.fine.speed_capped
 
@@ -220,9 +224,7 @@ class RefinedSolver(Solver):
         return self.coarse.shifted_distributions()
 
     def set_distributions(self, f: np.ndarray) -> None:
+        """The coarse state, and the fine lattice interpolated from it (its solid nodes are
+        reset by its next step; every link into them is a Bouzidi link)."""
         self.coarse.set_distributions(f)
         self._sync_fine_from_coarse()
-        if self.fine.body is not None:  # the body's nodes as the fine lattice holds them
-            b = self.fine.body
-            self.fine.set_body(None)
-            self.fine.set_body(b.shape, b.velocity, b.omega)

@@ -150,6 +150,8 @@ def test_bad_patches_and_bodies_are_refused_with_the_reason():
     s = RefinedSolver(cfg, (10, 10, 50, 30))
     with pytest.raises(ConfigError, match="must stay 3 cells inside"):
         s.set_body(Cylinder(diameter=10.0, x=15.0, y=20.0))
+    with pytest.raises(ConfigError, match="holds a fixed body"):
+        s.set_body(Cylinder(diameter=10.0, x=30.0, y=20.0), velocity=(0.01, 0.0))
     one = FlowConfig(nx=64, ny=32, nu=1.0 / 6.0, collision="bgk", x_boundary="periodic", y_boundary="periodic",
                      inflow_speed=0.0)
     with pytest.raises(ConfigError, match="relaxation time of 1"):
