@@ -80,6 +80,11 @@ class Solver(ABC):
     def step(self, n: int = 1) -> None:
         """Advance n steps; evaluate the enabled force models on each."""
 
+    @property
+    def nodes_per_step(self) -> int:
+        """Node updates per step (what MLUPS count): the lattice's nodes."""
+        return self.config.nx * self.config.ny
+
     # --- forces ---------------------------------------------------------------
     def enable_force_models(self, names) -> None:
         """Compute only these models (names from `solver.forces.MODELS`)."""

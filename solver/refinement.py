@@ -29,6 +29,8 @@ part with tau-).
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from solver.backend import Solver
@@ -48,30 +50,31 @@ _TAU_ONE_GAP = 0.02
 
 def _taus(config: FlowConfig) -> tuple[float, float]:
     """(tau+, tau-) of a config away from any sponge."""
-    op, om = relaxation_rates(FlowConfig(**{**config.__dict__, "sponge_cells": 0}))
+    op, om = relaxation_rates(replace(config, sponge_cells=0))
     return 1.0 / op, 1.0 / om
 
 
-def rescale(f: np.ndarray, ratio_p: float, ratio_m: float, incompressible: bool) -> np.ndarray:
-    """f^eq(rho, u) + ratio_p n+ + ratio_m n- of full post-collision populations f (9, ...)."""
+def rescale(f: np.ndarray, ratio_p: float, ratio_m: float, config: FlowConfig) -> np.ndarray:
+    """f^eq(rho, u) + ratio_p n+ + ratio_m n- of full post-collision populations f (9, ...), with
+    the equilibrium `config` names."""
     rho = f.sum(axis=0)
-    jx = np.tensordot(C[:, 0].astype(np.float64), f, axes=1)
-    jy = np.tensordot(C[:, 1].astype(np.float64), f, axes=1)
-    div = 1.0 if incompressible else rho
-    feq = equilibrium(rho, jx / div, jy / div, incompressible=incompressible).astype(np.float64)
+    per = config.velocity_divisor(rho)
+    ux = np.tensordot(C[:, 0].astype(np.float64), f, axes=1) / per
+    uy = np.tensordot(C[:, 1].astype(np.float64), f, axes=1) / per
+    feq = equilibrium(rho, ux, uy, incompressible=config.incompressible).astype(np.float64)
     neq = f - feq
     neq_opp = neq[OPP]
     return feq + 0.5 * ratio_p * (neq + neq_opp) + 0.5 * ratio_m * (neq - neq_opp)
 
 
 def cubic_midpoints(v: np.ndarray) -> np.ndarray:
-    """Values at the fine nodes of a coarse line: v (k, n + 2) holds n coarse nodes with one
-    halo node at each end; returns (k, 2 n - 1), the nodes as they are and the midpoints by
-    4-point Lagrange interpolation (-1, 9, 9, -1) / 16 (fourth order)."""
-    n = v.shape[1] - 2
-    out = np.empty((v.shape[0], 2 * n - 1))
-    out[:, 0::2] = v[:, 1:-1]
-    out[:, 1::2] = (9.0 * (v[:, 1:n] + v[:, 2:n + 1]) - v[:, 0:n - 1] - v[:, 3:n + 2]) / 16.0
+    """Values at the fine nodes of coarse lines along the last axis: v (..., n + 2) holds n
+    coarse nodes with one halo node at each end; returns (..., 2 n - 1), the nodes as they are
+    and the midpoints by 4-point Lagrange interpolation (-1, 9, 9, -1) / 16 (fourth order)."""
+    n = v.shape[-1] - 2
+    out = np.empty(v.shape[:-1] + (2 * n - 1,))
+    out[..., 0::2] = v[..., 1:-1]
+    out[..., 1::2] = (9.0 * (v[..., 1:n] + v[..., 2:n + 1]) - v[..., 0:n - 1] - v[..., 3:n + 2]) / 16.0
     return out
 
 
@@ -135,7 +138,7 @@ class RefinedSolver(Solver):
 
     # --- the two levels ---------------------------------------------------------
     def _rescaled(self, f, ratios):
-        return rescale(f, ratios[0], ratios[1], self.config.incompressible)
+        return rescale(f, ratios[0], ratios[1], self.config)
 
     def _ring(self) -> list[np.ndarray]:
         """The coarse border lines with one halo node at each end, rescaled for the fine
@@ -158,15 +161,14 @@ class RefinedSolver(Solver):
         self.coarse.g[:, y0 + 1:y1, x0 + 1:x1] = shifted(self._rescaled(f, self._to_coarse)).astype(self.coarse.g.dtype)
 
     def _sync_fine_from_coarse(self) -> None:
-        """The whole fine lattice from the coarse one (bicubic), for a new state."""
+        """The whole fine lattice from the coarse one (bicubic), for a new state; and the coarse
+        border the fine ring then holds (`_ring_now`)."""
         x0, y0, x1, y1 = self.patch
         f = self._rescaled(unshifted(self.coarse.g[:, y0 - 1:y1 + 2, x0 - 1:x1 + 2].astype(np.float64)),
                            self._to_fine)
-        k, ny, nx = f.shape
-        rows = cubic_midpoints(f.transpose(1, 0, 2).reshape(ny, k * nx).T)  # along y: (k nx, 2 ny' - 1)
-        rows = rows.T.reshape(-1, k, nx).transpose(1, 0, 2)                  # (k, 2 ny' - 1, nx)
-        full = np.stack([cubic_midpoints(rows[:, j, :]) for j in range(rows.shape[1])], axis=1)
+        full = cubic_midpoints(cubic_midpoints(f.swapaxes(1, 2)).swapaxes(1, 2))  # along y, then x
         self.fine.g[...] = shifted(full).astype(self.fine.g.dtype)
+        self._ring_now = self._ring()
 
     # --- Solver interface -------------------------------------------------------------
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
@@ -202,7 +204,7 @@ class RefinedSolver(Solver):
     def step(self, n: int = 1) -> None:
         sums: dict[str, list[float]] = {}
         for _ in range(int(n)):
-            ring_t = self._ring()  # what the fine ring holds now (set at the end of the last step)
+            ring_t = self._ring_now  # what the fine ring holds now; restriction leaves the border alone
             self.coarse.step(1)
             ring_t1 = self._ring()
             for ring in (None, [0.5 * (a + b) for a, b in zip(ring_t, ring_t1)]):
@@ -215,6 +217,7 @@ class RefinedSolver(Solver):
                     s[1] += fy
             self._restrict()
             self._set_fine_ring(ring_t1)  # the fine lattice whole at t + 1 (its ring was streamed over)
+            self._ring_now = ring_t1
             self.time = self.coarse.time
         if n > 0:
             # mean over the 2 n fine steps, and F_coarse = F_fine / 2 (module docstring)

@@ -91,7 +91,7 @@ class Stopwatch:
         solver.step(n)
         self.seconds += time.perf_counter() - t0
         self.steps += n
-        self.node_updates += n * getattr(solver, "nodes_per_step", solver.config.nx * solver.config.ny)
+        self.node_updates += n * solver.nodes_per_step
 
     def timed(self, nodes: int, steps: int, advance, *args):
         """Call `advance(*args)` (which runs `steps` steps on `nodes` nodes) and count it."""
