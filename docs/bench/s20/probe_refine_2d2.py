@@ -7,7 +7,12 @@ runs `solver.validation.schaefer_turek_2d2.run` with `RefinedSolver` on the patc
 ahead of the cylinder's centre to DOWN behind it and HALF to each side (the product's
 `Geometry.refined_patch` is 1 / 3 / 1), and prints the case's quantities. Set FF_ABSORB to change
 the outlet sponge's absorbing strength (the case's 0.1), FF_SHIFT=DX,DY to move the cylinder by
-DX, DY coarse cells (the patch stays where it was).
+DX, DY coarse cells (the patch stays where it was), and FF_VARIANT to try a variant of the level
+coupling (patched here, not in the product):
+  ring-t1   the fine ring's second step takes the coarse border at t + 1, not the mean of t, t + 1;
+  margin3   the restriction keeps 3 coarse cells inside the border, not 1;
+  odd-even  the odd non-equilibrium scaled with the even part's ratio;
+  odd-half  the odd non-equilibrium scaled by 0.5.
 """
 import dataclasses
 import math
@@ -17,6 +22,9 @@ import time
 
 sys.path.insert(0, os.getcwd())
 
+import numpy as np  # noqa: E402
+
+from solver.body import shifted, unshifted  # noqa: E402
 from solver.refinement import RefinedSolver  # noqa: E402
 from solver.validation import schaefer_turek as st  # noqa: E402
 from solver.validation import schaefer_turek_2d2 as case  # noqa: E402
@@ -34,6 +42,45 @@ if shift_x or shift_y:  # move the cylinder (and the front and back points) by w
         self.centre, self.front, self.back = ((x + shift_x, y + shift_y) for x, y in (self.centre, self.front, self.back))
 
     st.Geometry.__init__ = _shifted
+variant = os.environ.get("FF_VARIANT", "")
+if variant == "ring-t1":
+    def _step_t1(self, n=1):  # RefinedSolver.step with the t + 1 border for the second fine step
+        sums = {}
+        for _ in range(int(n)):
+            self.coarse.step(1)
+            ring_t1 = self._ring()
+            for ring in (None, ring_t1):
+                if ring is not None:
+                    self._set_fine_ring(ring)
+                self.fine.step(1)
+                for name, (fx, fy) in self.fine.forces().items():
+                    acc = sums.setdefault(name, [0.0, 0.0])
+                    acc[0] += fx
+                    acc[1] += fy
+            self._restrict()
+            self._set_fine_ring(ring_t1)
+            self._ring_now = ring_t1
+            self.time = self.coarse.time
+        self._forces = {name: (a[0] / (4 * n), a[1] / (4 * n)) for name, a in sums.items()}
+
+    RefinedSolver.step = _step_t1
+elif variant == "margin3":
+    def _restrict3(self):
+        x0, y0, x1, y1 = self.patch
+        f = unshifted(self.fine.g[:, 6:-6:2, 6:-6:2].astype(np.float64))
+        self.coarse.g[:, y0 + 3:y1 - 2, x0 + 3:x1 - 2] = shifted(self._rescaled(f, self._to_coarse)).astype(self.coarse.g.dtype)
+
+    RefinedSolver._restrict = _restrict3
+elif variant in ("odd-even", "odd-half"):
+    _init_solver = RefinedSolver.__init__
+
+    def _init_odd(self, *a, **k):
+        _init_solver(self, *a, **k)
+        odd = self._to_fine[0] if variant == "odd-even" else 0.5
+        self._to_fine = (self._to_fine[0], odd)
+        self._to_coarse = (1.0 / self._to_fine[0], 1.0 / odd)
+
+    RefinedSolver.__init__ = _init_odd
 cx = cy = 2 * d - 0.5
 patch = (math.floor(cx - up * d), math.floor(cy - half * d), math.ceil(cx + down * d), math.ceil(cy + half * d))
 t = time.time()
