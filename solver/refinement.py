@@ -154,6 +154,11 @@ class RefinedSolver(Solver):
         fg[:, 0, :], fg[:, -1, :] = bottom, top
         fg[:, :, 0], fg[:, :, -1] = left, right
 
+    @staticmethod
+    def _ring_between(ring_t, ring_t1):
+        """The border at t + 1/2 for the fine lattice's second step: linear in time."""
+        return [0.5 * (a + b) for a, b in zip(ring_t, ring_t1)]
+
     def _restrict(self) -> None:
         """Coarse nodes strictly inside the border take the fine values at the same place."""
         x0, y0, x1, y1 = self.patch
@@ -207,7 +212,7 @@ class RefinedSolver(Solver):
             ring_t = self._ring_now  # what the fine ring holds now; restriction leaves the border alone
             self.coarse.step(1)
             ring_t1 = self._ring()
-            for ring in (None, [0.5 * (a + b) for a, b in zip(ring_t, ring_t1)]):
+            for ring in (None, self._ring_between(ring_t, ring_t1)):
                 if ring is not None:
                     self._set_fine_ring(ring)
                 self.fine.step(1)
