@@ -542,7 +542,7 @@ def main(args) -> int:
               f"{result['d2q9_bound_mlups']} MLUPS at {BYTES_PER_NODE_STEP} bytes per node and step")
         for key, ratio in result["speedups"].items():
             each = result["speedups_per_round"][key]
-            print(f"gl / numpy, {key}: {ratio}x" + (f" (median of the rounds: {', '.join(f'{v:.2f}' for v in each)})"
+            print(f"gl / numpy, {key}: {ratio:.2f}x" + (f" (median of the rounds: {', '.join(f'{v:.2f}' for v in each)})"
                                                    if len(each) > 1 else ""))
     if getattr(args, "json", None):
         from app.files import write_json_atomic
