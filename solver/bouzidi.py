@@ -59,6 +59,22 @@ def periodic_wrap(config, window) -> tuple[bool, bool]:
             config.y_boundary == "periodic" and y0 == 0 and y1 == config.ny)
 
 
+def second_nodes(q: np.ndarray, solid: np.ndarray, i, iy, ix, wrap: tuple[bool, bool] = (False, False)):
+    """The second node x + c_i of each link (i: incoming direction, (iy, ix): the fluid node x,
+    window-local), wrapped across a periodic seam the window spans whole (`wrap`), and whether
+    an interpolation may use it: inside the window, fluid, and its own link along c_ib not cut.
+    Returns (fy, fx, usable)."""
+    h, w = solid.shape
+    fy, fx = iy + C[i, 1], ix + C[i, 0]
+    if wrap[0]:
+        fx = fx % w
+    if wrap[1]:
+        fy = fy % h
+    inside = (fy >= 0) & (fy < h) & (fx >= 0) & (fx < w)
+    fyc, fxc = np.clip(fy, 0, h - 1), np.clip(fx, 0, w - 1)
+    return fy, fx, inside & ~solid[fyc, fxc] & (q[i, iy, ix] == 0)
+
+
 def build_links(q: np.ndarray, solid: np.ndarray, x0: int, y0: int, center, velocity, omega,
                 wrap: tuple[bool, bool] = (False, False)) -> BodyLinks:
     """All body links of a window (q: (9, h, w), solid: (h, w), lower-left node (x0, y0)).
@@ -68,22 +84,13 @@ def build_links(q: np.ndarray, solid: np.ndarray, x0: int, y0: int, center, velo
     seam the window spans whole (`wrap`, from `periodic_wrap`): there it is the node at the
     window's other edge, where periodic streaming takes it from.
     """
-    h, w = solid.shape
-    fluid = ~solid
-    mask = (q[OPP] > 0) & fluid          # mask[i]: the link of x along c_ib is cut
+    mask = (q[OPP] > 0) & ~solid         # mask[i]: the link of x along c_ib is cut
     mask[0] = False
     i, iy, ix = np.nonzero(mask)
     ib = OPP[i]
     qq = q[ib, iy, ix].astype(np.float64)
     cx, cy = C[i, 0], C[i, 1]
-    fy, fx = iy + cy, ix + cx
-    if wrap[0]:
-        fx = fx % w
-    if wrap[1]:
-        fy = fy % h
-    inside = (fy >= 0) & (fy < h) & (fx >= 0) & (fx < w)
-    fyc, fxc = np.clip(fy, 0, h - 1), np.clip(fx, 0, w - 1)
-    second = inside & fluid[fyc, fxc] & (q[i, iy, ix] == 0)
+    fy, fx, second = second_nodes(q, solid, i, iy, ix, wrap)
     # wall velocity at the crossing x + q c_ib = x - q c_i (world coordinates)
     ux, uy = wall_velocity(x0 + ix - qq * cx, y0 + iy - qq * cy, center, velocity, omega)
     ux = np.broadcast_to(np.asarray(ux, dtype=np.float64), qq.shape)

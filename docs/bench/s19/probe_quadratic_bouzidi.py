@@ -4,8 +4,12 @@ Lallemand 2001) in place of the linear rule, numpy backend, patched in for one 2
 
     python docs/bench/s19/probe_quadratic_bouzidi.py 2d2 40     (or: 2d1 20)
 """
-import sys, time, json
+import os
+import sys
+
+sys.path[:0] = [".", os.path.dirname(os.path.dirname(os.path.abspath(__file__)))]
 import numpy as np
+from probe_run_case import run_case
 import solver.bouzidi as bz
 from solver.lattice import C, OPP, W, RHO0
 
@@ -55,15 +59,4 @@ for m in (bz, solver.body, me):
 for m in (bz, solver.numpy_backend, me):
     m.incoming = incoming
 
-from solver.backend import create_solver
-case, d = sys.argv[1], int(sys.argv[2])
-u = float(sys.argv[3]) if len(sys.argv) > 3 else 0.075
-fac = lambda c: create_solver("numpy", c)
-t0 = time.time()
-if case == "2d2":
-    from solver.validation import schaefer_turek_2d2 as st
-    r = st.run(fac, resolution=d)
-else:
-    from solver.validation import schaefer_turek_2d1 as st
-    r = st.run(fac, resolution=d, u_max=u)
-print(case, d, json.dumps(r.quantities), r.steps, round(time.time() - t0), "s")
+run_case(sys.argv)

@@ -10,28 +10,22 @@ d = 3 w RHO0 c_i.u_w (1 + a + b - c)); elsewhere the linear rule stays.
 
     python docs/bench/s21/probe_cli_bouzidi.py 2d2 40     (or: 2d1 20 [U_m])
 """
-import sys, time, json
-sys.path.insert(0, ".")
+import os
+import sys
+
+sys.path[:0] = [".", os.path.dirname(os.path.dirname(os.path.abspath(__file__)))]
 import numpy as np
 import solver.bouzidi as bz
+from probe_run_case import run_case
 
 _lin_build = bz.build_links
 
 
 def build_links(q, solid, x0, y0, center, velocity, omega, wrap=(False, False)):
     L = _lin_build(q, solid, x0, y0, center, velocity, omega, wrap)
-    h, w = solid.shape
-    i, iy, ix, qq = L.i, L.iy, L.ix, L.q
-    cx, cy = bz.C[i, 0], bz.C[i, 1]
-    fy, fx = iy + cy, ix + cx
-    if wrap[0]:
-        fx = fx % w
-    if wrap[1]:
-        fy = fy % h
-    inside = (fy >= 0) & (fy < h) & (fx >= 0) & (fx < w)
-    fyc, fxc = np.clip(fy, 0, h - 1), np.clip(fx, 0, w - 1)
-    ok = inside & ~solid[fyc, fxc] & (q[i, iy, ix] == 0)
-    cu = bz.W[i] * bz.RHO0 * (cx * L.uw[:, 0] + cy * L.uw[:, 1])
+    fy, fx, ok = bz.second_nodes(q, solid, L.i, L.iy, L.ix, wrap)
+    qq = L.q
+    cu = bz.W[L.i] * bz.RHO0 * (bz.C[L.i, 0] * L.uw[:, 0] + bz.C[L.i, 1] * L.uw[:, 1])
     k = (1 - 2 * qq) / (1 + 2 * qq)
     a = np.where(ok, 1.0, L.a)
     b = np.where(ok, k, L.b)
@@ -43,18 +37,6 @@ def build_links(q, solid, x0, y0, center, velocity, omega, wrap=(False, False)):
 
 import solver.body, solver.forces.momentum_exchange as me
 for m in (bz, solver.body, me):
-    if hasattr(m, "build_links"):
-        m.build_links = build_links
+    m.build_links = build_links
 
-from solver.backend import create_solver
-case, d = sys.argv[1], int(sys.argv[2])
-u = float(sys.argv[3]) if len(sys.argv) > 3 else 0.075
-fac = lambda c: create_solver("numpy", c)
-t0 = time.time()
-if case == "2d2":
-    from solver.validation import schaefer_turek_2d2 as st
-    r = st.run(fac, resolution=d)
-else:
-    from solver.validation import schaefer_turek_2d1 as st
-    r = st.run(fac, resolution=d, u_max=u)
-print(case, d, json.dumps(r.quantities), r.steps, round(time.time() - t0), "s")
+run_case(sys.argv)
