@@ -8,10 +8,11 @@
 
 `analyse` folds the last three shedding periods (upward zero crossings of C_L) into a
 period-averaged signal and prints: per-period C_D maxima, mean C_D, C_D,max and C_L,max of the
-raw (with C_L,min; five digits) and the period-averaged signal, the rms of C_D around the period-averaged signal (what does
-not repeat: sound), and the strongest lines of the C_D spectrum in units of the shedding
-frequency. Run from the repository root (numpy backend; `--backend gl` runs the fragment-shader
-backend, float32, on an EGL standalone context, several times faster on this machine).
+raw signal (with C_L,min; five digits) and of the period-averaged one, the rms of C_D around the
+period-averaged signal (what does not repeat: sound), and the strongest lines of the C_D
+spectrum in units of the shedding frequency. Run from the repository root (numpy backend;
+`--backend gl` runs the fragment-shader backend, float32, on an EGL standalone context, several
+times faster on this machine).
 
 `--stress` also records C_D from a second, independent force evaluation of the same flow: the
 pressure (lattice equation of state, `solver.forces.pressure`) plus the viscous stress
@@ -91,7 +92,8 @@ def analyse(path: str, periods: int = 3) -> None:
     if "cl_stress" in z:
         print(f"  C_D,max / C_L,max from pressure + viscous stress {z['cd_stress'][w].max():.4f} / "
               f"{z['cl_stress'][w].max():.4f} (sampled at block ends)")
-    print(f"  raw: C_D,max {cd[w].max():.5f} C_L,max {cl[w].max():.5f} C_L,min {cl[w].min():.5f}; period-averaged: "
+    print(f"  raw: C_D,max {cd[w].max():.5f} C_L,max {cl[w].max():.5f} C_L,min {cl[w].min():.5f}; "
+          f"period-averaged: "
           f"C_D,max {fold_cd.max():.4f} C_L,max {fold_cl.max():.4f}; rms of C_D around it {resid.std():.4f}")
     k0 = max(0, len(ups) - 9)  # spectrum over up to 8 periods
     w = (t >= ups[k0]) & (t < ups[-1])

@@ -12,21 +12,33 @@ sys.path.insert(0, ".")
 import time, numpy as np, moderngl
 from app.commands.bench_solver import scene_config, SceneRun
 from solver.gl_backend import GLSolver
-import solver.gl_backend as gb, solver.body as body, shapes.raster as raster, solver.bouzidi as bz
+import solver.gl_backend as gb, solver.body as body, shapes.raster as raster
 ctx = moderngl.create_context(standalone=True, backend="egl")
 s = GLSolver(scene_config("tunnel", 512, 256), ctx)
 run = SceneRun("tunnel", s)
 run.advance(200)
 acc = {}
-def wrap(mod, name):
-    f = getattr(mod, name)
-    def g(*a, **k):
-        t = time.perf_counter(); r = f(*a, **k); acc[name] = acc.get(name, 0) + time.perf_counter() - t; return r
-    setattr(mod, name, g)
-wrap(body, "make_body_state"); wrap(raster, "rasterise"); wrap(body, "refill"); wrap(gb, "move_body")
-wrap(GLSolver, "set_body"); wrap(GLSolver, "_upload_raster"); wrap(GLSolver, "_read_texels"); wrap(GLSolver, "_write_texels")
-wrap(bz, "build_links"); wrap(gb, "node_mask"); wrap(GLSolver, "_set_rects"); wrap(GLSolver, "_upload_body_uniforms")
-# moves only (no steps): the pure CPU cost of a move
+
+
+def wrap(owner, name):
+    """Time every call of owner.name into acc[name]."""
+    f = getattr(owner, name)
+
+    def timed(*a, **k):
+        t = time.perf_counter()
+        try:
+            return f(*a, **k)
+        finally:
+            acc[name] = acc.get(name, 0.0) + time.perf_counter() - t
+    setattr(owner, name, timed)
+
+
+for owner, names in ((body, ("make_body_state", "refill")), (raster, ("rasterise",)),
+                     (gb, ("move_body", "node_mask")),
+                     (GLSolver, ("set_body", "_upload_raster", "_read_texels", "_write_texels", "_set_rects",
+                                 "_upload_body_uniforms"))):
+    for name in names:
+        wrap(owner, name)
 n = 300  # moves, no steps between them: the CPU cost of a move alone
 for k in range(n):
     run.k += 10
