@@ -78,6 +78,11 @@ def cubic_midpoints(v: np.ndarray) -> np.ndarray:
     return out
 
 
+def fine_point(x: float, y: float, x0: int, y0: int) -> tuple[float, float]:
+    """A coarse position on the fine lattice of a patch with its corner at coarse node (x0, y0)."""
+    return 2.0 * (x - x0), 2.0 * (y - y0)
+
+
 def fine_shape(shape, x0: int, y0: int):
     """The shape on the fine lattice of a patch with its corner at coarse node (x0, y0)."""
     from shapes.io import from_dict
@@ -88,8 +93,7 @@ def fine_shape(shape, x0: int, y0: int):
             d[key] = 2.0 * d[key]
     if "vertices" in d:
         d["vertices"] = [[2.0 * a, 2.0 * b] for a, b in d["vertices"]]
-    d["x"] = 2.0 * (shape.x - x0)
-    d["y"] = 2.0 * (shape.y - y0)
+    d["x"], d["y"] = fine_point(shape.x, shape.y, x0, y0)
     return from_dict(d)
 
 

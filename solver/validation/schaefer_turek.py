@@ -132,12 +132,12 @@ class Geometry:
             rho, _, _ = solver.macroscopic()
             shape, front, back = self.cylinder(), self.front, self.back
         else:
-            from solver.refinement import fine_shape
+            from solver.refinement import fine_point, fine_shape
 
             x0, y0 = solver.patch[:2]
             rho, _, _ = fine.macroscopic()
             shape = fine_shape(self.cylinder(), x0, y0)
-            front, back = ((2 * (x - x0), 2 * (y - y0)) for x, y in (self.front, self.back))
+            front, back = (fine_point(x, y, x0, y0) for x, y in (self.front, self.back))
         y, x = np.mgrid[0:rho.shape[0], 0:rho.shape[1]].astype(np.float64)
         solid = shape.contains(x, y)
         p_front = units.pressure(surface_value(rho, solid, front, -1))
