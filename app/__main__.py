@@ -1,6 +1,6 @@
-"""`python -m app` is the `feelflow` command."""
+"""`python -m feelflow.app` is the `feelflow` command."""
 import sys
 
-from app.cli import main
+from feelflow.app.cli.main import main
 
 sys.exit(main())

@@ -3,8 +3,8 @@
 """
 from __future__ import annotations
 
-from app.cli import UserError
-from solver.backend import BACKENDS, BackendError, create_solver
+from feelflow.app.errors import UserError
+from feelflow.solver.backend import BACKENDS, BackendError, create_solver
 
 _gl_context = None
 

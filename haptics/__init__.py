@@ -1,9 +1,9 @@
 """FeelFlow haptics: devices (serial, HID, simulated) and the safe 1 kHz force loop.
 
 Qt-free and solver-free (DESIGN.md rule 1): what crosses the boundary are the small value types
-of `haptics.types`. The API for the app:
+of `feelflow.haptics.types`. The API for the app:
 
-    from haptics import list_devices, open_device, ForceLoop, LoopConfig, ForceSample
+    from feelflow.haptics import list_devices, open_device, ForceLoop, LoopConfig, ForceSample
 
     for info in list_devices():          # DeviceInfo(url, name, kind, driver, details)
         print(info.url, info.name)       # serial ports, HID devices with a driver, sim://...
@@ -36,11 +36,11 @@ device maximum every tick; drivers clamp again. Poses are metres in the device f
 Errors: `DeviceError` (cannot open / no answer), `DeviceDisconnected`, `BadDeviceURL`
 (one-line messages, fit for the user).
 """
-from haptics.errors import BadDeviceURL, DeviceDisconnected, DeviceError
-from haptics.loop import ForceLoop, LoopConfig, LoopStatus
-from haptics.registry import list_devices, open_device
-from haptics.safety import SafetyConfig
-from haptics.types import BodyTarget, Capabilities, DeviceInfo, ForceSample, Pose
+from feelflow.haptics.errors import BadDeviceURL, DeviceDisconnected, DeviceError
+from feelflow.haptics.loop import ForceLoop, LoopConfig, LoopStatus
+from feelflow.haptics.registry import list_devices, open_device
+from feelflow.haptics.safety import SafetyConfig
+from feelflow.haptics.types import BodyTarget, Capabilities, DeviceInfo, ForceSample, Pose
 
 __all__ = [
     "BadDeviceURL", "BodyTarget", "Capabilities", "DeviceDisconnected", "DeviceError", "DeviceInfo",
@@ -50,9 +50,9 @@ __all__ = [
 ]
 
 
-def __getattr__(name):  # ProcessForceLoop lazily: `python -m haptics.process_loop` imports this package
+def __getattr__(name):  # ProcessForceLoop lazily: `python -m feelflow.haptics.process_loop` imports this package
     if name == "ProcessForceLoop":
-        from haptics.process_loop import ProcessForceLoop
+        from feelflow.haptics.process_loop import ProcessForceLoop
 
         return ProcessForceLoop
     raise AttributeError(f"module 'haptics' has no attribute {name!r}")

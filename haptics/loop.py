@@ -28,13 +28,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from haptics.coupling import TunnelMap, VirtualCoupling
-from haptics.drivers.base import clamp_force
-from haptics.errors import DeviceDisconnected, DeviceError
-from haptics.safety import SafetyConfig, SafetyGate
-from haptics.shaping import ForceInterpolator, ForceScale
-from haptics.timing import Ticker, try_realtime
-from haptics.types import BodyTarget, ForceSample, Pose
+from feelflow.haptics.coupling import TunnelMap, VirtualCoupling
+from feelflow.haptics.drivers.base import clamp_force
+from feelflow.haptics.errors import DeviceDisconnected, DeviceError
+from feelflow.haptics.safety import SafetyConfig, SafetyGate
+from feelflow.haptics.shaping import ForceInterpolator, ForceScale
+from feelflow.haptics.timing import Ticker, try_realtime
+from feelflow.haptics.types import BodyTarget, ForceSample, Pose
 
 
 @dataclass

@@ -8,7 +8,7 @@ A child process has its own interpreter, where the loop competes with nothing of
 
 `ProcessForceLoop(url, config)` offers the ForceLoop API (start, stop, pause, resume,
 emergency_stop, clear_stop, submit_force, body_target, status, set_tunnel, set_scaling,
-capabilities) plus close(). The child (`python -m haptics.process_loop`, started with
+capabilities) plus close(). The child (`python -m feelflow.haptics.process_loop`, started with
 subprocess: no multiprocessing, so the app's __main__ is never re-run, and nothing is pickled)
 opens the device itself; sim:// simulators live there too.
   parent -> child: its stdin, length-prefixed messages: b'F' + 3 doubles (a force sample) or
@@ -25,7 +25,6 @@ import dataclasses
 import json
 import mmap
 import os
-import pathlib
 import struct
 import subprocess
 import sys
@@ -33,11 +32,11 @@ import tempfile
 import threading
 import time
 
-from haptics.errors import DeviceDisconnected, DeviceError
-from haptics.loop import LoopConfig, LoopStatus
-from haptics.safety import SafetyConfig
-from haptics.timing import try_realtime
-from haptics.types import BodyTarget, Capabilities, ForceSample
+from feelflow.haptics.errors import DeviceDisconnected, DeviceError
+from feelflow.haptics.loop import LoopConfig, LoopStatus
+from feelflow.haptics.safety import SafetyConfig
+from feelflow.haptics.timing import try_realtime
+from feelflow.haptics.types import BodyTarget, Capabilities, ForceSample
 
 _LEN = struct.Struct("<I")
 _SAMPLE = struct.Struct("<cddd")
@@ -101,8 +100,8 @@ def _publish(mm, loop, seq: list, vals: list, st=None) -> None:
 
 
 def child_main(argv) -> int:
-    from haptics.loop import ForceLoop
-    from haptics.registry import open_device
+    from feelflow.haptics.loop import ForceLoop
+    from feelflow.haptics.registry import open_device
 
     url, shm_path = argv[0], argv[1]
     out = os.fdopen(os.dup(1), "wb")
@@ -205,10 +204,8 @@ class ProcessForceLoop:
         os.close(fd)
         with open(self._shm_path, "r+b") as fh:
             self._mm = mmap.mmap(fh.fileno(), _ARRAY.size)
-        root = str(pathlib.Path(__file__).resolve().parents[1])  # where `haptics` is importable
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join([root, os.environ.get("PYTHONPATH", "")]))
-        self._proc = subprocess.Popen([sys.executable, "-m", "haptics.process_loop", url, self._shm_path],
-                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env)
+        self._proc = subprocess.Popen([sys.executable, "-m", "feelflow.haptics.process_loop", url, self._shm_path],
+                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE)
         self._send_lock = threading.Lock()
         self._send(_config_to_json(self.config).encode())
         self._ready = threading.Event()
@@ -319,7 +316,7 @@ class ProcessForceLoop:
         self._cmd("set_tunnel", rect=[float(v) for v in rect], flip_y=flip_y)
 
     def set_scaling(self, expected_peak: float, comfort_fraction: float | None = None) -> None:
-        from haptics.shaping import ForceScale
+        from feelflow.haptics.shaping import ForceScale
 
         # validate here, so a bad scene value raises in the caller as with ForceLoop
         ForceScale(expected_peak, 0.5 if comfort_fraction is None else comfort_fraction, 1.0)

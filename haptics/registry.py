@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import urllib.parse
 
-from haptics.errors import BadDeviceURL, DeviceError
-from haptics.protocols import diyhid
-from haptics.protocols import spacemouse as sm
-from haptics.types import DeviceInfo
+from feelflow.haptics.errors import BadDeviceURL, DeviceError
+from feelflow.haptics.protocols import diyhid
+from feelflow.haptics.protocols import spacemouse as sm
+from feelflow.haptics.types import DeviceInfo
 
 SIMULATORS = {
     "haply2diy": "Haply 2DIY pantograph (simulated, hAPI serial over a pseudo-terminal)",
@@ -27,10 +27,10 @@ SERIAL_IDS = {(0x2341, 0x003E): "haply2diy",  # Arduino Due native port (Haply M
 
 
 def _drivers():
-    from haptics.drivers.diyhid import DiyHid
-    from haptics.drivers.hapkit import Hapkit
-    from haptics.drivers.haply2diy import Haply2DIY
-    from haptics.drivers.spacemouse import SpaceMouse
+    from feelflow.haptics.drivers.diyhid import DiyHid
+    from feelflow.haptics.drivers.hapkit import Hapkit
+    from feelflow.haptics.drivers.haply2diy import Haply2DIY
+    from feelflow.haptics.drivers.spacemouse import SpaceMouse
     return {"haply2diy": Haply2DIY, "hapkit": Hapkit, "spacemouse": SpaceMouse, "diyhid": DiyHid}
 
 
@@ -83,12 +83,12 @@ def _parse(url: str):
 
 
 def open_device(url: str):
-    """Open and hand-shake the device at `url`; returns a `haptics.drivers.base.Device`.
+    """Open and hand-shake the device at `url`; returns a `feelflow.haptics.drivers.base.Device`.
 
     Raises BadDeviceURL for a URL we do not understand and DeviceError when the device does
     not answer. The caller closes it (`with open_device(url) as dev:` works).
     """
-    from haptics.transport import HidTransport, SerialTransport
+    from feelflow.haptics.transport import HidTransport, SerialTransport
 
     drivers = _drivers()
     u, q = _parse(url)
@@ -154,12 +154,12 @@ def _guess_serial_driver(port: str) -> str:
 
 
 def _open_sim(kind: str, url: str, drivers):
-    from haptics.transport import HidTransport, SerialTransport
+    from feelflow.haptics.transport import HidTransport, SerialTransport
 
     if kind in ("haply2diy", "hapkit"):  # serial boards: a simulator process behind a pty
-        from haptics.drivers.haply2diy import WORKSPACE
-        from haptics.sim.hapkit_sim import INFO
-        from haptics.sim.serve import RemoteSim
+        from feelflow.haptics.drivers.haply2diy import WORKSPACE
+        from feelflow.haptics.sim.hapkit_sim import INFO
+        from feelflow.haptics.sim.serve import RemoteSim
         ws = WORKSPACE if kind == "haply2diy" else ((INFO.x_min, INFO.x_max), (0.0, 0.0))
         sim = RemoteSim(kind, ws)
         try:
@@ -168,7 +168,7 @@ def _open_sim(kind: str, url: str, drivers):
             sim.stop()
             raise
     else:
-        from haptics.sim.hid_sim import DiyHidSim, SpaceMouseSim
+        from feelflow.haptics.sim.hid_sim import DiyHidSim, SpaceMouseSim
         sim = SpaceMouseSim() if kind == "spacemouse" else DiyHidSim()
         dev = drivers[kind](HidTransport(device=sim, name=url), url)
     dev.simulator = sim

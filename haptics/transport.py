@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 import time
 
-from haptics.errors import DeviceDisconnected, DeviceError
+from feelflow.haptics.errors import DeviceDisconnected, DeviceError
 
 
 class SerialTransport:
@@ -97,7 +97,7 @@ class SerialTransport:
 
 class HidTransport:
     """A HID device behind hidapi's `hid.device` interface (or anything with the same methods:
-    the simulators in `haptics.sim` provide exactly the methods used here)."""
+    the simulators in `feelflow.haptics.sim` provide exactly the methods used here)."""
 
     kind = "hid"
 

@@ -2,11 +2,11 @@
 
 Qt-free and solver-free (numpy only). Geometry in lattice units, angles in radians (CCW).
 """
-from shapes.base import BodyRaster, Shape, ShapeError
-from shapes.cylinder import Cylinder
-from shapes.polygon import FlatPlate, HalfAirfoil, Polygon, PolygonalShape, Wedge
-from shapes.io import from_dict, load_shape, save_shape, to_dict
-from shapes.raster import rasterise
+from feelflow.shapes.base import BodyRaster, Shape, ShapeError
+from feelflow.shapes.cylinder import Cylinder
+from feelflow.shapes.polygon import FlatPlate, HalfAirfoil, Polygon, PolygonalShape, Wedge
+from feelflow.shapes.io import from_dict, load_shape, save_shape, to_dict
+from feelflow.shapes.raster import rasterise
 
 __all__ = [
     "BodyRaster", "Shape", "ShapeError", "Cylinder", "Polygon", "PolygonalShape", "FlatPlate",

@@ -60,7 +60,7 @@ class Shape(ABC):
 
     @abstractmethod
     def to_dict(self) -> dict:
-        """JSON-ready description; `shapes.from_dict` reverses it."""
+        """JSON-ready description; `feelflow.shapes.from_dict` reverses it."""
 
 
 class BodyRaster:

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from shapes.base import Shape
-from shapes.validation import (check_extent, check_in_domain, check_pose, finite_number, positive_number,
+from feelflow.shapes.base import Shape
+from feelflow.shapes.validation import (check_extent, check_in_domain, check_pose, finite_number, positive_number,
                                unit_direction)
 
 

@@ -11,9 +11,9 @@ import os
 import tempfile
 from pathlib import Path
 
-from shapes.base import Shape, ShapeError
-from shapes.cylinder import Cylinder
-from shapes.polygon import FlatPlate, HalfAirfoil, Polygon, Wedge
+from feelflow.shapes.base import Shape, ShapeError
+from feelflow.shapes.cylinder import Cylinder
+from feelflow.shapes.polygon import FlatPlate, HalfAirfoil, Polygon, Wedge
 
 #: kind -> (class, required parameter keys, optional keys with defaults)
 KINDS: dict[str, tuple[type, tuple[str, ...], dict]] = {

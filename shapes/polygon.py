@@ -14,8 +14,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from shapes.base import Shape, ShapeError
-from shapes.validation import (check_extent, check_in_domain, check_pose, finite_number, positive_number,
+from feelflow.shapes.base import Shape, ShapeError
+from feelflow.shapes.validation import (check_extent, check_in_domain, check_pose, finite_number, positive_number,
                                unit_direction)
 
 #: points closer than this to an edge count as on the boundary (and so inside)

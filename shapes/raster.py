@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 
-from shapes.base import BodyRaster, Shape
-from shapes.polygon import BOUNDARY_TOLERANCE, PolygonalShape, edge_crossing_x, edge_distance, link_edge_hit
+from feelflow.shapes.base import BodyRaster, Shape
+from feelflow.shapes.polygon import BOUNDARY_TOLERANCE, PolygonalShape, edge_crossing_x, edge_distance, link_edge_hit
 
 #: D2Q9 velocities in the order of solver/lattice.py (shapes may not import solver, see
 #: pyproject's import contract; tests/test_shapes_raster.py checks the two agree).

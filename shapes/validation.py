@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from shapes.base import Shape, ShapeError
+from feelflow.shapes.base import Shape, ShapeError
 
 #: smallest allowed extent of a body, in lattice cells (issue 2: "smaller than 2 cells")
 MIN_EXTENT = 2.0

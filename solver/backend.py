@@ -9,12 +9,12 @@ from abc import ABC, abstractmethod
 
 import numpy as np
 
-from solver.config import FlowConfig
+from feelflow.solver.config import FlowConfig
 
 #: backend name -> "module:Class"; no silent fallback from one to the other
 BACKENDS: dict[str, str] = {
-    "numpy": "solver.numpy_backend:NumpySolver",
-    "gl": "solver.gl_backend:GLSolver",
+    "numpy": "feelflow.solver.numpy_backend:NumpySolver",
+    "gl": "feelflow.solver.gl_backend:GLSolver",
 }
 
 
@@ -53,7 +53,7 @@ class Solver(ABC):
     def set_inflow_speed(self, speed: float) -> None:
         """Change the inlet speed U (tunnel) from the next step on, capped at config.max_speed
         (solver/speed_limit.py); `inflow_capped` and `speed_capped` say when the cap bit."""
-        from solver.speed_limit import cap_speed
+        from feelflow.solver.speed_limit import cap_speed
 
         u, _, capped = cap_speed(float(speed), 0.0, self.config.max_speed)
         self.inflow_speed, self.inflow_capped = u, capped
@@ -70,7 +70,7 @@ class Solver(ABC):
         force window wide enough for every enabled model (solver/body.py)."""
         if shape is None:
             return None
-        from solver.body import make_body_state, window_margin
+        from feelflow.solver.body import make_body_state, window_margin
 
         return make_body_state(shape, velocity, omega, self.config,
                                window_margin(self._models.values()), raster)
@@ -87,8 +87,8 @@ class Solver(ABC):
 
     # --- forces ---------------------------------------------------------------
     def enable_force_models(self, names) -> None:
-        """Compute only these models (names from `solver.forces.MODELS`)."""
-        from solver.forces import create_model
+        """Compute only these models (names from `feelflow.solver.forces.MODELS`)."""
+        from feelflow.solver.forces import create_model
 
         self._models = {name: create_model(name) for name in names}
         self._forces = {}
@@ -103,7 +103,7 @@ class Solver(ABC):
         """The body's force window for the margin the enabled models need (solver/body.py)."""
         b = self.body
         if b is not None:
-            from solver.body import make_body_state, window_margin
+            from feelflow.solver.body import make_body_state, window_margin
 
             self.body = make_body_state(b.shape, b.velocity, b.omega, self.config,
                                         window_margin(self._models.values()), b.raster)
@@ -120,7 +120,7 @@ class Solver(ABC):
 
     def distributions(self) -> np.ndarray:
         """Full (unshifted) post-collision populations f*, float64 array (9, ny, nx)."""
-        from solver.lattice import RHO0, W
+        from feelflow.solver.lattice import RHO0, W
 
         return self.shifted_distributions().astype(np.float64) + (W * RHO0)[:, None, None]
 
@@ -135,7 +135,7 @@ class Solver(ABC):
         With a body force F (Guo et al. 2002) the collision adds F to the momentum, so the
         fluid velocity of the step is u = (sum_i c_i f*_i - F/2) / rho (sum_i c_i w_i = 0).
         With the incompressible equilibrium (He & Luo 1997) the velocity is j / RHO0."""
-        from solver.lattice import C, RHO0
+        from feelflow.solver.lattice import C, RHO0
 
         g = self.shifted_distributions()
         rho = g.sum(axis=0, dtype=np.float64) + RHO0
@@ -147,7 +147,7 @@ class Solver(ABC):
 
     def total_mass(self) -> float:
         """sum f over the grid, accumulated in float64 on the shifted storage."""
-        from solver.lattice import RHO0
+        from feelflow.solver.lattice import RHO0
 
         return float(self.shifted_distributions().sum(dtype=np.float64)) + RHO0 * self.config.nx * self.config.ny
 

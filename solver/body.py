@@ -13,9 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.bouzidi import BodyLinks, build_links, periodic_wrap, wall_velocity
-from solver.lattice import C, Q, RHO0, W, equilibrium
-from solver.speed_limit import cap_rigid_motion
+from feelflow.solver.bouzidi import BodyLinks, build_links, periodic_wrap, wall_velocity
+from feelflow.solver.lattice import C, Q, RHO0, W, equilibrium
+from feelflow.solver.speed_limit import cap_rigid_motion
 
 #: nodes around the raster window the force window keeps: the Bouzidi second node (1) + 1
 BASE_MARGIN = 2
@@ -209,7 +209,7 @@ class BodyState:
 def make_body_state(shape, velocity, omega, config, margin: int, raster=None) -> BodyState:
     """Rasterise `shape` (unless `raster` is given: a BodyRaster of this shape with any
     window margin), cap its motion and build its links on raster.window + margin."""
-    from shapes.raster import rasterise
+    from feelflow.shapes.raster import rasterise
 
     nx, ny = config.nx, config.ny
     shape.validate(nx, ny)

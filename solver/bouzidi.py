@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.lattice import C, OPP, RHO0, W
+from feelflow.solver.lattice import C, OPP, RHO0, W
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver.lattice import C, RHO0, W
+from feelflow.solver.lattice import C, RHO0, W
 
 #: opposite pairs (i, ib); the loop computes c_i . u for i
 PAIRS = ((1, 3), (2, 4), (5, 7), (6, 8))

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from solver.lattice import CS2, RHO0
+from feelflow.solver.lattice import CS2, RHO0
 
 X_BOUNDARIES = ("tunnel", "periodic")
 Y_BOUNDARIES = ("no_slip", "free_slip", "periodic")

@@ -1,6 +1,6 @@
 """The fragment-shader backend: docs/algorithm.md in GLSL 330 core, run through moderngl.
 
-`GLSolver(config, ctx=moderngl_context)` implements `solver.backend.Solver` with the same extra
+`GLSolver(config, ctx=moderngl_context)` implements `feelflow.solver.backend.Solver` with the same extra
 methods as the numpy reference (`add_force_model`, `body_window`). It never
 creates a GL context: the CLI and the tests hand it an EGL standalone one, the window Qt's.
 Arithmetic is float32 whatever `config.dtype` says.
@@ -41,7 +41,7 @@ API for the app (a QOpenGLWidget sharing this context):
   both nodes of a texel) of the final state over tiles (`shaders/finite_check.glsl`; NaN reaches
   every population of the neighbours within a step, so a NaN never vanishes from the fluid) and the windows and sums are read once. A non-finite sum
   replays the block from its start state, which a third state side keeps, with a check after
-  every step: `solver.backend.SolverDiverged` names the exact step, as in the reference; a
+  every step: `feelflow.solver.backend.SolverDiverged` names the exact step, as in the reference; a
   non-finite body window raises it with the step of that window.
 - Where the only force models are the momentum exchanges (LINK_SUM_MODELS; tuning
   forces="gpu", the default), their links are summed on the GPU instead of copying the window.
@@ -66,15 +66,15 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from shapes.raster import distinct_sorted
-from solver.backend import BackendError, Solver, SolverDiverged
-from solver.body import expand_box, move_body, shifted, union_box, unshifted
-from solver.forces.base import BodyWindow
-from solver.gl_layout import TEXTURES, pack, texel_box, texels, unpack
-from solver.gl_programs import create_program
-from solver.inflow import inlet_wall_profile, profile, ramp
-from solver.lattice import C, OPP, Q, RHO0, W, equilibrium
-from solver.numpy_backend import absorb_keep, relaxation_rates
+from feelflow.shapes.raster import distinct_sorted
+from feelflow.solver.backend import BackendError, Solver, SolverDiverged
+from feelflow.solver.body import expand_box, move_body, shifted, union_box, unshifted
+from feelflow.solver.forces.base import BodyWindow
+from feelflow.solver.gl_layout import TEXTURES, pack, texel_box, texels, unpack
+from feelflow.solver.gl_programs import create_program
+from feelflow.solver.inflow import inlet_wall_profile, profile, ramp
+from feelflow.solver.lattice import C, OPP, Q, RHO0, W, equilibrium
+from feelflow.solver.numpy_backend import absorb_keep, relaxation_rates
 
 #: texture units (fixed; every pass binds all it samples)
 UNIT_G = tuple(range(TEXTURES))

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver.lattice import Q
+from feelflow.solver.lattice import Q
 
 A, B = 0, 1
 #: texture t -> its four channels, each (direction, node A or B), or None (no population)

@@ -2,7 +2,7 @@
 
 Every file in `shaders/` is one shader stage whose line 1 is the `#version` directive for GLSL
 330 core (GL 3.3 core, which macOS's 4.1 core also runs). A line `// @LATTICE` is replaced by the D2Q9 constants of
-`solver.lattice.glsl_constants()` (the one lattice definition, DESIGN rule 3) and by any
+`feelflow.solver.lattice.glsl_constants()` (the one lattice definition, DESIGN rule 3) and by any
 compile-time `#define`s a variant asks for; a `#line` directive after the injected block puts
 the driver's line numbers back on the file's own lines, so a compile error reported by the
 driver as "0:57(3)" is line 57 of the file. `ShaderError` names the file and that line.
@@ -18,9 +18,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from solver.lattice import glsl_constants
-
-SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
+from feelflow import SHADER_DIR
+from feelflow.solver.lattice import glsl_constants
 MARKER = "// @LATTICE"
 INCLUDE = "// @INCLUDE "
 #: line-number offset of each included file (file k starts at k * INCLUDE_LINES + 1)

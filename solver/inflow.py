@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from solver.lattice import C, OPP, RHO0, W
+from feelflow.solver.lattice import C, OPP, RHO0, W
 
 #: the populations the inlet supplies (c_x = +1)
 INLET_DIRECTIONS = (1, 5, 8)

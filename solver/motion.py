@@ -1,7 +1,7 @@
 """Motion scripts: a body driven through phases of constant velocity (the seed's experiment:
 stopped, moving with the stream, stopped, moving against it; SEED-NOTES 'Experiments').
 
-`MotionRunner` is the one place that turns a script into `solver.set_body` calls: `feelflow run`,
+`MotionRunner` is the one place that turns a script into `feelflow.solver.set_body` calls: `feelflow run`,
 the validation cases, the report and the GUI's scripted mode all use it. Positions advance exactly by the velocity
 each step (sub-cell poses), and the body is re-placed before every step it moves.
 """
@@ -84,7 +84,7 @@ class MotionRunner:
     """Moves `shape` through `script` in `solver`; returns mean forces per model.
 
     Pose at step t: X(t) = X(0) + displacement(t). Before every step in which the body moves,
-    `solver.set_body(shape at X(t), V(t))`; while it rests, the solver steps in blocks.
+    `feelflow.solver.set_body(shape at X(t), V(t))`; while it rests, the solver steps in blocks.
     """
 
     def __init__(self, solver, shape, script: MotionScript):

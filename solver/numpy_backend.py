@@ -10,14 +10,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver.backend import Solver, SolverDiverged
-from solver.body import move_body, shifted, unshifted
-from solver.bouzidi import incoming
-from solver.collision import Collider
-from solver.config import FlowConfig
-from solver.forces.base import BodyWindow
-from solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS, inlet_wall_profile, outlet_incoming, profile, ramp
-from solver.lattice import C, OPP, Q, RHO0, W, equilibrium
+from feelflow.solver.backend import Solver, SolverDiverged
+from feelflow.solver.body import move_body, shifted, unshifted
+from feelflow.solver.bouzidi import incoming
+from feelflow.solver.collision import Collider
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.forces.base import BodyWindow
+from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS, inlet_wall_profile, outlet_incoming, profile, ramp
+from feelflow.solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 
 #: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall
 MIRROR_Y = np.array([0, 1, 4, 3, 2, 8, 7, 6, 5])

@@ -33,11 +33,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from solver.backend import Solver
-from solver.body import shifted, unshifted
-from solver.config import ConfigError, FlowConfig
-from solver.lattice import C, OPP, equilibrium
-from solver.numpy_backend import NumpySolver, relaxation_rates
+from feelflow.solver.backend import Solver
+from feelflow.solver.body import shifted, unshifted
+from feelflow.solver.config import ConfigError, FlowConfig
+from feelflow.solver.lattice import C, OPP, equilibrium
+from feelflow.solver.numpy_backend import NumpySolver, relaxation_rates
 
 #: coarse cells between the patch's border and the body, and between the border and the domain edge
 BODY_MARGIN = 3
@@ -85,7 +85,7 @@ def fine_point(x: float, y: float, x0: int, y0: int) -> tuple[float, float]:
 
 def fine_shape(shape, x0: int, y0: int):
     """The shape on the fine lattice of a patch with its corner at coarse node (x0, y0)."""
-    from shapes.io import from_dict
+    from feelflow.shapes.io import from_dict
 
     d = shape.to_dict()
     for key in _LENGTH_KEYS:

@@ -15,7 +15,7 @@ nu the viscosity, d the body size in cells):
   start) stay stable up to Re_cell = 10 at d = 20 (sqrt(d) Re_cell = 44.7) and fail from 11.25.
 * BGK: within 6 d / U only the shaken cylinder failed, at the panel's extreme corner (Re_cell
   45 at d = 20; K_bgk = 156.5); runs of 30 d / U at that corner (`python -m
-  solver.validation.stability --u 0.09 --nu 0.002 --collision bgk --convective-times 30`): the
+  feelflow.solver.validation.stability --u 0.09 --nu 0.002 --collision bgk --convective-times 30`): the
   shaken cylinder runs away after 1200 steps, the other three last.
   Its limit is therefore not measured finely; BGK gets TRT's K, at which all four cases ran
   30 d / U stably with both operators (`... --u 0.09 --k 27.67 --collision bgk|trt

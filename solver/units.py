@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from solver.lattice import CS2, RHO0
+from feelflow.solver.lattice import CS2, RHO0
 
 #: speed of sound in lattice units
 CS = math.sqrt(CS2)

@@ -19,8 +19,8 @@ def gl_context():
     """The process's standalone EGL OpenGL 3.3 core context (app.headless.gl_context: llvmpipe
     where there is no GPU), the one the CLI's gl solvers get too."""
     pytest.importorskip("moderngl")
-    from app.cli import UserError
-    from app.headless import gl_context as egl_context, release_gl_context
+    from feelflow.app.errors import UserError
+    from feelflow.app.headless import gl_context as egl_context, release_gl_context
 
     try:
         ctx = egl_context()
@@ -32,7 +32,7 @@ def gl_context():
 
 def make_solver(backend: str, config, request=None):
     """Create a solver of the named backend; gl gets the session EGL context."""
-    from solver.backend import create_solver
+    from feelflow.solver.backend import create_solver
 
     if backend == "gl":
         ctx = request.getfixturevalue("gl_context")

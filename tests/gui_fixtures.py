@@ -15,8 +15,8 @@ GRID = (128, 64)
 def pytest_collection_finish(session):
     """The surface format must be the default before pytest-qt creates the QApplication."""
     if os.environ.get("DISPLAY") and any(item.get_closest_marker("gui") for item in session.items):
-        from app.commands.gui import set_surface_format
-        from app.qt_runtime import make_none_immortal
+        from feelflow.app.cli.commands.gui import set_surface_format
+        from feelflow.app.gui.qt_runtime import make_none_immortal
 
         make_none_immortal()
         set_surface_format()
@@ -27,8 +27,8 @@ def window(qtbot, tmp_path):
     """The FeelFlow window on the numpy solver and a small grid, running, settings in tmp_path."""
     from PySide6.QtCore import QSettings
 
-    from app.main_window import MainWindow
-    from app.simulation import Params
+    from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.model.simulation import Params
 
     settings = QSettings(str(tmp_path / "settings.ini"), QSettings.IniFormat)
     w = MainWindow(backend="numpy", settings=settings, params=Params(grid=GRID, size=12))

@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 
-from haptics.timing import try_realtime
+from feelflow.haptics.timing import try_realtime
 
 
 def wait_for(cond, timeout=3.0, step=0.002):
@@ -29,7 +29,7 @@ class Feeder:
     """
 
     def __init__(self, loop, fx=0.0, fy=0.0, hz=100.0):
-        from haptics import ForceSample
+        from feelflow.haptics import ForceSample
 
         self.loop, self.fx, self.fy, self.hz = loop, fx, fy, hz
         self.sending = True

@@ -1,8 +1,8 @@
 """A short recorded session for the session tests: a cylinder pushed across a small tunnel."""
 from __future__ import annotations
 
-from shapes.cylinder import Cylinder
-from solver.config import FlowConfig
+from feelflow.shapes.cylinder import Cylinder
+from feelflow.solver.config import FlowConfig
 
 MODELS = ("momentum_exchange",)
 

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from app.coupling import SpringDamper
+from feelflow.app.model.coupling import SpringDamper
 
 
 def test_spring_damper_settles_on_the_target_without_overshoot():
@@ -33,7 +33,7 @@ def test_spring_damper_caps_the_speed_and_says_so():
 
 
 def test_power_law_fit_recovers_the_exponent():
-    from app.force_plot import fit_power_law
+    from feelflow.app.model.power_law import fit_power_law
 
     rng = np.random.default_rng(0)
     u = np.repeat([0.02, 0.03, 0.045, 0.065, 0.09], 40)
@@ -45,7 +45,7 @@ def test_power_law_fit_recovers_the_exponent():
 
 
 def test_history_drag_and_lift_are_along_and_across_the_relative_wind():
-    from app.simulation import History
+    from feelflow.app.model.simulation import History
 
     h = History()
     h.add(1, (0.0, 0.0), (0.05, 0.0), {"m": (2.0, 1.0)})
@@ -55,8 +55,8 @@ def test_history_drag_and_lift_are_along_and_across_the_relative_wind():
 
 
 def test_a_turn_follows_the_pointer_across_180_degrees_and_snaps():
-    from app.simulation import wrap_degrees
-    from app.turn_handle import Turn, pointer_degrees
+    from feelflow.app.model.simulation import wrap_degrees
+    from feelflow.app.gui.turn_handle import Turn, pointer_degrees
 
     assert pointer_degrees((10.0, 10.0), (10.0, 15.0)) == pytest.approx(90.0)   # y up: counter-clockwise
     turn = Turn(pointer_deg=170.0, body_deg=30.0)

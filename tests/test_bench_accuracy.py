@@ -4,12 +4,12 @@ import math
 
 import pytest
 
-from app.commands import bench_accuracy
-from app.cli import main as cli_main
+from feelflow.app.bench import accuracy as bench_accuracy
+from feelflow.app.cli.main import main as cli_main
 
 
 def _numpy64(config):
-    from solver.backend import create_solver
+    from feelflow.solver.backend import create_solver
 
     return create_solver("numpy", config)
 

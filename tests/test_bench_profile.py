@@ -3,7 +3,7 @@ import json
 
 import pytest
 
-from app.cli import main as cli_main
+from feelflow.app.cli.main import main as cli_main
 
 pytestmark = pytest.mark.gl
 

@@ -5,8 +5,8 @@ import json
 import numpy as np
 import pytest
 
-from app.cli import main as cli_main
-from app.commands.bench_solver import BOX, DEFAULT_TUNNEL, NO_BODY_ONE_CALL, NUMPY_TUNNEL, STAIRCASE, against_numpy
+from feelflow.app.cli.main import main as cli_main
+from feelflow.app.bench.solver_speed import BOX, DEFAULT_TUNNEL, NO_BODY_ONE_CALL, NUMPY_TUNNEL, STAIRCASE, against_numpy
 
 
 def test_ratios_are_taken_within_each_round_not_between_the_best_figures():
@@ -31,7 +31,7 @@ def test_the_staircase_prices_each_part_within_each_round():
 
 
 def test_cpu_work_cost_is_the_added_time_per_call_within_each_round():
-    from app.commands.bench_solver import (MOVE_EVERY, WORK_AFTER_READ, WORK_BEFORE_READ,
+    from feelflow.app.bench.solver_speed import (MOVE_EVERY, WORK_AFTER_READ, WORK_BEFORE_READ,
                                            cpu_work_cost)
 
     nodes = 100_000  # a call of MOVE_EVERY steps at 50 MLUPS takes 20 ms, at 40 MLUPS 25 ms
@@ -72,8 +72,8 @@ def test_tunnel_warm_up_outlasts_the_subnormal_start_up_transient():
     """The bench measures a tunnel only after its start-up transient: while the inlet's sound
     front crosses the still fluid, float32 stores populations so small they are subnormal, which
     slow numpy's arithmetic (not llvmpipe's, which flushes them to zero) and so bias the ratio."""
-    from app.commands.bench_solver import SceneRun, scene_config, warmup_steps
-    from solver.backend import create_solver
+    from feelflow.app.bench.solver_speed import SceneRun, scene_config, warmup_steps
+    from feelflow.solver.backend import create_solver
 
     run = SceneRun("tunnel", create_solver("numpy", scene_config("tunnel", 256, 128)))
     tiny = np.finfo(np.float32).tiny

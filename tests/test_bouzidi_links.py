@@ -1,8 +1,8 @@
 """Body links across a periodic seam (solver/bouzidi.py `build_links`, `periodic_wrap`)."""
 import numpy as np
 
-from solver.bouzidi import build_links, periodic_wrap
-from solver.config import FlowConfig
+from feelflow.solver.bouzidi import build_links, periodic_wrap
+from feelflow.solver.config import FlowConfig
 
 
 def _wall_window(w=6, h=5, q_cut=0.3):

@@ -14,13 +14,13 @@ import math
 import numpy as np
 import pytest
 
-from shapes import Cylinder, FlatPlate, HalfAirfoil, Wedge
-from solver.config import FlowConfig
-from solver.forces import create_model
-from solver.forces.base import BodyWindow
-from solver.forces.pressure import BETA_LATTICE
-from solver.forces.stress import viscous_force
-from solver.lattice import C, CS2, RHO0, W, equilibrium
+from feelflow.shapes import Cylinder, FlatPlate, HalfAirfoil, Wedge
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.forces import create_model
+from feelflow.solver.forces.base import BodyWindow
+from feelflow.solver.forces.pressure import BETA_LATTICE
+from feelflow.solver.forces.stress import viscous_force
+from feelflow.solver.lattice import C, CS2, RHO0, W, equilibrium
 
 CONFIG = FlowConfig(nx=256, ny=128, nu=0.05)
 

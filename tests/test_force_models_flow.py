@@ -21,12 +21,12 @@ import pytest
 from conftest import make_solver
 from solver_backends import BACKENDS
 
-from shapes import Cylinder, HalfAirfoil, rasterise
-from solver.config import FlowConfig
-from solver.forces.base import BodyWindow
-from solver.forces.stress import viscous_force
-from solver.lattice import equilibrium
-from solver.motion import MotionRunner, MotionScript, Phase
+from feelflow.shapes import Cylinder, HalfAirfoil, rasterise
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.forces.base import BodyWindow
+from feelflow.solver.forces.stress import viscous_force
+from feelflow.solver.lattice import equilibrium
+from feelflow.solver.motion import MotionRunner, MotionScript, Phase
 
 ME, CLASSIC = "momentum_exchange", "momentum_exchange_classic"
 #: the seed's protocol as relative speeds of the stream past the body, in units of U

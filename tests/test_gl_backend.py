@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 from conftest import make_solver
 
-from shapes import Cylinder
-from solver.backend import BackendError, SolverDiverged, create_solver
-from solver.config import FlowConfig
-from solver.lattice import equilibrium
+from feelflow.shapes import Cylinder
+from feelflow.solver.backend import BackendError, SolverDiverged, create_solver
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.lattice import equilibrium
 
 pytestmark = pytest.mark.gl
 
@@ -102,8 +102,8 @@ def test_discard_check_counts_the_body_window_drawn_over_the_interior(gl_context
 def test_body_upload_touches_only_the_window(request):
     """Moving the body rewrites the mask (and q) only around the old and new windows; removing
     the body clears them there."""
-    from solver.body import expand_box, union_box
-    from solver.gl_backend import node_mask
+    from feelflow.solver.body import expand_box, union_box
+    from feelflow.solver.gl_backend import node_mask
 
     cfg = FlowConfig(nx=64, ny=32)
     s = make_solver("gl", cfg, request)
@@ -156,7 +156,7 @@ def test_link_sums_on_the_gpu_give_the_momentum_exchanges_of_the_window(gl_conte
     blocks (Bouzidi links of both kinds, moving wall, cover/uncover impulses), agree with the
     models on the window to float32 round-off of the sums (1e-5 of the largest force; measured
     2.8e-7), and the state is the same bit for bit."""
-    from shapes import FlatPlate
+    from feelflow.shapes import FlatPlate
 
     cfg = FlowConfig(nx=96, ny=48, inflow_speed=0.05, inflow_ramp_steps=10)
     names = ["momentum_exchange", "momentum_exchange_classic"]
@@ -191,7 +191,7 @@ def test_the_step_pass_sums_the_links_of_a_single_momentum_exchange(gl_context, 
     the forces agree with the model's code on the copied window to float32 round-off (1e-5 of
     the largest force; measured 2.0e-7), the state is the same bit for bit, and enabling both
     exchanges switches to the link-sum pass."""
-    from shapes import FlatPlate
+    from feelflow.shapes import FlatPlate
 
     cfg = FlowConfig(nx=96, ny=48, inflow_speed=0.05, inflow_ramp_steps=10)
     runs = []
@@ -263,8 +263,8 @@ def test_before_read_runs_once_per_block_while_its_steps_are_still_unread(gl_con
 
 def test_window_wider_than_the_band_area_falls_back_to_the_atlas(gl_context):
     """A body window wider than the band area (BAND_WIDTH) takes the atlas path, same numbers."""
-    from shapes import FlatPlate
-    from solver.gl_backend import BAND_WIDTH
+    from feelflow.shapes import FlatPlate
+    from feelflow.solver.gl_backend import BAND_WIDTH
 
     cfg = FlowConfig(nx=BAND_WIDTH + 64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)
     plate = FlatPlate(length=BAND_WIDTH + 10.0, thickness=2.0, x=cfg.nx / 2, y=16.0, angle=np.pi / 2)

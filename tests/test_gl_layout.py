@@ -5,8 +5,8 @@ import re
 import numpy as np
 import pytest
 
-from solver.gl_layout import LAYOUT, TEXTURES, pack, slots, texel_box, texels, unpack
-from solver.gl_programs import SHADER_DIR
+from feelflow.solver.gl_layout import LAYOUT, TEXTURES, pack, slots, texel_box, texels, unpack
+from feelflow.solver.gl_programs import SHADER_DIR
 
 
 @pytest.mark.parametrize("w", [1, 6, 7])
@@ -28,7 +28,7 @@ def test_streaming_fetches_each_neighbour_texel_once():
     """What stream_pair (shaders/lbm_step.glsl) relies on: the populations that reach the two
     nodes of texel k from texel k + dk (dk = -1, 0, 1) of row y - c_y lie in one texture, which
     holds nothing a neighbour in another column needs (nine fetches for two nodes)."""
-    from solver.lattice import C
+    from feelflow.solver.lattice import C
 
     source = {}  # (texture, channel) -> texel offset (dk, dy) it is fetched from
     for i in range(9):

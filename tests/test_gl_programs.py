@@ -5,8 +5,8 @@ import re
 
 import pytest
 
-from solver.gl_programs import SHADER_DIR, ShaderError, create_program, shader_source
-from solver.lattice import glsl_constants
+from feelflow.solver.gl_programs import SHADER_DIR, ShaderError, create_program, shader_source
+from feelflow.solver.lattice import glsl_constants
 
 pytestmark = pytest.mark.gl
 

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from conftest import make_solver
 
-from shapes import Cylinder, FlatPlate
-from solver.config import FlowConfig
-from solver.forces import MODELS
+from feelflow.shapes import Cylinder, FlatPlate
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.forces import MODELS
 
 pytestmark = pytest.mark.gl
 
@@ -71,7 +71,7 @@ def test_periodic_box_with_body_force(collision, nx, request):
                      y_boundary="periodic", body_force=(1e-5, -2e-6), initial_velocity=(0.03, 0.01))
     solvers, _ = _run_pair(cfg, request)
     rng = np.random.default_rng(3)  # then a disturbed state, so that streaming matters
-    from solver.lattice import equilibrium
+    from feelflow.solver.lattice import equilibrium
     f = equilibrium(1 + 1e-3 * rng.standard_normal((32, nx)), 0.02 * rng.standard_normal((32, nx)),
                     0.02 * rng.standard_normal((32, nx)))
     for s in solvers:

@@ -15,7 +15,7 @@ pytestmark = [pytest.mark.gui,
 
 
 def test_time_view_force_axis_leaves_out_the_start_pulse(window, qtbot):
-    from app.force_plot import start_pulse_steps
+    from feelflow.app.gui.force_plot import start_pulse_steps
 
     sim, plot = window.sim, window.plot
     settle = start_pulse_steps(sim.params.size)

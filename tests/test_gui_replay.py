@@ -19,7 +19,7 @@ def record_in_window(window, qtbot, path, monkeypatch):
     """File > Record session: drag the body, change the wind, stop and save to `path`."""
     from PySide6.QtWidgets import QFileDialog
 
-    from app.selftest import send_mouse
+    from feelflow.app.gui.selftest import send_mouse
 
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(path), ""))
     vp, sim = window.viewport, window.sim
@@ -45,8 +45,8 @@ def test_replay_in_the_window_and_stop_returns_to_the_live_tunnel(window, qtbot,
     from PySide6.QtTest import QTest
     from PySide6.QtWidgets import QFileDialog
 
-    from app.selftest import send_mouse
-    from app.session import load_session
+    from feelflow.app.gui.selftest import send_mouse
+    from feelflow.app.sessions import load_session
 
     path = tmp_path / "lesson.ffsession"
     record_in_window(window, qtbot, path, monkeypatch)
@@ -151,9 +151,9 @@ def test_gl_window_replays_in_its_own_context(qtbot, tmp_path, monkeypatch):
     the replay's field texture, then the live one again."""
     from PySide6.QtCore import QSettings
 
-    from app.main_window import MainWindow
-    from app.session import load_session
-    from app.simulation import Params
+    from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.sessions import load_session
+    from feelflow.app.model.simulation import Params
     from gui_fixtures import GRID
 
     w = MainWindow(backend="gl", settings=QSettings(str(tmp_path / "s.ini"), QSettings.IniFormat),
@@ -225,7 +225,7 @@ def test_an_impossible_event_mid_replay_is_one_line_and_back_to_live(window, qtb
     replay stops with a one-line dialog and the live tunnel is back."""
     from PySide6.QtWidgets import QMessageBox
 
-    from app.session import load_session, save_session
+    from feelflow.app.sessions import load_session, save_session
 
     path = tmp_path / "lesson.ffsession"
     record_in_window(window, qtbot, path, monkeypatch)

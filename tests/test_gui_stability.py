@@ -13,7 +13,7 @@ pytestmark = [pytest.mark.gui,
 
 
 def test_lowest_viscosity_at_highest_wind_runs_finite_and_says_so(window, qtbot):
-    from solver.stability_limit import inside, min_stable_viscosity
+    from feelflow.solver.stability_limit import inside, min_stable_viscosity
 
     panel, sim = window.panel, window.sim
     panel.wind.setValue(panel.wind.maximum())

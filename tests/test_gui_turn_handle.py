@@ -22,7 +22,7 @@ pytestmark = [pytest.mark.gui,
 def knob_after_hover(window):
     """Bring the pointer over the body (the handle appears), then onto the knob; the knob's
     centre and the reference point, widget pixels."""
-    from app.selftest import send_mouse
+    from feelflow.app.gui.selftest import send_mouse
 
     vp, sim = window.viewport, window.sim
     send_mouse(vp, "hover", vp.to_widget(*sim.pos))
@@ -36,7 +36,7 @@ def drag_handle(window, degrees: float, moves: int = 12, modifiers=None):
     """Press on the knob and carry it `degrees` counter-clockwise about the reference point."""
     from PySide6.QtCore import QPointF, Qt
 
-    from app.selftest import send_mouse
+    from feelflow.app.gui.selftest import send_mouse
 
     vp = window.viewport
     modifiers = Qt.NoModifier if modifiers is None else modifiers
@@ -104,7 +104,7 @@ def test_the_handle_is_refused_while_a_replay_shows(window, qtbot, tmp_path, mon
     from PySide6.QtCore import QPointF
     from test_gui_replay import record_in_window
 
-    from app.selftest import send_mouse
+    from feelflow.app.gui.selftest import send_mouse
 
     path = tmp_path / "turn.ffsession"
     record_in_window(window, qtbot, path, monkeypatch)
@@ -128,7 +128,7 @@ def test_the_handle_is_refused_while_a_replay_shows(window, qtbot, tmp_path, mon
 
 
 def test_the_handle_is_refused_while_a_script_or_a_device_drives_the_body(window, qtbot):
-    from app.selftest import send_mouse
+    from feelflow.app.gui.selftest import send_mouse
 
     vp = window.viewport
     assert window.apply_preset("seed_protocol")
@@ -186,7 +186,7 @@ def test_a_wheel_turn_is_one_undo_step_back_to_the_exact_angle(window, qtbot):
 
 
 def test_a_burst_of_wheel_notches_is_one_undo_step(window, qtbot):
-    from app.turn_handle import BURST_S
+    from feelflow.app.gui.turn_handle import BURST_S
 
     sim = at_57_degrees(window)
     window.set_paused(True)                                        # paused: each notch turns it at once
@@ -222,7 +222,7 @@ def test_a_burst_of_wheel_notches_across_180_degrees_is_one_undo_step(window):
 def test_edits_of_the_angle_box_are_one_undo_step(window, qtbot):
     from PySide6.QtCore import Qt
 
-    from app.turn_handle import BURST_S
+    from feelflow.app.gui.turn_handle import BURST_S
 
     sim = at_57_degrees(window)
     qtbot.wait(int(BURST_S * 1000) + 300)                           # the 57 is a step of its own

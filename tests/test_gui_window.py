@@ -18,7 +18,7 @@ pytestmark = [pytest.mark.gui,
 
 
 def test_window_opens_runs_and_shows_a_live_field(window, qtbot):
-    from app.selftest import field_is_alive
+    from feelflow.app.gui.selftest import field_is_alive
 
     assert "llvmpipe" in window.viewport.renderer() or window.viewport.renderer() != "no GL"
     qtbot.waitUntil(lambda: window.sim.solver.time > 300, timeout=30000)   # the wind ramps up
@@ -86,7 +86,7 @@ def test_force_model_selector_drives_plot_and_readouts(window, qtbot):
 
 
 def test_dragging_moves_the_body_and_hold_still_freezes_it(window, qtbot):
-    from app.selftest import send_mouse
+    from feelflow.app.gui.selftest import send_mouse
 
     sim, vp = window.sim, window.viewport
     start = sim.pos
@@ -146,7 +146,7 @@ def test_polygon_edit_undo_redo_and_invalid_refused(window, monkeypatch):
 def test_vertex_handles_move_add_delete_and_undo(window, qtbot):
     from PySide6.QtCore import Qt
 
-    from app.selftest import send_mouse
+    from feelflow.app.gui.selftest import send_mouse
 
     sim = _polygon_window(window)
     window.panel.edit.setChecked(True)
@@ -177,7 +177,7 @@ def test_vertex_handles_move_add_delete_and_undo(window, qtbot):
 def test_screenshot_shows_the_body_where_it_is(window, qtbot, tmp_path):
     from PySide6.QtGui import QImage
 
-    from app.viewport import BODY_FILL
+    from feelflow.app.gui.viewport import BODY_FILL
 
     sim = window.sim
     window.panel.hold_still.setChecked(True)
@@ -263,8 +263,8 @@ def test_plot_exports_csv_and_png(window, qtbot, tmp_path):
 def test_settings_are_remembered(qtbot, tmp_path):
     from PySide6.QtCore import QSettings
 
-    from app.main_window import MainWindow
-    from app.simulation import Params
+    from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.model.simulation import Params
 
     path = str(tmp_path / "settings.ini")
     w = MainWindow(backend="numpy", settings=QSettings(path, QSettings.IniFormat), params=Params(grid=GRID, size=12))
@@ -297,8 +297,8 @@ def test_without_a_display_one_line_and_exit_2():
 
 @pytest.mark.parametrize("key", ["drag_speed", "shape_matters", "lift", "vortex_street", "seed_protocol", "models"])
 def test_each_lesson_preset_loads_its_scene_and_runs(window, qtbot, key):
-    from app.presets import PRESETS
-    from app.scene import load_scene
+    from feelflow.app.model.presets import PRESETS
+    from feelflow.app.model.scene import load_scene
 
     assert window.apply_preset(key)
     scene = load_scene(PRESETS[key].path)
@@ -326,9 +326,9 @@ def test_seed_protocol_moves_the_body_with_the_stream(window, qtbot):
 def test_gl_backend_runs_in_the_widgets_own_context(qtbot, tmp_path):
     from PySide6.QtCore import QSettings
 
-    from app.main_window import MainWindow
-    from app.selftest import field_is_alive
-    from app.simulation import Params
+    from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.selftest import field_is_alive
+    from feelflow.app.model.simulation import Params
 
     w = MainWindow(backend="gl", settings=QSettings(str(tmp_path / "s.ini"), QSettings.IniFormat),
                    params=Params(grid=GRID, size=12))
@@ -364,8 +364,8 @@ def test_haptic_device_moves_the_body_feels_the_force_and_unplugging_falls_back_
 def test_recording_a_session_saves_inputs_parameters_and_forces(window, qtbot, tmp_path, monkeypatch):
     from PySide6.QtWidgets import QFileDialog
 
-    from app.selftest import send_mouse
-    from app.session import load_session
+    from feelflow.app.gui.selftest import send_mouse
+    from feelflow.app.sessions import load_session
 
     path = tmp_path / "lesson.ffsession"
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(path), ""))
@@ -393,7 +393,7 @@ def test_a_backend_that_cannot_run_is_a_dialog_and_a_clean_close(qtbot, tmp_path
     from PySide6.QtCore import QSettings
     from PySide6.QtWidgets import QMessageBox
 
-    from app.main_window import MainWindow
+    from feelflow.app.gui.main_window import MainWindow
 
     shown = []
     monkeypatch.setattr(QMessageBox, "critical", lambda *a, **k: shown.append(a[2]))

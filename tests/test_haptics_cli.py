@@ -5,7 +5,7 @@ import sys
 
 import pytest
 
-from haptics import BadDeviceURL, list_devices, open_device
+from feelflow.haptics import BadDeviceURL, list_devices, open_device
 
 
 def run(*args):

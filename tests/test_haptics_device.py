@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from haptics import ForceLoop, ForceSample, LoopConfig, open_device
+from feelflow.haptics import ForceLoop, ForceSample, LoopConfig, open_device
 
 URL = os.environ.get("FEELFLOW_DEVICE")
 pytestmark = [pytest.mark.device,

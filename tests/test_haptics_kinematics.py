@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from haptics.kinematics import HAPLY_2DIY, OutOfReach, Pantograph
+from feelflow.haptics.kinematics import HAPLY_2DIY, OutOfReach, Pantograph
 
 L_, l_ = 0.09, 0.07
 

@@ -4,9 +4,9 @@ import time
 
 import pytest
 
-from haptics import ForceLoop, LoopConfig, open_device
-from haptics.protocols import diyhid, hapkit, haply
-from tests.haptics_helpers import Feeder, wait_for
+from feelflow.haptics import ForceLoop, LoopConfig, open_device
+from feelflow.haptics.protocols import diyhid, hapkit, haply
+from haptics_helpers import Feeder, wait_for
 
 
 def run_loop(dev):

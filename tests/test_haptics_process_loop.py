@@ -4,9 +4,9 @@ import time
 
 import pytest
 
-from haptics import DeviceError, LoopConfig, SafetyConfig
-from haptics.process_loop import ProcessForceLoop
-from tests.haptics_helpers import Feeder, force, wait_for
+from feelflow.haptics import DeviceError, LoopConfig, SafetyConfig
+from feelflow.haptics.process_loop import ProcessForceLoop
+from haptics_helpers import Feeder, force, wait_for
 
 PEAK = 0.01
 

@@ -10,12 +10,12 @@ import time
 import pytest
 import serial
 
-from haptics.drivers.haply2diy import PORTS
-from haptics.protocols import diyhid, hapkit, haply
-from haptics.protocols import spacemouse as sm
-from haptics.sim.hapkit_sim import HapkitSim
-from haptics.sim.haply_sim import HaplySim
-from haptics.sim.hid_sim import DiyHidSim, SpaceMouseSim
+from feelflow.haptics.drivers.haply2diy import PORTS
+from feelflow.haptics.protocols import diyhid, hapkit, haply
+from feelflow.haptics.protocols import spacemouse as sm
+from feelflow.haptics.sim.hapkit_sim import HapkitSim
+from feelflow.haptics.sim.haply_sim import HaplySim
+from feelflow.haptics.sim.hid_sim import DiyHidSim, SpaceMouseSim
 
 H = bytes.fromhex
 
@@ -183,8 +183,8 @@ def test_diyhid_rejects_other_versions_and_truncation():
 def test_hapkit_driver_over_pyserial_loopback():
     # loop:// echoes what is written: the driver's own FORCE frames come back and are rejected
     # as host-only ('unexpected'); a STATE frame written into the loop is read as the pose.
-    from haptics.drivers.hapkit import Hapkit
-    from haptics.transport import SerialTransport
+    from feelflow.haptics.drivers.hapkit import Hapkit
+    from feelflow.haptics.transport import SerialTransport
 
     dev = Hapkit(SerialTransport("loop://"), "loop://")
     dev.transport.write(hapkit.encode_state(hapkit.State(3, 0.012, 1)))
@@ -196,7 +196,7 @@ def test_hapkit_driver_over_pyserial_loopback():
 
 
 def test_hid_driver_choice_by_usb_id():
-    from haptics.registry import hid_driver_for
+    from feelflow.haptics.registry import hid_driver_for
 
     assert hid_driver_for(0x046D, 0xC626) == "spacemouse"
     assert hid_driver_for(0x256F, 0xC635) == "spacemouse"

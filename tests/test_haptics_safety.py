@@ -10,9 +10,9 @@ import time
 import numpy as np
 import pytest
 
-from haptics import ForceLoop, LoopConfig, SafetyConfig, open_device
-from haptics.drivers.base import clamp_force
-from tests.haptics_helpers import Feeder, force, force_after, record, wait_for
+from feelflow.haptics import ForceLoop, LoopConfig, SafetyConfig, open_device
+from feelflow.haptics.drivers.base import clamp_force
+from haptics_helpers import Feeder, force, force_after, record, wait_for
 
 PEAK = 0.01  # lattice units; felt as half the device maximum
 

@@ -3,9 +3,9 @@ import math
 
 import pytest
 
-from haptics.coupling import TunnelMap, VirtualCoupling
-from haptics.shaping import ForceInterpolator, ForceScale
-from haptics.timing import Ticker
+from feelflow.haptics.coupling import TunnelMap, VirtualCoupling
+from feelflow.haptics.shaping import ForceInterpolator, ForceScale
+from feelflow.haptics.timing import Ticker
 
 
 def test_scale_maps_expected_peak_to_comfort_fraction_of_max():

@@ -1,10 +1,10 @@
 """The command line's solver factory: a backend that cannot run is one line for the user."""
 import pytest
 
-from app.cli import UserError
-from app.headless import make_solver
-from solver import backend
-from solver.config import FlowConfig
+from feelflow.app.errors import UserError
+from feelflow.app.headless import make_solver
+from feelflow.solver import backend
+from feelflow.solver.config import FlowConfig
 
 
 def test_unknown_backend_is_a_user_error():
@@ -13,7 +13,7 @@ def test_unknown_backend_is_a_user_error():
 
 
 def test_backend_module_missing_is_one_clear_line(monkeypatch):
-    monkeypatch.setitem(backend.BACKENDS, "future", "solver.future_backend:FutureSolver")
+    monkeypatch.setitem(backend.BACKENDS, "future", "feelflow.solver.future_backend:FutureSolver")
     with pytest.raises(UserError) as info:
         make_solver("future", FlowConfig(nx=16, ny=16))
     assert str(info.value) == "--backend future: this backend is not available in this version"

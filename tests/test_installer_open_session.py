@@ -27,11 +27,11 @@ def test_gui_with_a_session_file_opens_the_window_replaying_it(qapp, tmp_path):
     from PySide6.QtCore import QTimer
     from PySide6.QtWidgets import QApplication
 
-    from app.cli import main
-    from app.main_window import MainWindow
-    from app.session import SessionRecorder, SessionSolver
+    from feelflow.app.cli.main import main
+    from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.sessions import SessionRecorder, SessionSolver
     from session_scenes import MODELS, drive_moving_cylinder, small_config, start_body
-    from solver.backend import create_solver
+    from feelflow.solver.backend import create_solver
 
     cfg = small_config()
     rec = SessionRecorder(cfg, start_body(), MODELS)

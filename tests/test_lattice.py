@@ -1,7 +1,7 @@
 """The D2Q9 lattice: isotropy moments and the equilibrium's moments (Krueger et al. 2017, 3.4)."""
 import numpy as np
 
-from solver.lattice import C, CS2, OPP, Q, W, equilibrium
+from feelflow.solver.lattice import C, CS2, OPP, Q, W, equilibrium
 
 
 def test_weights_and_opposites():
@@ -39,7 +39,7 @@ def test_equilibrium_moments():
 def test_incompressible_equilibrium_moments():
     """He & Luo (1997): sum f = rho, sum c f = RHO0 u, sum c c f = rho c_s^2 I + RHO0 u u, so the
     density fluctuation enters only the pressure."""
-    from solver.lattice import RHO0
+    from feelflow.solver.lattice import RHO0
 
     rho, ux, uy = 1.013, 0.04, -0.03
     f = equilibrium(np.array(rho), np.array(ux), np.array(uy), incompressible=True)

@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from app.simulation import History
+from feelflow.app.model.simulation import History
 
 
 def test_a_sample_is_settled_once_the_wind_has_held_for_settle_steps():
@@ -31,9 +31,9 @@ def test_a_sample_is_settled_once_the_wind_has_held_for_settle_steps():
 
 
 def _lesson_sim(key):
-    from app.presets import PRESETS
-    from app.scene import load_scene
-    from app.simulation import Simulation
+    from feelflow.app.model.presets import PRESETS
+    from feelflow.app.model.scene import load_scene
+    from feelflow.app.model.simulation import Simulation
 
     sim = Simulation(backend="numpy")
     sim.load_scene(load_scene(PRESETS[key].path))
@@ -65,7 +65,7 @@ def test_lift_lesson_settles_to_a_steady_lift():
     fifth session (no absorbing layer, put into a moving stream) its scatter was 0.13 of the
     drag (`feelflow report lessons --compare`, README 'Lessons'); with the smooth start and the
     absorbing layer 0.0014."""
-    from app.lesson_report import run_lesson
+    from feelflow.app.reports.lessons import run_lesson
 
     r = run_lesson("lift")
     assert r["lift_mean"] > 0.5 * abs(r["drag_mean"])      # lift up, flat side down
@@ -77,7 +77,7 @@ def test_drag_speed_lesson_fits_the_steady_drag_law():
     each hold, and the drag holds still there; plain (sudden start and wind steps, no absorbing
     layer) the scatter was 0.6 - 2.6 of the drag and the view's fit 1.02; now 0.03 - 0.06 and 1.57
     (`feelflow report lessons --compare`, README 'Lessons')."""
-    from app.lesson_report import run_lesson
+    from feelflow.app.reports.lessons import run_lesson
 
     r = run_lesson("drag_speed")
     rows = r["sweep"]

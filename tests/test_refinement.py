@@ -10,10 +10,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from solver.config import ConfigError, FlowConfig
-from solver.lattice import C, OPP, equilibrium
-from solver.numpy_backend import NumpySolver
-from solver.refinement import RefinedSolver, _taus, cubic_midpoints, fine_shape, rescale
+from feelflow.solver.config import ConfigError, FlowConfig
+from feelflow.solver.lattice import C, OPP, equilibrium
+from feelflow.solver.numpy_backend import NumpySolver
+from feelflow.solver.refinement import RefinedSolver, _taus, cubic_midpoints, fine_shape, rescale
 
 
 def test_cubic_midpoints_are_exact_for_cubics():
@@ -90,7 +90,7 @@ def test_the_level_transfer_matches_a_twice_finer_lattice(collision):
 
 
 def _channel(d=10):
-    from solver.validation.schaefer_turek import Geometry
+    from feelflow.solver.validation.schaefer_turek import Geometry
 
     geo = Geometry(d, 20.0)
     return geo, geo.config()
@@ -123,7 +123,7 @@ def test_a_refined_patch_takes_2d1_towards_the_finer_lattice():
     (docs/bench/s17/accuracy.txt), 0.13 % above at 20 cells and -0.04 % at 40. With the
     cylinder and its near wake (1 D ahead, 3 D behind, 1 D each side) at 20 cells the error
     must be at most half the plain lattice's."""
-    from solver.validation import schaefer_turek_2d1 as case
+    from feelflow.solver.validation import schaefer_turek_2d1 as case
 
     d = 10
     plain = case.run(NumpySolver, resolution=d)
@@ -134,8 +134,8 @@ def test_a_refined_patch_takes_2d1_towards_the_finer_lattice():
 
 
 def test_fine_shape_is_the_same_body_at_twice_the_size():
-    from shapes.cylinder import Cylinder
-    from shapes.polygon import Wedge
+    from feelflow.shapes.cylinder import Cylinder
+    from feelflow.shapes.polygon import Wedge
 
     for shape in (Cylinder(diameter=8.0, x=30.3, y=20.7), Wedge(length=12.0, apex_angle=0.7, x=31.0, y=19.5, angle=0.3)):
         fine = fine_shape(shape, 20, 10)
@@ -144,7 +144,7 @@ def test_fine_shape_is_the_same_body_at_twice_the_size():
 
 
 def test_bad_patches_and_bodies_are_refused_with_the_reason():
-    from shapes.cylinder import Cylinder
+    from feelflow.shapes.cylinder import Cylinder
 
     _, cfg = _channel()
     with pytest.raises(ConfigError, match="refine: the patch"):

@@ -4,9 +4,9 @@ import pathlib
 
 import pytest
 
-from app.cli import UserError
-from app.scene import load_scene, scene_from_dict
-from solver.motion import MotionScript, Phase
+from feelflow.app.errors import UserError
+from feelflow.app.model.scene import load_scene, scene_from_dict
+from feelflow.solver.motion import MotionScript, Phase
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SCENES = sorted((ROOT / "scenes").rglob("*.toml"))
@@ -32,7 +32,7 @@ def test_example_scenes_load(path):
 
 
 def test_examples_cover_every_shape_kind():
-    from shapes.io import KINDS
+    from feelflow.shapes.io import KINDS
 
     kinds = {load_scene(p).body.kind for p in SCENES}
     assert kinds == set(KINDS)

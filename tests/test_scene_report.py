@@ -7,9 +7,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-from app.scene import load_scene
-from app.scene_report import SCENES, run_scene_calm
-from app.simulation import default_base_config
+from feelflow.app.model.scene import load_scene
+from feelflow.app.reports.scenes import SCENES, run_scene_calm
+from feelflow.app.model.simulation import default_base_config
 
 ROOT = Path(__file__).resolve().parents[1]
 

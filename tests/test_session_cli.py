@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from app.session import SessionRecorder, SessionSolver
+from feelflow.app.sessions import SessionRecorder, SessionSolver
 from session_scenes import MODELS, drive_moving_cylinder, small_config, start_body
-from solver.backend import create_solver
+from feelflow.solver.backend import create_solver
 
 ROOT = Path(__file__).resolve().parents[1]
 

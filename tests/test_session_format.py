@@ -9,11 +9,11 @@ import zipfile
 import numpy as np
 import pytest
 
-import app.session as session_mod
-from app.session import (FORCES, INPUTS, MANIFEST, PARAMETERS, SessionError, SessionRecorder, SessionSolver,
+import feelflow.app.sessions as session_mod
+from feelflow.app.sessions import (FORCES, INPUTS, MANIFEST, PARAMETERS, SessionError, SessionRecorder, SessionSolver,
                          load_session)
 from session_scenes import MODELS, drive_moving_cylinder, small_config, start_body
-from solver.backend import create_solver
+from feelflow.solver.backend import create_solver
 
 
 @pytest.fixture(scope="module")
@@ -201,9 +201,8 @@ def test_atomic_write_keeps_the_old_file_when_writing_fails(good, tmp_path, monk
     def disk_full(*_a, **_k):
         raise OSError(28, "No space left on device")
 
-    import app.files
-
-    monkeypatch.setattr(app.files.os, "fsync", disk_full)  # the fsync of every atomic write
+    import feelflow.app.files
+    monkeypatch.setattr(feelflow.app.files.os, "fsync", disk_full)  # the fsync of every atomic write
     with pytest.raises(SessionError, match="No space left on device") as info:
         rec.save(target)
     assert "\n" not in str(info.value)
@@ -218,7 +217,7 @@ def test_atomic_write_keeps_the_old_file_when_writing_fails(good, tmp_path, monk
 def test_an_impossible_event_is_refused_at_replay(good, tmp_path):
     """An input that puts the body across the domain edge loads (it is on the grid) but cannot
     be replayed: one line naming the event."""
-    from app.session import replay
+    from feelflow.app.sessions import replay
 
     path, _ = good
     data = members(path)

@@ -7,9 +7,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from app.session import SessionSolver, load_session, replay
+from feelflow.app.sessions import SessionSolver, load_session, replay
 from session_scenes import MODELS, small_config, start_body
-from solver.backend import create_solver
+from feelflow.solver.backend import create_solver
 
 
 @pytest.mark.parametrize("dtype", ["float32", "float64"])
@@ -45,9 +45,9 @@ def test_recording_started_mid_flow_replays(tmp_path, dtype):
 
 
 def test_gui_simulation_through_a_session_solver(tmp_path):
-    """app.simulation drives its solver by set_body/step/forces/set_inflow_speed; wrapped in a
+    """feelflow.app.model.simulation drives its solver by set_body/step/forces/set_inflow_speed; wrapped in a
     SessionSolver, a mouse drag recorded mid-run replays to the same forces."""
-    from app.simulation import Params, Simulation
+    from feelflow.app.model.simulation import Params, Simulation
 
     sim = Simulation(Params(grid=(192, 96), size=16.0))
     sim.solver = SessionSolver(sim.solver, body=sim.shape)

@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from app.session import SessionError, SessionRecorder, SessionSolver, load_session, replay
-from app.session_player import SessionPlayer
+from feelflow.app.sessions import SessionError, SessionRecorder, SessionSolver, load_session, replay
+from feelflow.app.sessions import SessionPlayer
 from session_scenes import drive_moving_cylinder, small_config, start_body
-from solver.backend import create_solver
+from feelflow.solver.backend import create_solver
 
 
 @pytest.fixture(scope="module")
@@ -97,7 +97,7 @@ def test_a_scene_that_cannot_be_built_is_a_session_error(recorded):
 def test_replay_simulation_feeds_the_history_the_replayed_rows(recorded):
     """What the window's plot reads: one history sample per replayed row, its forces and time
     the recorded ones, the relative wind from the recorded body velocity and inflow."""
-    from app.replay_simulation import ReplaySimulation
+    from feelflow.app.model.replay_simulation import ReplaySimulation
 
     s = recorded
     sim = ReplaySimulation(s)

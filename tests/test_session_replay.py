@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from app.session import (SessionRecorder, SessionSolver, export_csv, force_columns, load_session,
+from feelflow.app.sessions import (SessionRecorder, SessionSolver, export_csv, force_columns, load_session,
                          record_headless, replay)
 from session_scenes import MODELS, drive_moving_cylinder, small_config, start_body
-from solver.backend import create_solver
+from feelflow.solver.backend import create_solver
 from solver_backends import BACKENDS
 from conftest import make_solver
 
@@ -140,8 +140,8 @@ def test_record_headless_records_a_scripted_run(tmp_path):
     wrapped solver; the file replays to the same forces."""
     import tomllib
 
-    from app.scene import scene_from_dict
-    from solver.motion import MotionRunner
+    from feelflow.app.model.scene import scene_from_dict
+    from feelflow.solver.motion import MotionRunner
 
     scene = scene_from_dict(tomllib.loads(SCENE_TOML), "plate.toml")
     solver = create_solver("numpy", scene.config)

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from shapes import Cylinder, FlatPlate, HalfAirfoil, Polygon, Wedge
-from shapes.polygon import naca_half_thickness, polygon_area_centroid
+from feelflow.shapes import Cylinder, FlatPlate, HalfAirfoil, Polygon, Wedge
+from feelflow.shapes.polygon import naca_half_thickness, polygon_area_centroid
 
 ALL = [
     Cylinder(20.0, x=50.0, y=40.0, angle=0.3),

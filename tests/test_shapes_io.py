@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from shapes import (Cylinder, FlatPlate, HalfAirfoil, Polygon, ShapeError, Wedge, from_dict, load_shape,
+from feelflow.shapes import (Cylinder, FlatPlate, HalfAirfoil, Polygon, ShapeError, Wedge, from_dict, load_shape,
                     rasterise, save_shape)
 
 SHAPES = [

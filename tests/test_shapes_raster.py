@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from shapes import Cylinder, FlatPlate, HalfAirfoil, Polygon, Wedge, rasterise
-from shapes.raster import LINKS
-from solver.lattice import C, OPP
+from feelflow.shapes import Cylinder, FlatPlate, HalfAirfoil, Polygon, Wedge, rasterise
+from feelflow.shapes.raster import LINKS
+from feelflow.solver.lattice import C, OPP
 
 E, N, W, S, NE, NW, SW, SE = 1, 2, 3, 4, 5, 6, 7, 8
 

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from shapes import Cylinder, FlatPlate, HalfAirfoil, Polygon, ShapeError, Wedge
+from feelflow.shapes import Cylinder, FlatPlate, HalfAirfoil, Polygon, ShapeError, Wedge
 
 SQUARE = [[0, 0], [4, 0], [4, 4], [0, 4]]
 

@@ -10,9 +10,9 @@ import pytest
 from conftest import make_solver
 from solver_backends import BACKENDS
 
-from shapes import Cylinder
-from solver.backend import SolverDiverged
-from solver.config import FlowConfig
+from feelflow.shapes import Cylinder
+from feelflow.solver.backend import SolverDiverged
+from feelflow.solver.config import FlowConfig
 
 
 def _tunnel(backend, request, **kw):

@@ -11,10 +11,10 @@ import pytest
 from conftest import make_solver
 from solver_backends import BACKENDS
 
-from solver.config import FlowConfig
-from solver.inflow import INLET_DIRECTIONS, inflow_velocity, inlet_wall_profile, profile, ramp
-from solver.lattice import equilibrium
-from solver.numpy_backend import relaxation_rates
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.inflow import INLET_DIRECTIONS, inflow_velocity, inlet_wall_profile, profile, ramp
+from feelflow.solver.lattice import equilibrium
+from feelflow.solver.numpy_backend import relaxation_rates
 
 
 def test_ramp_is_smooth_from_zero_to_one():
@@ -201,7 +201,7 @@ def test_absorbing_sponge_stops_the_tunnel_sloshing_after_a_ramp(request):
     the mean is steady within 2 % from step 3000 on."""
     from dataclasses import replace
 
-    from app.simulation import default_base_config
+    from feelflow.app.model.simulation import default_base_config
 
     swing = {}
     for absorb in (0.0, 0.1):

@@ -12,8 +12,8 @@ import pytest
 from conftest import make_solver
 from solver_backends import BACKENDS
 
-from solver.config import FlowConfig
-from solver.lattice import C, RHO0, equilibrium
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.lattice import C, RHO0, equilibrium
 
 COLLISIONS = ["bgk", "trt"]
 
@@ -142,7 +142,7 @@ def test_walls_across_the_periodic_seam_keep_the_flow_the_same_in_every_column(b
     second-order error. With the second node taken as outside the domain (before the seventh
     session) the edge columns fell back to half-way bounce-back: after these 6000 steps the
     columns differed by 1 % of U_PEAK, and the error was 0.013 at 16 rows (against 0.0033)."""
-    from solver.validation import poiseuille as P
+    from feelflow.solver.validation import poiseuille as P
 
     assert P.Q_BOTTOM < 0.5 < P.Q_TOP
     ch = P.Channel(16)
@@ -170,7 +170,7 @@ def test_moving_walls_across_the_periodic_seam_refill_whatever_the_seam(backend,
     and gives the mass the move creates or destroys back to the fluid ring around the body;
     across a periodic seam the window spans whole those neighbours continue on the other side
     (solver.body.refill, `wrap`), so where the seam lies does not change the result."""
-    from solver.validation import poiseuille as P
+    from feelflow.solver.validation import poiseuille as P
 
     ch = P.Channel(16)
     y, x = np.mgrid[0:ch.ny, 0:P.NX].astype(float)

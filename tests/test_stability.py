@@ -15,9 +15,9 @@ import pytest
 from conftest import make_solver
 from solver_backends import BACKENDS
 
-from solver.stability_limit import (SAFETY_MARGIN, STABLE_U_SQRT_D_OVER_NU, inside, measured_cell_reynolds,
+from feelflow.solver.stability_limit import (SAFETY_MARGIN, STABLE_U_SQRT_D_OVER_NU, inside, measured_cell_reynolds,
                                     min_stable_viscosity)
-from solver.validation import stability
+from feelflow.solver.validation import stability
 
 #: the fastest a stable flow here may get: the largest relative speed (wind 0.09 + Mach cap
 #: 0.098 for the shaken cylinder) times ~1.6, less than the 2x of potential flow past a cylinder
@@ -57,7 +57,7 @@ def test_the_shaken_scenes_moves_count_in_the_stopwatch(request):
     (the solver's set_body slowed by a known 2 ms a move, so the figure cannot hide it)."""
     import time
 
-    from solver.validation.base import Stopwatch
+    from feelflow.solver.validation.base import Stopwatch
 
     def slowed(config):
         solver = make_solver("numpy", config, request)
@@ -77,7 +77,7 @@ def test_the_shaken_scenes_moves_count_in_the_stopwatch(request):
 
 def test_the_scan_runs_the_windows_tunnel():
     """The scan's tunnel is the window's: its sponge and the sponge's absorbing layer."""
-    from app.simulation import default_base_config
+    from feelflow.app.model.simulation import default_base_config
 
     window = default_base_config(stability.GRID)
     scan = stability.scene_config("plate45", "trt", 0.05, 0.02)
@@ -92,9 +92,9 @@ def test_quick_case_meets_its_checks(request):
 
 def test_presets_lie_inside_the_guarded_region():
     """Every lesson's scene, and every wind of a lesson's sweep, at the scene's viscosity."""
-    from app.bodies import params_for_shape
-    from app.presets import PRESETS
-    from app.scene import load_scene
+    from feelflow.app.model.bodies import params_for_shape
+    from feelflow.app.model.presets import PRESETS
+    from feelflow.app.model.scene import load_scene
 
     for key, lesson in PRESETS.items():
         scene = load_scene(lesson.path)
@@ -104,7 +104,7 @@ def test_presets_lie_inside_the_guarded_region():
 
 
 def test_guard_raises_the_viscosity_and_says_so():
-    from app.simulation import Params, Simulation
+    from feelflow.app.model.simulation import Params, Simulation
 
     sim = Simulation(Params(grid=(96, 48), size=10, wind=0.09, nu=0.002), backend="numpy")
     assert sim.params.wind == 0.09   # the wind the student chose stays

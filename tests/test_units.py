@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from solver import units
+from feelflow.solver import units
 
 
 def test_reynolds_and_viscosity_are_inverse():

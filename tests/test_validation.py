@@ -5,15 +5,15 @@ benchmarks, Galilean invariance, conservation); the targets are issue 2's.
 """
 import pytest
 
-from solver.validation import CASES, case_module
-from tests.conftest import make_solver
+from feelflow.solver.validation import CASES, case_module
+from conftest import make_solver
 
 BACKENDS = ["numpy", pytest.param("gl", marks=pytest.mark.gl)]
 
 
 def factory(backend, request):
     if backend == "gl":
-        pytest.importorskip("solver.gl_backend", reason="the gl backend is not built yet")
+        pytest.importorskip("feelflow.solver.gl_backend", reason="the gl backend is not built yet")
     return lambda config: make_solver(backend, config, request)
 
 
@@ -46,7 +46,7 @@ def test_mass_drift_of_a_moving_body_is_small(backend, request):
 def test_surface_value_extrapolates_a_quadratic_exactly():
     import numpy as np
 
-    from solver.validation.schaefer_turek import surface_value
+    from feelflow.solver.validation.schaefer_turek import surface_value
 
     y, x = np.mgrid[0:6, 0:10].astype(float)
     field = 1 + 0.1 * x + 0.02 * x ** 2 + 0.3 * y
@@ -96,7 +96,7 @@ def test_schaefer_turek_2d1_drag_converges_at_second_order_with_tau_held(request
     item 10)."""
     import math
 
-    from app.commands.bench_accuracy import TAU_FIXED
+    from feelflow.app.bench.accuracy import TAU_FIXED
 
     st = case_module("schaefer-turek-2d1")
     points = TAU_FIXED[:2]  # (20, 0.075), (30, 0.05)
@@ -110,7 +110,7 @@ def test_schaefer_turek_2d1_drag_converges_at_second_order_with_tau_held(request
 def test_schaefer_turek_refuses_a_channel_that_is_not_whole_cells_high(d):
     """4.1 D must be a whole number of cells (walls half-way between nodes): a resolution that
     is not a multiple of 10 would change the blockage D / H, so it is refused, naming why."""
-    from solver.validation.schaefer_turek import Geometry
+    from feelflow.solver.validation.schaefer_turek import Geometry
 
     with pytest.raises(ValueError, match="multiple of 10"):
         Geometry(d, 20.0)
@@ -120,7 +120,7 @@ def test_schaefer_turek_refuses_a_channel_that_is_not_whole_cells_high(d):
 def test_schaefer_turek_lengths_keep_the_benchmark_ratios(d):
     """Channel 4.1 D high between the half-way walls (-1/2 and ny - 1/2) and 22 D long, cylinder
     2 D from the bottom wall and from the inlet (x = -1/2), 2.1 D from the top wall."""
-    from solver.validation.schaefer_turek import Geometry
+    from feelflow.solver.validation.schaefer_turek import Geometry
 
     g = Geometry(d, 100.0)
     assert 10 * g.ny == 41 * d and g.nx == 22 * d

@@ -10,8 +10,8 @@ import math
 import time
 from abc import ABC, abstractmethod
 
-from haptics.errors import DeviceError
-from haptics.types import Capabilities, Pose
+from feelflow.haptics.errors import DeviceError
+from feelflow.haptics.types import Capabilities, Pose
 
 
 def clamp_force(fx: float, fy: float, max_force: float) -> tuple[float, float]:

@@ -3,10 +3,10 @@ from __future__ import annotations
 
 import time
 
-from haptics.drivers.base import Device
-from haptics.errors import DeviceError
-from haptics.protocols import diyhid
-from haptics.types import Capabilities, Pose
+from feelflow.haptics.drivers.base import Device
+from feelflow.haptics.errors import DeviceError
+from feelflow.haptics.protocols import diyhid
+from feelflow.haptics.types import Capabilities, Pose
 
 
 class DiyHid(Device):

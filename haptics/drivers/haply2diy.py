@@ -9,11 +9,11 @@ from __future__ import annotations
 import math
 import time
 
-from haptics.drivers.base import Device
-from haptics.errors import DeviceError
-from haptics.kinematics import HAPLY_2DIY, OutOfReach
-from haptics.protocols import haply
-from haptics.types import Capabilities, Pose
+from feelflow.haptics.drivers.base import Device
+from feelflow.haptics.errors import DeviceError
+from feelflow.haptics.kinematics import HAPLY_2DIY, OutOfReach
+from feelflow.haptics.protocols import haply
+from feelflow.haptics.types import Capabilities, Pose
 
 DEVICE_ID = 5
 #: port -> (motor dir, encoder dir, encoder offset deg, resolution); port 2 = joint 1

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import time
 
-from haptics.drivers.base import Device
-from haptics.protocols import spacemouse as sm
-from haptics.types import Capabilities, Pose
+from feelflow.haptics.drivers.base import Device
+from feelflow.haptics.protocols import spacemouse as sm
+from feelflow.haptics.types import Capabilities, Pose
 
 HALF_WIDTH = 0.05  # metres of virtual workspace each side
 SPEED = 0.10  # metres per second at full deflection

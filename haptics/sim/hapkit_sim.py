@@ -9,9 +9,9 @@ from __future__ import annotations
 import threading
 import time
 
-from haptics.protocols import hapkit
-from haptics.sim.hand import ForceLog, Hand
-from haptics.sim.pty_device import PtyDevice
+from feelflow.haptics.protocols import hapkit
+from feelflow.haptics.sim.hand import ForceLog, Hand
+from feelflow.haptics.sim.pty_device import PtyDevice
 
 INFO = hapkit.Info(dof=1, x_min=-0.04, x_max=0.04, max_force=2.0, firmware=100)
 WATCHDOG_S = 0.050

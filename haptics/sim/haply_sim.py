@@ -12,11 +12,11 @@ import collections
 import math
 import struct
 
-from haptics.drivers.haply2diy import MAX_TORQUE, WORKSPACE
-from haptics.kinematics import HAPLY_2DIY, OutOfReach
-from haptics.protocols import haply
-from haptics.sim.hand import ForceLog, Hand
-from haptics.sim.pty_device import PtyDevice
+from feelflow.haptics.drivers.haply2diy import MAX_TORQUE, WORKSPACE
+from feelflow.haptics.kinematics import HAPLY_2DIY, OutOfReach
+from feelflow.haptics.protocols import haply
+from feelflow.haptics.sim.hand import ForceLog, Hand
+from feelflow.haptics.sim.pty_device import PtyDevice
 
 
 class HaplySim(PtyDevice):

@@ -7,9 +7,9 @@ import collections
 import threading
 import time
 
-from haptics.protocols import diyhid
-from haptics.protocols import spacemouse as sm
-from haptics.sim.hand import ForceLog, Hand
+from feelflow.haptics.protocols import diyhid
+from feelflow.haptics.protocols import spacemouse as sm
+from feelflow.haptics.sim.hand import ForceLog, Hand
 
 
 class _HidBase:
@@ -124,7 +124,7 @@ class DiyHidSim(_HidBase):
             self.inject(diyhid.encode_info(self.info))
         else:
             _, _, fx, fy, enabled = msg
-            from haptics.drivers.base import clamp_force
+            from feelflow.haptics.drivers.base import clamp_force
             self.motor = clamp_force(fx, fy, self.info.max_force) if enabled else (0.0, 0.0)
             self.last_force_at = time.monotonic()
             self.forces.record(*self.motor)

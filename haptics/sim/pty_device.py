@@ -7,7 +7,7 @@ import select
 import threading
 import tty
 
-from haptics.timing import try_realtime
+from feelflow.haptics.timing import try_realtime
 
 
 class PtyDevice:

@@ -1,4 +1,4 @@
-"""A serial device simulator in its own process, as real hardware is: `python -m haptics.sim.serve
+"""A serial device simulator in its own process, as real hardware is: `python -m feelflow.haptics.sim.serve
 haply2diy|hapkit` creates the simulator (behind a pseudo-terminal), prints one JSON line
 {"port": "/dev/pts/N"} and then obeys one JSON command per line on stdin (the simulated hand,
 fault injection, what the device was commanded). EOF on stdin stops it.
@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 import os
-import pathlib
 import subprocess
 import sys
 import threading
@@ -21,10 +20,10 @@ import time
 
 def _make(kind: str):
     if kind == "haply2diy":
-        from haptics.sim.haply_sim import HaplySim
+        from feelflow.haptics.sim.haply_sim import HaplySim
         return HaplySim()
     if kind == "hapkit":
-        from haptics.sim.hapkit_sim import HapkitSim
+        from feelflow.haptics.sim.hapkit_sim import HapkitSim
         return HapkitSim()
     raise SystemExit(f"unknown serial simulator {kind!r}")
 
@@ -112,10 +111,8 @@ class RemoteSim:
     that tests and the bench use: port, hand, forces, inject, muted, disconnect, stop, errors)."""
 
     def __init__(self, kind: str, workspace=None):
-        root = str(pathlib.Path(__file__).resolve().parents[2])
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join([root, os.environ.get("PYTHONPATH", "")]))
-        self._proc = subprocess.Popen([sys.executable, "-m", "haptics.sim.serve", kind],
-                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env, text=True)
+        self._proc = subprocess.Popen([sys.executable, "-m", "feelflow.haptics.sim.serve", kind],
+                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         self._lock = threading.Lock()
         line = self._proc.stdout.readline()
         if not line:

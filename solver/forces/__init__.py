@@ -8,10 +8,10 @@ from __future__ import annotations
 import importlib
 
 MODELS: dict[str, str] = {
-    "momentum_exchange": "solver.forces.momentum_exchange:GalileanMomentumExchange",
-    "momentum_exchange_classic": "solver.forces.momentum_exchange:ClassicMomentumExchange",
-    "macroscopic": "solver.forces.macroscopic:MacroscopicDrag",
-    "pressure": "solver.forces.pressure:PressureIntegration",
+    "momentum_exchange": "feelflow.solver.forces.momentum_exchange:GalileanMomentumExchange",
+    "momentum_exchange_classic": "feelflow.solver.forces.momentum_exchange:ClassicMomentumExchange",
+    "macroscopic": "feelflow.solver.forces.macroscopic:MacroscopicDrag",
+    "pressure": "feelflow.solver.forces.pressure:PressureIntegration",
 }
 
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.config import FlowConfig
+from feelflow.solver.config import FlowConfig
 
 
 @dataclass

@@ -28,9 +28,9 @@ import math
 
 import numpy as np
 
-from solver.forces.base import BodyWindow, ForceModel
-from solver.forces.sampling import bilinear_stencil, moments_at
-from solver.lattice import RHO0
+from feelflow.solver.forces.base import BodyWindow, ForceModel
+from feelflow.solver.forces.sampling import bilinear_stencil, moments_at
+from feelflow.solver.lattice import RHO0
 
 #: kind -> (C_D, source). Wedges depend on which way they face (see `drag_coefficient`).
 DRAG_COEFFICIENTS: dict[str, tuple[float, str]] = {

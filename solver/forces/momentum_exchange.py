@@ -4,15 +4,15 @@ Galilean-invariant form: Wen, Zhang, Tu, Wang & Fang, J. Comput. Phys. 266 (2014
 (c_ib - u_w) f*_ib(x) - (c_i - u_w) f_i^in(x), plus the cover/uncover impulse J.
 Classic form (Ladd 1994; Mei, Yu, Shyy & Luo 2002; the seed): c_ib (f*_ib(x) + f_i^in(x)),
 no cover/uncover terms: not Galilean invariant on a moving body, kept to show that.
-f_i^in comes from the same `solver.bouzidi.incoming` the numpy backend streams with.
+f_i^in comes from the same `feelflow.solver.bouzidi.incoming` the numpy backend streams with.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from solver.bouzidi import BodyLinks, build_links, incoming, outgoing, periodic_wrap
-from solver.forces.base import BodyWindow, ForceModel
-from solver.lattice import C
+from feelflow.solver.bouzidi import BodyLinks, build_links, incoming, outgoing, periodic_wrap
+from feelflow.solver.forces.base import BodyWindow, ForceModel
+from feelflow.solver.lattice import C
 
 
 def window_links(window: BodyWindow) -> BodyLinks:

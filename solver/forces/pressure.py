@@ -27,9 +27,9 @@ import math
 
 import numpy as np
 
-from solver.forces.base import BodyWindow, ForceModel
-from solver.forces.sampling import fluid_fit_stencil, moments_at
-from solver.lattice import CS2, RHO0
+from feelflow.solver.forces.base import BodyWindow, ForceModel
+from feelflow.solver.forces.sampling import fluid_fit_stencil, moments_at
+from feelflow.solver.lattice import CS2, RHO0
 
 #: beta that makes eq. 23 equal to the lattice pressure c_s^2 (rho - rho_0) to first order
 BETA_LATTICE = RHO0 * CS2 / 2.0

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from shapes.raster import distinct_sorted
-from solver.lattice import C
+from feelflow.shapes.raster import distinct_sorted
+from feelflow.solver.lattice import C
 
 
 def moments(window):

@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver.forces.base import BodyWindow
-from solver.forces.sampling import fluid_extrapolate, moments
-from solver.lattice import C, equilibrium
+from feelflow.solver.forces.base import BodyWindow
+from feelflow.solver.forces.sampling import fluid_extrapolate, moments
+from feelflow.solver.lattice import C, equilibrium
 
 
 def viscous_stress(window: BodyWindow):

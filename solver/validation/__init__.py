@@ -11,13 +11,13 @@ from __future__ import annotations
 import importlib
 
 CASES: dict[str, str] = {
-    "poiseuille": "solver.validation.poiseuille",
-    "taylor-green": "solver.validation.taylor_green",
-    "schaefer-turek-2d1": "solver.validation.schaefer_turek_2d1",
-    "schaefer-turek-2d2": "solver.validation.schaefer_turek_2d2",
-    "galilean": "solver.validation.galilean",
-    "mass": "solver.validation.mass",
-    "stability": "solver.validation.stability",
+    "poiseuille": "feelflow.solver.validation.poiseuille",
+    "taylor-green": "feelflow.solver.validation.taylor_green",
+    "schaefer-turek-2d1": "feelflow.solver.validation.schaefer_turek_2d1",
+    "schaefer-turek-2d2": "feelflow.solver.validation.schaefer_turek_2d2",
+    "galilean": "feelflow.solver.validation.galilean",
+    "mass": "feelflow.solver.validation.mass",
+    "stability": "feelflow.solver.validation.stability",
 }
 
 

@@ -6,8 +6,8 @@ import time
 from dataclasses import dataclass, field
 from typing import Callable
 
-from solver.backend import Solver
-from solver.config import FlowConfig
+from feelflow.solver.backend import Solver
+from feelflow.solver.config import FlowConfig
 
 #: builds a solver of the chosen backend for a configuration (the CLI and tests supply it)
 SolverFactory = Callable[[FlowConfig], Solver]

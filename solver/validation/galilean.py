@@ -21,11 +21,11 @@ import math
 
 import numpy as np
 
-from solver import units
-from solver.config import FlowConfig
-from solver.lattice import equilibrium
-from solver.motion import MotionRunner, MotionScript, Phase
-from solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
+from feelflow.solver import units
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.lattice import equilibrium
+from feelflow.solver.motion import MotionRunner, MotionScript, Phase
+from feelflow.solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
 
 NAME = "galilean"
 DEFAULT_RESOLUTION = 16  # cells per diameter
@@ -37,7 +37,7 @@ MODEL = "momentum_exchange"
 
 
 def _mean_drag(make_solver, config, d, fluid_u, body_u, steps, watch):
-    from shapes.cylinder import Cylinder
+    from feelflow.shapes.cylinder import Cylinder
 
     solver = make_solver(config)
     try:

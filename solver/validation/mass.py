@@ -9,9 +9,9 @@ Target (ours, set before the first measurement): |drift| below 1e-3.
 """
 from __future__ import annotations
 
-from solver.config import FlowConfig
-from solver.motion import MotionRunner, MotionScript, Phase
-from solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.motion import MotionRunner, MotionScript, Phase
+from feelflow.solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
 
 NAME = "mass"
 DEFAULT_RESOLUTION = 16  # cells per diameter
@@ -25,7 +25,7 @@ TARGET = 1e-3
 
 def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool = False,
         backend: str = "numpy", steps: int | None = None) -> CaseResult:
-    from shapes.cylinder import Cylinder
+    from feelflow.shapes.cylinder import Cylinder
 
     d = resolution or (QUICK_RESOLUTION if quick else DEFAULT_RESOLUTION)
     steps = steps or (QUICK_STEPS if quick else STEPS)

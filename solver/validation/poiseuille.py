@@ -1,7 +1,7 @@
 """Plane Poiseuille flow between walls at fractional positions: second-order convergence.
 
 A channel periodic in x, driven by a uniform body force g (Guo, Zheng & Shi 2002), between two
-walls that are two rectangles (`shapes.Polygon`) seen by the solver as one body
+walls that are two rectangles (`feelflow.shapes.Polygon`) seen by the solver as one body
 (`ChannelWalls`); the walls sit a fraction q of a link away from the last fluid nodes
 (q = Q_BOTTOM, Q_TOP: not 1/2), so the interpolated bounce-back (Bouzidi et al. 2001) is what
 places them. Steady solution u(y) = g / (2 nu) (y - y_b)(y_t - y). Diffusive scaling: tau and
@@ -23,11 +23,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from shapes.base import Shape, ShapeError
-from shapes.polygon import Polygon
-from solver.config import FlowConfig
-from solver.lattice import C, equilibrium
-from solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
+from feelflow.shapes.base import Shape, ShapeError
+from feelflow.shapes.polygon import Polygon
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.lattice import C, equilibrium
+from feelflow.solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
 
 NAME = "poiseuille"
 RESOLUTIONS = (8, 16, 32, 64)

@@ -22,9 +22,9 @@ import math
 
 import numpy as np
 
-from solver import units
-from solver.config import FlowConfig
-from solver.lattice import CS2, equilibrium
+from feelflow.solver import units
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.lattice import CS2, equilibrium
 
 #: peak inflow speed in lattice units: Ma = 0.13, compressibility error ~ Ma^2 / 3 (stated, not tuned)
 U_MAX = 0.075
@@ -66,7 +66,7 @@ class Geometry:
         return FlowConfig(**kw)
 
     def cylinder(self):
-        from shapes.cylinder import Cylinder
+        from feelflow.shapes.cylinder import Cylinder
 
         return Cylinder(diameter=float(self.d), x=self.centre[0], y=self.centre[1])
 
@@ -91,7 +91,7 @@ class Geometry:
         resolution (the cylinder then has 2 d cells per diameter)."""
         if not refine:
             return make_solver
-        from solver.refinement import RefinedSolver
+        from feelflow.solver.refinement import RefinedSolver
 
         return lambda config: RefinedSolver(config, self.refined_patch())
 
@@ -132,7 +132,7 @@ class Geometry:
             rho, _, _ = solver.macroscopic()
             shape, front, back = self.cylinder(), self.front, self.back
         else:
-            from solver.refinement import fine_point, fine_shape
+            from feelflow.solver.refinement import fine_point, fine_shape
 
             x0, y0 = solver.patch[:2]
             rho, _, _ = fine.macroscopic()

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import math
 
-from solver import units
-from solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
-from solver.validation.schaefer_turek import (REF_2D1, U_MAX, Geometry, check_resolution,  # noqa: F401 (validate's hook)
+from feelflow.solver import units
+from feelflow.solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
+from feelflow.solver.validation.schaefer_turek import (REF_2D1, U_MAX, Geometry, check_resolution,  # noqa: F401 (validate's hook)
                                              reference_dp_coefficient)
 
 NAME = "schaefer-turek-2d1"

@@ -17,7 +17,7 @@ the force with amplitudes ~0.015 in C_D each. That raised C_D,max at 40 cells fr
 3.337 and made three-period maxima scatter by 0.02 - 0.03 from period to period, while the mean
 C_D and the shedding were unchanged. Ramped in over two acoustic periods, the rms of C_D around
 its period-averaged signal falls from 0.013 to 0.0004 (20 cells) and successive periods agree to
-0.02 %, hence the tighter `PERIODIC_TOL`. Diagnostics: `python -m solver.validation.st2d2_diagnose`.
+0.02 %, hence the tighter `PERIODIC_TOL`. Diagnostics: `python -m feelflow.app.bench.st2d2_diagnose`.
 
 Why the absorbing sponge (fourth session, measured, docs/validation.md): even after a smooth
 start, the drag's oscillation at twice the shedding frequency drives the tunnel's sound, and
@@ -32,9 +32,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from solver import units
-from solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
-from solver.validation.schaefer_turek import INTERVALS_2D2, Geometry, check_resolution  # noqa: F401 (validate's hook)
+from feelflow.solver import units
+from feelflow.solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
+from feelflow.solver.validation.schaefer_turek import INTERVALS_2D2, Geometry, check_resolution  # noqa: F401 (validate's hook)
 
 NAME = "schaefer-turek-2d2"
 DEFAULT_RESOLUTION = 40

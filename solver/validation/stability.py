@@ -44,9 +44,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solver.backend import SolverDiverged
-from solver.config import FlowConfig
-from solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
+from feelflow.solver.backend import SolverDiverged
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
 
 NAME = "stability"
 DEFAULT_RESOLUTION = 20   # body size d in cells (the window's default)
@@ -102,7 +102,7 @@ def scene_config(scene: str, collision: str, speed: float, nu: float, grid=GRID)
 
 
 def scene_body(scene: str, size: float, grid=GRID):
-    from shapes import Cylinder, FlatPlate, Wedge
+    from feelflow.shapes import Cylinder, FlatPlate, Wedge
 
     x, y = 0.3 * grid[0], 0.5 * grid[1]
     if scene == "plate45":
@@ -231,7 +231,7 @@ def limits(points) -> dict:
 
 def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool = False,
         backend: str = "numpy", progress=None) -> CaseResult:
-    from solver.stability_limit import SAFETY_MARGIN, STABLE_U_SQRT_D_OVER_NU, min_stable_viscosity
+    from feelflow.solver.stability_limit import SAFETY_MARGIN, STABLE_U_SQRT_D_OVER_NU, min_stable_viscosity
 
     size = resolution or DEFAULT_RESOLUTION
     watch = Stopwatch()
@@ -280,7 +280,7 @@ def quick_points():
     """(scene, collision, U, nu) for the default test suite: per hard case, the window's own
     corner (the highest wind at the lowest viscosity the guard allows, TRT as in the window)
     and the panel's extreme corner (U = 0.09, nu = 0.002), far outside the measured region."""
-    from solver.stability_limit import min_stable_viscosity
+    from feelflow.solver.stability_limit import min_stable_viscosity
 
     u = max(SPEEDS)
     out = []
@@ -318,14 +318,14 @@ def format_details(result: CaseResult) -> str:
 
 
 def main(argv=None) -> int:
-    """`python -m solver.validation.stability --u 0.09 --nu 0.002 --collision bgk --convective-times 30`:
+    """`python -m feelflow.solver.validation.stability --u 0.09 --nu 0.002 --collision bgk --convective-times 30`:
     the four hard cases at one point for longer than the scan (numpy), one line each."""
     import argparse
     import warnings
 
-    from solver.backend import create_solver
+    from feelflow.solver.backend import create_solver
 
-    parser = argparse.ArgumentParser(prog="python -m solver.validation.stability", description=main.__doc__)
+    parser = argparse.ArgumentParser(prog="python -m feelflow.solver.validation.stability", description=main.__doc__)
     parser.add_argument("--u", type=float, required=True, help="wind speed (cells per step)")
     parser.add_argument("--nu", type=float, default=None, help="viscosity (default: --k gives it)")
     parser.add_argument("--k", type=float, default=None, help="instead of --nu: nu = U sqrt(d) / K")

@@ -11,9 +11,9 @@ import math
 
 import numpy as np
 
-from solver.config import FlowConfig
-from solver.lattice import CS2, RHO0, equilibrium
-from solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.lattice import CS2, RHO0, equilibrium
+from feelflow.solver.validation.base import CaseResult, Check, SolverFactory, Stopwatch
 
 NAME = "taylor-green"
 DEFAULT_RESOLUTION = 64  # N x N nodes, one vortex period

@@ -1,0 +1,39 @@
+"""`feelflow bench [solver|accuracy|haptics]`: speed of the solver backends, their speed against
+their error, or the haptic loop.
+
+The solver bench lives in `app/commands/bench_solver.py`, speed against error in
+`app/commands/bench_accuracy.py`, the haptic one in `app/commands/bench_haptics.py`; this
+module only dispatches.
+"""
+from __future__ import annotations
+
+import importlib
+
+from feelflow.app.bench.accuracy import AXES
+
+TARGETS = {"solver": "feelflow.app.bench.solver_speed", "accuracy": "feelflow.app.bench.accuracy",
+           "haptics": "feelflow.app.bench.haptic_loop"}
+
+
+def add_arguments(parser):
+    parser.add_argument("target", nargs="?", default="solver", choices=sorted(TARGETS),
+                        help="what to measure (default: solver)")
+    parser.add_argument("--json", metavar="PATH", help="also write the results as JSON")
+    parser.add_argument("--device", metavar="URL", default="sim://haply2diy",
+                        help="haptics: the device to run the loop against (default: a simulator)")
+    parser.add_argument("--seconds", type=float, default=None, help="how long to measure")
+    parser.add_argument("--rounds", type=int, default=None,
+                        help="solver: alternating numpy / gl rounds per scene, medians reported (default 3; --quick 1)")
+    parser.add_argument("--quick", action="store_true", help="solver, accuracy: fewer steps or points (smoke test)")
+    parser.add_argument("--backend", action="append", choices=("numpy", "gl"),
+                        help="accuracy: only this backend (repeatable; default: numpy float64, numpy float32, gl)")
+    parser.add_argument("--axis", action="append", choices=AXES,
+                        help="accuracy: only this axis (repeatable; default: all three)")
+    parser.add_argument("--variants", action="store_true",
+                        help="solver: compare the gl backend's tuning variants (docs/performance.md)")
+    parser.add_argument("--profile", action="store_true",
+                        help="solver: where the gl moving tunnel's wall time goes (docs/performance.md)")
+
+
+def main(args) -> int:
+    return importlib.import_module(TARGETS[args.target]).main(args)

@@ -1,0 +1,108 @@
+"""`feelflow gui [SESSION]` (the default command) and `feelflow --selftest [--screenshot PATH] [--seconds S]`.
+
+`feelflow gui FILE.ffsession` opens the window and replays that session in it as soon as the live
+tunnel runs (what File > Replay session does); the desktop entry's `Exec=... gui %f` uses it, so
+double-clicking a session file in the file manager replays it; `feelflow --selftest gui FILE`
+measures that replay (frames and session steps per second).
+
+The OpenGL surface format (3.3 core, no depth buffer, no vsync) is set before the QApplication
+exists (shared/notes/gl-qt-on-this-machine.md). Without a display there is no window: one line
+says so and the command exits 2 (try `feelflow run` for a headless run).
+"""
+from __future__ import annotations
+
+import os
+import sys
+
+from feelflow.app.errors import UserError
+
+DEFAULT_BACKEND = "gl"
+
+
+def add_arguments(parser):
+    parser.add_argument("session", nargs="?", default=None, metavar="SESSION",
+                        help="a recorded session file (.ffsession) to replay in the window once it has started")
+    parser.add_argument("--backend", choices=("gl", "numpy"), default=None,
+                        help=f"solver backend (default {DEFAULT_BACKEND}; numpy uploads the field every frame)")
+    parser.add_argument("--fresh", action="store_true", help="ignore remembered settings")
+
+
+def has_display() -> bool:
+    """Is there a screen Qt can open a window with OpenGL on?"""
+    platform = os.environ.get("QT_QPA_PLATFORM", "")
+    if platform.startswith("offscreen") or platform.startswith("minimal"):
+        return False
+    if sys.platform.startswith("linux"):
+        return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    return True
+
+
+def set_surface_format():
+    from PySide6.QtGui import QSurfaceFormat
+
+    fmt = QSurfaceFormat()
+    fmt.setVersion(3, 3)
+    fmt.setProfile(QSurfaceFormat.CoreProfile)
+    fmt.setDepthBufferSize(0)
+    fmt.setStencilBufferSize(8)
+    fmt.setSwapInterval(0)
+    QSurfaceFormat.setDefaultFormat(fmt)
+
+
+def replay_when_ready(window, path) -> None:
+    """Replay the session at `path` once, when the window's live simulation first runs
+    (`MainWindow.start_replay` needs it; a bad file is its one-line dialog)."""
+    def start():
+        window.simulationReady.disconnect(start)
+        window.start_replay(path)
+    window.simulationReady.connect(start)
+
+
+def main(args) -> int:
+    session = getattr(args, "session", None)
+    if session is not None and not os.path.isfile(session):
+        raise UserError(f"{session}: no such session file")
+    if not has_display():
+        raise UserError("no display to open the window on (DISPLAY is not set); "
+                        "use 'feelflow run' for a headless run, or run under xvfb-run")
+    backend = getattr(args, "backend", None) or DEFAULT_BACKEND
+    from feelflow.app.gui.qt_runtime import make_none_immortal
+
+    make_none_immortal()
+    set_surface_format()
+    from PySide6.QtCore import QSettings
+    from PySide6.QtWidgets import QApplication
+
+    from feelflow.app.gui.main_window import MainWindow
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    app.setApplicationName("FeelFlow")
+    app.setOrganizationName("FeelFlow")
+    app.setDesktopFileName("feelflow")   # the installed feelflow.desktop: its name and icon (installer/)
+    selftest = getattr(args, "selftest", False)
+    if selftest or getattr(args, "fresh", False):
+        import tempfile
+
+        settings = QSettings(os.path.join(tempfile.mkdtemp(prefix="feelflow-selftest-"), "settings.ini"),
+                             QSettings.IniFormat)
+    else:
+        settings = QSettings()
+    window = MainWindow(backend=backend, settings=settings)
+    if session is not None:
+        replay_when_ready(window, session)
+    if selftest:
+        from feelflow.app.gui.selftest import SelfTest
+
+        test = SelfTest(window, seconds=args.seconds, screenshot=args.screenshot, replay=session is not None)
+        window.show()
+        app.exec()
+        if window.startup_error:
+            print(f"feelflow: {window.startup_error}", file=sys.stderr)
+            return 2
+        return test.exit_code
+    window.show()
+    code = app.exec()
+    if window.startup_error:
+        print(f"feelflow: {window.startup_error}", file=sys.stderr)
+        return 2
+    return code

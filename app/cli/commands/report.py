@@ -1,0 +1,149 @@
+"""`feelflow report seed`: reproduce the seed's experiments with all four force models and write
+docs/report-seed.md with PNG plots (the work is in app/seed_report.py).
+`feelflow report lessons [--only KEY,...] [--compare] [--json PATH]`: run the Presets menu's
+lessons headless as the window does and print how steady their forces are (app/lesson_report.py).
+`feelflow report scenes [--only NAME,...] [--compare] [--json PATH]`: run the example scenes with an
+outlet sponge as `feelflow run` does and print how calm their tunnel is (app/scene_report.py).
+
+Parts (`--only`): protocol (or one diameter, protocol:d32), shapes, sweep, lift; each stores its
+series in OUT/report-seed/data-<part>.json (data-protocol-<d>.json per diameter), and the report
+is written from every part stored there, so parts can be run separately (or again, or in
+parallel) and `--replot` rebuilds text and plots without running.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from feelflow.app.errors import UserError
+
+TARGETS = ("seed", "lessons", "scenes")
+
+
+def add_arguments(parser):
+    parser.add_argument("target", choices=TARGETS,
+                        help="which report (seed: the thesis's experiments; lessons: the Presets menu's lessons; "
+                             "scenes: how calm the example scenes' tunnels are)")
+    parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
+    parser.add_argument("--quick", action="store_true",
+                        help="a few dozen steps per run: a smoke test of the whole chain, not physics")
+    parser.add_argument("--phase-steps", default=None, metavar="N",
+                        help="steps per protocol phase instead of the scenes' 15000 (stated in the report)")
+    parser.add_argument("--only", default=None, metavar="PART[,PART]",
+                        help="run only these parts: protocol (or protocol:d16, :d24, :d32), shapes, sweep, "
+                             "lift (default: all); for lessons, lesson keys (drag_speed, lift, ...); for "
+                             "scenes, scene names (default, plate, ...)")
+    parser.add_argument("--compare", action="store_true",
+                        help="lessons: also run each one plain (no absorbing layer, wind everywhere from the "
+                             "first step, sudden wind changes); scenes: also without the absorbing layer")
+    parser.add_argument("--json", default=None, metavar="PATH", help="lessons, scenes: also write the runs as JSON")
+    parser.add_argument("--scenes", default="scenes", metavar="DIR", help="folder holding the scenes (default: scenes)")
+    parser.add_argument("--out", default="docs", metavar="DIR",
+                        help="folder for report-seed.md and report-seed/ (default: docs)")
+    parser.add_argument("--replot", action="store_true",
+                        help="rebuild text and plots from the stored series without running the flow")
+
+
+def main(args) -> int:
+    if args.target == "lessons":
+        return lessons(args)
+    if args.target == "scenes":
+        return scene_calm(args)
+    from feelflow.app.reports.seed import PARTS, PROTOCOL, run_part, save_part, write_report
+
+    out = Path(args.out)
+    if not out.is_dir():
+        raise UserError(f"--out: {args.out!r} is not a folder")
+    phase_steps = None
+    if args.phase_steps is not None:
+        try:
+            phase_steps = int(args.phase_steps)
+        except ValueError:
+            phase_steps = 0
+        if phase_steps < 1:
+            raise UserError(f"--phase-steps: must be a positive integer, got {args.phase_steps!r}")
+    parts = PARTS
+    keys = None  # protocol diameters
+    if args.only is not None:
+        parts = tuple(p.strip() for p in args.only.split(",") if p.strip())
+        diameters = tuple(key for key, _ in PROTOCOL)
+        keys = tuple(p.split(":", 1)[1] for p in parts if p.startswith("protocol:")) or None
+        parts = tuple(dict.fromkeys("protocol" if p.startswith("protocol:") else p for p in parts))
+        bad = [p for p in parts if p not in PARTS] + [k for k in keys or () if k not in diameters]
+        if bad or not parts:
+            raise UserError(f"--only: unknown part {bad[0] if bad else args.only!r}; choose from "
+                            f"{', '.join(PARTS)} (protocol:{'|'.join(diameters)} for one diameter)")
+    if not args.replot:
+        scenes = Path(args.scenes)
+        if not scenes.is_dir():
+            raise UserError(f"--scenes: {args.scenes!r} is not a folder")
+        for part in parts:
+            print(f"feelflow report seed: {part} on {args.backend}", file=sys.stderr, flush=True)
+            data = run_part(part, scenes, args.backend, args.quick, phase_steps,
+                            log=lambda line: print(line, file=sys.stderr, flush=True), keys=keys)
+            save_part(out / "report-seed", data)
+    path = write_report(out)
+    print(f"{path}: written")
+    return 0
+
+
+def lessons(args) -> int:
+    from feelflow.app.headless import gl_context
+    from feelflow.app.reports.lessons import format_table, run_lesson
+    from feelflow.app.model.presets import PRESETS
+
+    keys = _chosen(args.only, list(PRESETS), "lesson")
+    if args.backend == "gl":
+        gl_context()   # one line on stderr, exit 2, when there is no EGL context
+    elif args.backend != "numpy":
+        raise UserError(f"--backend: must be numpy or gl, got {args.backend!r}")
+    runs = []
+    for key in keys:
+        for plain in ((False, True) if args.compare else (False,)):
+            print(f"feelflow report lessons: {key}{' (plain)' if plain else ''} on {args.backend}",
+                  file=sys.stderr, flush=True)
+            runs.append(run_lesson(key, args.backend, plain=plain, make_ctx=gl_context))
+    return _print_runs(runs, format_table(runs), args.json)
+
+
+def scene_calm(args) -> int:
+    from feelflow.app.reports.scenes import SCENES, format_table, run_scene_calm
+
+    folder = Path(args.scenes)
+    names = _chosen(args.only, list(SCENES), "scene")
+    missing = [n for n in names if not (folder / f"{n}.toml").is_file()]
+    if missing:
+        raise UserError(f"--scenes: {str(folder / (missing[0] + '.toml'))!r} not found")
+    runs = []
+    for name in names:
+        for without in ((False, True) if args.compare else (False,)):
+            print(f"feelflow report scenes: {name}{' (without the absorbing layer)' if without else ''} "
+                  f"on {args.backend}", file=sys.stderr, flush=True)
+            runs.append(run_scene_calm(folder / f"{name}.toml", args.backend, without_layer=without,
+                                       steps=40 if args.quick else None))
+    return _print_runs(runs, format_table(runs), args.json)
+
+
+def _chosen(only: str | None, choices: list[str], what: str) -> list[str]:
+    """The names given to --only (comma-separated), all of `choices` without it; UserError names
+    the first unknown one."""
+    if only is None:
+        return choices
+    names = [k.strip() for k in only.split(",") if k.strip()]
+    bad = [k for k in names if k not in choices]
+    if bad or not names:
+        raise UserError(f"--only: unknown {what} {bad[0] if bad else only!r}; choose from {', '.join(choices)}")
+    return names
+
+
+def _print_runs(runs: list[dict], table: str, json_path: str | None) -> int:
+    """Print the report's table; with --json also write the runs and the machine (atomically)."""
+    import json
+
+    from feelflow.app.bench.solver_speed import machine
+    from feelflow.app.files import write_text_atomic
+
+    print(table)
+    if json_path:
+        write_text_atomic(json_path, json.dumps({"machine": machine(), "runs": runs}, indent=1) + "\n")
+    return 0

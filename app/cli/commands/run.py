@@ -1,0 +1,159 @@
+"""`feelflow run SCENE.toml`: run a scene headless, write the body's forces as CSV.
+
+Columns: `step,x,y,vx,vy` then `fx_<model>,fy_<model>` per force model, lattice units, one row
+per output interval: `step` = steps done, (x, y) the body position then, (vx, vy) its velocity
+during the last step, forces averaged over the interval. The file is written atomically.
+"""
+from __future__ import annotations
+
+import csv
+import math
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from feelflow.app.errors import UserError
+
+
+def add_arguments(parser):
+    parser.add_argument("scene", metavar="SCENE.toml", help="the scene file (keys: docs/scenes.md)")
+    parser.add_argument("--backend", default=None, metavar="numpy|gl",
+                        help="solver backend (default: the scene's run.backend, else numpy)")
+    parser.add_argument("--steps", default=None, metavar="N", help="number of steps (default: the scene's)")
+    parser.add_argument("--out", default="forces.csv", metavar="PATH", help="CSV file to write (default: forces.csv)")
+    parser.add_argument("--record", default=None, metavar="FILE.ffsession",
+                        help="also record the run as a session file (docs/sessions.md)")
+
+
+def positive_int_option(name: str, text):
+    """An option that must be a positive integer; UserError (one line) otherwise."""
+    try:
+        value = int(text)
+    except (TypeError, ValueError):
+        raise UserError(f"{name}: must be a positive integer, got {text!r}") from None
+    if value < 1:
+        raise UserError(f"{name}: must be a positive integer, got {value}")
+    return value
+
+
+def write_csv_atomic(path: Path, header, rows) -> None:
+    """Write a CSV next to its destination, then rename it into place (never half a file)."""
+    directory = path.parent if str(path.parent) else Path(".")
+    if not directory.is_dir():
+        raise UserError(f"--out: directory {str(directory)!r} does not exist")
+    from feelflow.app.files import atomic_path
+
+    with atomic_path(path, suffix=".tmp") as tmp, open(tmp, "w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(header)
+        writer.writerows(rows)
+
+
+def _fmt(v: float) -> str:
+    return f"{v:.10g}"
+
+
+def main(args) -> int:
+    from feelflow.app.headless import make_solver
+    from feelflow.app.model.scene import load_scene
+
+    scene = load_scene(args.scene)
+    warn_outside_stable_region(scene, args.scene)
+    backend = args.backend if args.backend is not None else scene.backend
+    steps = positive_int_option("--steps", args.steps) if args.steps is not None else scene.steps
+    out = Path(args.out)
+    if out.is_dir():
+        raise UserError(f"--out: {args.out!r} is a directory")
+    if not (out.parent if str(out.parent) else Path(".")).is_dir():
+        raise UserError(f"--out: directory {str(out.parent)!r} does not exist")
+
+    solver = make_solver(backend, scene.config)
+    recorder = None
+    if args.record:
+        from feelflow.app.sessions import record_headless
+
+        solver, recorder = record_headless(solver, scene, scene_toml=Path(args.scene).read_text())
+    try:
+        # a blow-up is detected and reported in one line, not as floating-point warnings
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)
+            header, rows, wall, diverged = run_scene(scene, solver, steps)
+    finally:
+        solver.close()
+
+    write_csv_atomic(out, header, rows)
+    if recorder is not None:
+        from feelflow.app.sessions import SessionError
+
+        try:
+            recorder.save(args.record)
+        except SessionError as exc:
+            raise UserError(str(exc)) from None
+    if diverged is not None:
+        print(f"feelflow: the simulation diverged (NaN) within steps {diverged[0]}..{diverged[1]}; "
+              f"the {len(rows)} rows before it are in {out}. Lower the speeds or raise the viscosity "
+              f"or the resolution.", file=sys.stderr)
+        return 1
+    cells = scene.config.nx * scene.config.ny
+    mlups = cells * steps / wall / 1e6 if wall > 0 else float("nan")
+    print(f"{out}: {len(rows)} rows, {steps} steps on {backend} ({scene.config.nx} x {scene.config.ny}, "
+          f"Re {scene.reynolds:.4g} with L = {scene.reference_length:g} cells, U = {scene.reference_speed:g}, "
+          f"Ma {scene.mach:.3f}); {wall:.1f} s, {mlups:.1f} MLUPS")
+    return 0
+
+
+def warn_outside_stable_region(scene, name) -> bool:
+    """One line on stderr when the scene lies outside the measured stable region,
+    U sqrt(d) / nu <= K (solver/stability_limit.py); the scene is run as written (the window, by
+    contrast, raises the viscosity). U is the scene's reference speed (the inflow, or the fastest
+    motion phase in fluid at rest), d the body's larger bounding-box side (the scan's d: cylinder
+    diameter, plate or wedge length)."""
+    from feelflow.solver.stability_limit import measured_cell_reynolds
+
+    cfg = scene.config
+    speed = abs(scene.reference_speed)
+    x0, y0, x1, y1 = scene.body.bounding_box()
+    size = max(x1 - x0, y1 - y0)
+    limit = measured_cell_reynolds(cfg.collision, size)
+    if speed / cfg.nu <= limit:
+        return False
+    print(f"feelflow: warning: {name}: U / nu = {speed / cfg.nu:.3g} is above {limit:.3g}, the measured stable "
+          f"cell Reynolds number for a {size:.3g}-cell body ({cfg.collision}, "
+          f"solver/stability_limit.py); the run may diverge (nu >= {speed / limit:.4g} keeps it inside)",
+          file=sys.stderr)
+    return True
+
+
+def run_scene(scene, solver, steps: int):
+    """Step `scene` in `solver` along its motion script for `steps` steps.
+
+    Returns (header, rows, wall seconds, None or (first, last) step of the interval in which the
+    flow diverged)."""
+    from feelflow.solver import backend as backends
+    from feelflow.solver.motion import MotionRunner
+
+    diverged_error = getattr(backends, "SolverDiverged", ())
+    solver.enable_force_models(scene.force_models)
+    runner = MotionRunner(solver, scene.body, scene.motion)
+    header = ["step", "x", "y", "vx", "vy"]
+    for m in scene.force_models:
+        header += [f"fx_{m}", f"fy_{m}"]
+    rows = []
+    start = time.perf_counter()
+    while runner.t < steps:
+        t0 = runner.t
+        n = min(scene.output_interval, steps - t0)
+        velocity = scene.motion.velocity_at(t0 + n - 1)
+        try:
+            forces = runner.advance(n)
+        except diverged_error:
+            return header, rows, time.perf_counter() - start, (t0, t0 + n)
+        values = [v for m in scene.force_models for v in forces[m]]
+        if not all(math.isfinite(v) for v in values) or not math.isfinite(solver.total_mass()):
+            return header, rows, time.perf_counter() - start, (t0, t0 + n)
+        x, y = runner.position
+        rows.append([runner.t] + [_fmt(v) for v in (x, y, *velocity, *values)])
+    return header, rows, time.perf_counter() - start, None

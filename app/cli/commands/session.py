@@ -1,0 +1,133 @@
+"""`feelflow session info|replay|export FILE`: look into, re-simulate or export a session file.
+
+Format: docs/sessions.md. A bad file is one line on stderr and exit 2 (app.cli.UserError).
+`replay --check` exits 1 when the replay deviates from the recorded forces by more than
+`--tolerance` (relative to the largest recorded force).
+"""
+from __future__ import annotations
+
+import json
+import sys
+
+from feelflow.app.errors import UserError
+
+
+def add_arguments(parser):
+    sub = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
+    p = sub.add_parser("info", help="print what a session file holds")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("--json", action="store_true", help="print the whole manifest as JSON")
+    p = sub.add_parser("replay", help="re-simulate a session and compare with the recorded forces")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("--backend", default=None, metavar="numpy|gl", help="backend (default: the recorded one)")
+    p.add_argument("--out", default=None, metavar="PATH", help="write the replayed forces as CSV")
+    p.add_argument("--check", action="store_true",
+                   help="exit 1 unless the replay reproduces the recorded forces within --tolerance")
+    p.add_argument("--tolerance", default="1e-12", metavar="REL",
+                   help="--check: largest deviation relative to the largest recorded force (default 1e-12)")
+    p = sub.add_parser("export", help="write the recorded force series as CSV and/or the manifest as JSON")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("--csv", default=None, metavar="PATH", help="the force series (columns as `feelflow run`)")
+    p.add_argument("--manifest", default=None, metavar="PATH", help="the manifest as JSON")
+
+
+def _load(path):
+    from feelflow.app.sessions import SessionError, load_session
+
+    try:
+        return load_session(path)
+    except SessionError as exc:
+        raise UserError(str(exc)) from None
+
+
+def _write(fn, *args):
+    from feelflow.app.sessions import SessionError
+
+    try:
+        return fn(*args)
+    except SessionError as exc:
+        raise UserError(str(exc)) from None
+
+
+def _make_factory(backend: str):
+    """Backends by name for the replay, through `feelflow.app.headless.make_solver` (gl gets the
+    process's EGL context); UserError (one line) when the backend cannot run here."""
+    from feelflow.app.headless import make_solver
+
+    def factory(config):
+        return make_solver(backend, config)
+    return factory
+
+
+def info(args) -> int:
+    s = _load(args.file)
+    m = s.manifest
+    if args.json:
+        print(json.dumps(m, indent=2))
+        return 0
+    c, counts = s.config, m["counts"]
+    body = s.body.to_dict() if s.body is not None else None
+    kind = body.pop("kind") if body else "none"
+    body_text = kind + (" " + ", ".join(f"{k}={v}" for k, v in body.items() if k != "vertices") if body else "")
+    print(f"{args.file}: FeelFlow session, format version {m['version']} (FeelFlow {m['feelflow_version']})")
+    print(f"  created   {m['created']}")
+    print(f"  backend   {m['backend']} (renderer: {m['renderer']})")
+    print(f"  scene     {m['scene'].get('source') or '(no file)'}: grid {c.nx} x {c.ny}, nu {c.nu:g}, "
+          f"{c.collision}, inflow {c.inflow_speed:g} ({c.inflow_profile}), walls {c.y_boundary}")
+    print(f"  body      {body_text}")
+    print(f"  forces    {', '.join(s.models) or 'none'}")
+    start = "from the scene's initial flow" if s.start is None else \
+        f"from a running flow at solver step {s.start['time']} (state saved)"
+    print(f"  recorded  {counts['steps']} steps {start}: {counts['inputs']} input samples, "
+          f"{counts['parameters']} parameter changes, {counts['forces']} force rows")
+    return 0
+
+
+def replay(args) -> int:
+    from feelflow.app.sessions import SessionError, export_csv, replay as run_replay
+
+    try:
+        tolerance = float(args.tolerance)
+    except ValueError:
+        raise UserError(f"--tolerance: must be a number, got {args.tolerance!r}") from None
+    if not tolerance >= 0:
+        raise UserError(f"--tolerance: must be zero or positive, got {args.tolerance!r}")
+    s = _load(args.file)
+    backend = args.backend or s.backend
+    factory = _make_factory(backend)
+    try:
+        result = run_replay(s, backend, factory=factory)
+    except SessionError as exc:
+        raise UserError(str(exc)) from None
+    if args.out:
+        _write(export_csv, s, args.out, result.values)
+    same = "same backend" if backend == s.backend else f"recorded on {s.backend}"
+    print(f"{args.file}: replayed {s.steps} steps on {backend} ({same}); largest force deviation "
+          f"{result.max_deviation:.3g} ({result.relative_deviation:.3g} of the largest recorded force "
+          f"{result.max_force:.4g})" + (f"; wrote {args.out}" if args.out else ""))
+    if result.diverged_at is not None:
+        print(f"feelflow: the replay diverged at step {result.diverged_at}", file=sys.stderr)
+    if args.check and not result.relative_deviation <= tolerance:
+        print(f"feelflow: replay check failed: relative deviation {result.relative_deviation:.3g} "
+              f"> tolerance {tolerance:g}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def export(args) -> int:
+    from feelflow.app.sessions import export_csv, export_manifest
+
+    if not args.csv and not args.manifest:
+        raise UserError("session export: give --csv PATH and/or --manifest PATH")
+    s = _load(args.file)
+    if args.csv:
+        _write(export_csv, s, args.csv)
+        print(f"{args.csv}: {len(s.forces['step'])} rows, columns step,x,y,vx,vy + fx/fy for {', '.join(s.models) or 'no model'}")
+    if args.manifest:
+        _write(export_manifest, s, args.manifest)
+        print(f"{args.manifest}: manifest")
+    return 0
+
+
+def main(args) -> int:
+    return {"info": info, "replay": replay, "export": export}[args.action](args)

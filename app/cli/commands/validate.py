@@ -1,0 +1,161 @@
+"""`feelflow validate`: run the physics validation cases, print a table, optionally write JSON.
+
+Cases live in `solver/validation/` (one module each); the registry is `feelflow.solver.validation.CASES`.
+The exit code is 0 when every target is met, 1 otherwise.
+"""
+from __future__ import annotations
+
+import os
+import platform
+from pathlib import Path
+
+from feelflow.app.errors import UserError
+from feelflow.app.machine import cpu_name
+
+
+def add_arguments(parser):
+    from feelflow.solver.validation import CASES
+
+    parser.add_argument("--case", action="append", metavar="NAME",
+                        help=f"a case to run (repeatable; default: all): {', '.join(CASES)}")
+    parser.add_argument("--resolution", default=None, metavar="N",
+                        help="cells per diameter (a multiple of 10 for the Schaefer-Turek cases, whose channel "
+                             "is 4.1 diameters high; channel width for poiseuille, grid size for taylor-green); "
+                             "default: each case's own")
+    parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
+    parser.add_argument("--json", default=None, metavar="PATH", help="also write the results as JSON")
+    parser.add_argument("--quick", action="store_true", help="small grids and short runs (the test-suite versions)")
+    parser.add_argument("--refine", action="store_true",
+                        help="the Schaefer-Turek cases with the cylinder and its near wake in a patch of twice the "
+                             "resolution (numpy only; solver/refinement.py); default cases: those two")
+
+
+def machine_description() -> str:
+    return (f"{cpu_name()} ({os.cpu_count()} logical CPUs), {platform.system()} {platform.release()}, "
+            f"Python {platform.python_version()}")
+
+
+def _fmt(v) -> str:
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+def format_table(results) -> str:
+    """A Markdown table: one row per measured quantity that has a target, plus speed."""
+    lines = ["| case | N | quantity | value | target | met | steps | wall s | MLUPS |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in results:
+        met = r.check_results()
+        checked = {c.quantity: c for c in r.checks}
+        first = True
+        for name, value in r.quantities.items():
+            target = checked[name].describe() if name in checked else ""
+            ok = ("yes" if met[name] else "**no**") if name in checked else ""
+            speed = [str(r.steps), f"{r.wall_seconds:.1f}", f"{r.mlups:.1f}"] if first else ["", "", ""]
+            lines.append(f"| {r.name if first else ''} | {r.resolution if first else ''} | {name} | {_fmt(value)} "
+                         f"| {target} | {ok} | " + " | ".join(speed) + " |")
+            first = False
+    return "\n".join(lines)
+
+
+def write_json_atomic(path: Path, data) -> None:
+    directory = path.parent if str(path.parent) else Path(".")
+    if not directory.is_dir():
+        raise UserError(f"--json: directory {str(directory)!r} does not exist")
+    from feelflow.app import files
+
+    files.write_json_atomic(path, data)
+
+
+def refinable(name: str) -> bool:
+    """Whether a case's `run` takes `refine` (it has a body to refine around)."""
+    import inspect
+
+    from feelflow.solver.validation import case_module
+
+    return "refine" in inspect.signature(case_module(name).run).parameters
+
+
+def run_case(name: str, factory, resolution, quick: bool, backend: str, refine: bool = False):
+    """One case; a flow that blows up is a failed case (stable = 0), not a traceback."""
+    import time
+    import warnings
+
+    import numpy as np
+
+    from feelflow.solver import backend as backends
+    from feelflow.solver.validation import case_module
+    from feelflow.solver.validation.base import CaseResult, Check
+
+    module = case_module(name)
+    t0 = time.perf_counter()
+    try:
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)
+            extra = {"refine": True} if refine else {}
+            result = module.run(factory, resolution=resolution, quick=quick, backend=backend, **extra)
+    except backends.SolverDiverged as exc:
+        n = resolution or (module.QUICK_RESOLUTION if quick else module.DEFAULT_RESOLUTION)
+        result = CaseResult(name, backend, n, quantities={"stable": 0.0, "diverged_at_step": float(exc.step)},
+                            checks=[Check("stable", 1.0, 1.0, "the flow must not blow up")])
+        result.notes = str(exc)
+    result.case_seconds = time.perf_counter() - t0
+    return result
+
+
+def main(args) -> int:
+    from feelflow.app.cli.commands.run import positive_int_option
+    from feelflow.app.headless import make_solver
+    from feelflow.solver.validation import CASES, case_module
+
+    refine = bool(getattr(args, "refine", False))
+    for name in args.case or []:
+        if name not in CASES:
+            raise UserError(f"--case: unknown case {name!r}; choose from {', '.join(CASES)}")
+    names = args.case or [name for name in CASES if refinable(name) or not refine]
+    if refine:
+        if args.backend != "numpy":
+            raise UserError(f"--refine: the refined patch runs on the numpy backend only, not {args.backend!r}")
+        for name in names:
+            if not refinable(name):
+                raise UserError(f"--refine: case {name!r} has no body to refine around; "
+                                f"choose from {', '.join(n for n in CASES if refinable(n))}")
+    resolution = positive_int_option("--resolution", args.resolution) if args.resolution is not None else None
+    for name in names:
+        check = getattr(case_module(name), "check_resolution", None)
+        if resolution is not None and check is not None:
+            try:
+                check(resolution)
+            except ValueError as exc:
+                raise UserError(f"--resolution: {name}: {exc}") from None
+    if args.json is not None and Path(args.json).is_dir():
+        raise UserError(f"--json: {args.json!r} is a directory")
+    if args.json is not None and not (Path(args.json).parent if str(Path(args.json).parent) else Path(".")).is_dir():
+        raise UserError(f"--json: directory {str(Path(args.json).parent)!r} does not exist")
+
+    def factory(config):
+        return make_solver(args.backend, config)
+
+    results = []
+    for name in names:
+        print(f"running {name} ...", flush=True)
+        result = run_case(name, factory, resolution, args.quick, args.backend, refine)
+        results.append(result)
+        print(f"  {name}: {'targets met' if result.passed else 'TARGETS NOT MET'} "
+              f"({result.steps} steps, {result.wall_seconds:.1f} s stepping, {result.case_seconds:.1f} s in all)",
+              flush=True)
+    machine = machine_description()
+    print(f"\nFeelFlow validation, backend {args.backend}{', refined patch' if refine else ''}, on {machine}\n")
+    print(format_table(results))
+    for r in results:   # a case may add its own tables (e.g. the stability map)
+        details = getattr(case_module(r.name), "format_details", None)
+        if details is not None and details(r):
+            print("\n" + details(r))
+    failed = [r.name for r in results if not r.passed]
+    print(f"\n{len(results) - len(failed)} of {len(results)} cases meet their targets"
+          + (f"; not met: {', '.join(failed)}" if failed else ""))
+    if args.json:
+        write_json_atomic(Path(args.json), {"machine": machine, "backend": args.backend, "refine": refine,
+                                            "cases": [r.to_dict() for r in results]})
+    return 0 if not failed else 1

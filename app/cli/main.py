@@ -1,0 +1,81 @@
+"""The `feelflow` command line (also `python -m feelflow.app`).
+
+Each sub-command lives in `app/commands/<name>.py` with `add_arguments(parser)` and
+`main(args) -> int`. Errors a user can cause are reported as one line on stderr with exit 2;
+no tracebacks reach the user.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from feelflow.app.errors import UserError
+
+#: sub-command -> one-line help
+COMMANDS = {
+    "gui": "open the wind-tunnel window (the default)",
+    "run": "run a scene headless and write forces as CSV",
+    "validate": "run the physics validation cases and print a table",
+    "bench": "measure solver speed (both backends) or the haptic loop",
+    "devices": "list haptic devices: serial ports, HID devices, simulators",
+    "report": "reports: the seed's experiments (Markdown), how steady the lessons and example scenes are",
+    "session": "inspect, replay or export a recorded session file",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="feelflow", description="FeelFlow: a desktop wind tunnel you can touch")
+    parser.add_argument("--selftest", action="store_true",
+                        help="open the real window, exercise it and exit 0 only if everything worked")
+    parser.add_argument("--screenshot", metavar="PATH", help="with --selftest: save a screenshot")
+    parser.add_argument("--seconds", type=float, default=8.0, help="with --selftest: how long to run")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, help_ in COMMANDS.items():
+        p = sub.add_parser(name, help=help_, description=help_)
+        try:
+            module = importlib.import_module(f"feelflow.app.cli.commands.{name}")
+        except ModuleNotFoundError as exc:  # command not built yet
+            if exc.name != f"feelflow.app.cli.commands.{name}":
+                raise
+            p.set_defaults(_missing=name)
+            continue
+        module.add_arguments(p)
+        p.set_defaults(_module=module)
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.selftest or args.command is None:
+        args.command = "gui"
+    if not hasattr(args, "_module") and not hasattr(args, "_missing"):
+        # no sub-command on the line (`feelflow`, `feelflow --selftest`): the gui's defaults
+        try:
+            module = importlib.import_module("feelflow.app.cli.commands.gui")
+        except ModuleNotFoundError as exc:
+            if exc.name != "feelflow.app.cli.commands.gui":
+                raise
+            args._missing = "gui"
+        else:
+            sub = argparse.ArgumentParser()
+            module.add_arguments(sub)
+            for key, value in vars(sub.parse_args([])).items():
+                if not hasattr(args, key):
+                    setattr(args, key, value)
+            args._module = module
+    if getattr(args, "_missing", None):
+        print(f"feelflow: '{args.command}' is not available in this version", file=sys.stderr)
+        return 2
+    try:
+        return int(args._module.main(args) or 0)
+    except UserError as exc:
+        print(f"feelflow: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

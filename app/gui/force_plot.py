@@ -1,0 +1,303 @@
+"""The live force plot (pyqtgraph): drag and lift against time for the force model in use (or
+all models), C_D / C_L readouts, and "drag against relative speed" on log-log axes with the
+fitted exponent (the U^2 lesson: shared/reference/benchmarks.md, 'Low-Re drag').
+"""
+from __future__ import annotations
+
+import csv
+import io
+import math
+
+import numpy as np
+import pyqtgraph as pg
+import pyqtgraph.exporters
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import (QCheckBox, QComboBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget)
+
+from feelflow.app.files import atomic_path, write_text_atomic
+from feelflow.app.model.power_law import fit_power_law
+from feelflow.app.model.simulation import FORCE_MODELS, History, drag_direction
+from feelflow.solver.lattice import CS2
+
+#: the impulsive start's pressure pulse (the flow begins at full speed around a body that was not
+#: there) has passed once it crossed the body twice at the speed of sound: 2 D / c_s steps
+START_PULSE_CROSSINGS = 2.0
+
+
+def start_pulse_steps(size_cells: float) -> float:
+    """Solver steps after the flow (re)starts during which the forces show the start pulse, a
+    spike tens of times the steady drag; the time plot's force range leaves them out."""
+    return START_PULSE_CROSSINGS * size_cells / math.sqrt(CS2)
+
+MODEL_COLOURS = {"momentum_exchange": ((220, 40, 40), (40, 110, 240)),
+                 "macroscopic": ((230, 140, 20), (20, 170, 190)),
+                 "pressure": ((150, 60, 190), (40, 160, 60))}
+
+
+class ForcePlot(QWidget):
+    """Shows `sim.history`; `refresh()` redraws (the window calls it a few times a second)."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.sim = None
+        self.paused = False
+        self._frozen = None
+        self.view = QComboBox()
+        self.view.addItem("Drag and lift against time", "time")
+        self.view.addItem("Drag against relative speed (log-log)", "speed")
+        self.pause_box = QCheckBox("Pause plot")
+        self.clear_button = QPushButton("Clear")
+        self.csv_button = QPushButton("Export CSV\u2026")
+        self.png_button = QPushButton("Export PNG\u2026")
+        self.readout = QLabel("C<sub>D</sub> = \u2013   C<sub>L</sub> = \u2013")
+        self.readout.setTextFormat(Qt.RichText)
+        font = self.readout.font()
+        font.setPointSizeF(font.pointSizeF() * 1.35)
+        font.setBold(True)
+        self.readout.setFont(font)
+        bar = QHBoxLayout()
+        for w in (self.view, self.pause_box, self.clear_button, self.csv_button, self.png_button):
+            bar.addWidget(w)
+        # the widest readout keeps its place: the bar does not shift as the signs change
+        self.readout.setMinimumWidth(self.readout.fontMetrics().horizontalAdvance("CD = -00.00   CL = -00.00"))
+        bar.addStretch(1)
+        bar.addWidget(self.readout)
+
+        pg.setConfigOptions(antialias=True, background="w", foreground="k")
+        self.plot = pg.PlotWidget()
+        self.plot.showGrid(x=False, y=True, alpha=0.3)   # the grid is redrawn with the axes: keep it light
+        self.legend = self.plot.addLegend(offset=(10, 5))
+        self.plot.getAxis("bottom").setLabel("time (solver steps)")
+        self.plot.getAxis("left").setLabel("force (lattice units)")
+        for ax in ("bottom", "left"):
+            self.plot.getAxis(ax).enableAutoSIPrefix(False)
+            f = self.plot.getAxis(ax).label.font()
+            f.setPointSize(11)
+            self.plot.getAxis(ax).label.setFont(f)
+        self.follow_range = True   # the plot sets its ranges until the user zooms or pans
+        self.plot.getViewBox().sigRangeChangedManually.connect(self._user_moved_range)
+        self.curves = {}
+        self.scatter = self.fit_line = None
+        self.fitted_exponent = None
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(4, 4, 4, 4)
+        layout.addLayout(bar)
+        layout.addWidget(self.plot, 1)
+        self.view.currentIndexChanged.connect(self._switch_view)
+        self.pause_box.toggled.connect(self._pause)
+        self.clear_button.clicked.connect(self.clear)
+
+    # --- state -----------------------------------------------------------------------------
+    def _pause(self, on):
+        self.paused = on
+        if not on:
+            self.refresh()
+
+    def clear(self):
+        if self.sim is not None:
+            self.sim.history.clear()
+        self.refresh(force=True)
+
+    def _user_moved_range(self, *_):
+        self.follow_range = False
+
+    def _following(self) -> bool:
+        """Is the plot to set its own ranges? Yes until the user zooms or pans, and again once
+        the user clicks pyqtgraph's auto-range button ("A")."""
+        if all(self.plot.getViewBox().autoRangeEnabled()):   # "A" turns both on; a zoom of one axis turns that one off
+            self.follow_range = True
+        return self.follow_range
+
+    def _switch_view(self):
+        self._shown = None
+        self.follow_range = True
+        self.plot.enableAutoRange()
+        self.plot.clear()
+        self.curves.clear()
+        self._reset_legend(1)
+        speed_view = self.view.currentData() == "speed"
+        self.plot.setLogMode(speed_view, speed_view)
+        if speed_view:   # PlotDataItems: the log mode transforms them (bare scatter items it does not)
+            self.scatter = self.plot.plot([], [], pen=None, symbol="o", symbolSize=10,
+                                          symbolBrush=pg.mkBrush(220, 40, 40), symbolPen=pg.mkPen("k"),
+                                          name="mean drag at one speed")
+            self.fit_line = self.plot.plot([], [], pen=pg.mkPen((40, 40, 40), width=2, style=Qt.DashLine),
+                                           name="fit")
+            self._set_speed_ranges(np.array([]), np.array([]))
+            self.plot.getAxis("bottom").setLabel("relative speed |U - V| (lattice units)")
+            self.plot.getAxis("left").setLabel("drag (lattice units)")
+        else:
+            self.plot.getAxis("bottom").setLabel("time (solver steps)")
+            self.plot.getAxis("left").setLabel("force (lattice units)")
+        self.refresh(force=True)
+
+    def _reset_legend(self, columns: int):
+        """The plot keeps one legend across clear(): empty it and set its layout."""
+        self.legend = self.plot.addLegend(offset=(10, 5))
+        self.legend.clear()
+        self.legend.setColumnCount(columns)
+
+    def models_shown(self):
+        sim = self.sim
+        return list(FORCE_MODELS) if sim.params.compare_all else [sim.params.force_model]
+
+    # --- drawing ---------------------------------------------------------------------------
+    def refresh(self, force: bool = False):
+        if self.sim is None or (self.paused and not force):
+            return
+        self._update_readout()
+        if self.view.currentData() == "speed":
+            self._draw_speed_view()
+        else:
+            self._draw_time_view()
+
+    def coefficients(self, model=None, last: int = 30):
+        """(C_D, C_L) of the last `last` samples: F / (1/2 rho0 U_rel^2 A), A = frontal width."""
+        sim = self.sim
+        model = model or sim.params.force_model
+        t, drag, lift = sim.history.drag_lift(model)
+        if len(t) == 0:
+            return math.nan, math.nan
+        w = np.asarray(sim.history.wind[-last:], float)
+        u = float(np.hypot(w[:, 0], w[:, 1]).mean())
+        if u < 0.005 or sim.shape is None:
+            return math.nan, math.nan
+        area = sim.shape.frontal_area(tuple(drag_direction(w[-1])[0]))
+        q = 0.5 * u * u * area
+        d, l_ = drag[-last:], lift[-last:]
+        if not np.isfinite(d).any():
+            return math.nan, math.nan
+        return float(np.nanmean(d) / q), float(np.nanmean(l_) / q)
+
+    def _update_readout(self):
+        cd, cl = self.coefficients()
+
+        def fmt(v):
+            return "\u2013" if not math.isfinite(v) else f"{v + 0.0:.2f}".replace("-0.00", "0.00")
+        self.readout.setText(f"C<sub>D</sub> = {fmt(cd)} &nbsp; C<sub>L</sub> = {fmt(cl)}")
+
+    def _curve(self, key, pen, name):
+        if key not in self.curves:
+            self.curves[key] = self.plot.plot([], [], pen=pen, name=name)
+        return self.curves[key]
+
+    def _draw_time_view(self):
+        sim = self.sim
+        shown = self.models_shown()
+        if getattr(self, "_shown", None) != (tuple(shown), sim.params.compare_all):
+            self._shown = (tuple(shown), sim.params.compare_all)
+            self.plot.clear()                  # curves and legend rebuilt for the new set of models
+            self.curves.clear()
+            self._reset_legend(3 if len(shown) > 1 else 1)
+        values = []
+        for model in shown:
+            t, drag, lift = sim.history.drag_lift(model)
+            first = int(np.argmax(np.isfinite(drag))) if np.isfinite(drag).any() else len(t)
+            t, drag, lift = t[first:], drag[first:], lift[first:]   # from when the model was switched on
+            cd, cl = MODEL_COLOURS.get(model, ((0, 0, 0), (90, 90, 90)))
+            self._curve((model, "drag"), pg.mkPen(cd, width=2.5), self._name((model, "drag"))).setData(t, drag, connect="finite")
+            self._curve((model, "lift"), pg.mkPen(cl, width=2.5, style=Qt.DashLine if len(shown) > 1 else Qt.SolidLine),
+                        self._name((model, "lift"))).setData(t, lift, connect="finite")
+            settled = t >= start_pulse_steps(sim.params.size)
+            values.append(np.r_[drag[settled], lift[settled]])
+        self._set_force_range(np.concatenate(values) if values else np.array([]))
+
+    def _set_force_range(self, values):
+        """Force axis of the time view: the settled forces and zero, not the start pulse (whose
+        curve runs off the top, data unchanged); pyqtgraph's own auto-range until there are
+        settled samples."""
+        if not self._following():
+            return
+        values = values[np.isfinite(values)]
+        if values.size == 0:
+            self.plot.enableAutoRange(y=True)
+            return
+        lo, hi = min(0.0, float(values.min())), max(0.0, float(values.max()))
+        if hi - lo < 1e-12:
+            hi = lo + 1e-6
+        self.plot.setYRange(lo, hi, padding=0.08)
+
+    def _name(self, key):
+        model, what = key
+        return f"{what}" if not self.sim.params.compare_all else f"{what}, {FORCE_MODELS[model].split(' (')[0].lower()}"
+
+    def speed_drag(self):
+        """(relative wind speed, drag) of the settled samples only (History.settled): drag
+        while the wind or the body's speed is changing carries the acceleration's force and is
+        not the steady drag the law describes."""
+        sim = self.sim
+        _, drag, _ = sim.history.drag_lift(sim.params.force_model)
+        w = np.asarray(sim.history.wind, float).reshape(-1, 2)
+        settled = np.asarray(sim.history.settled, bool)
+        return np.hypot(w[settled, 0], w[settled, 1]), drag[settled]
+
+    def _draw_speed_view(self):
+        us, fs, n = fit_power_law(*self.speed_drag())
+        self.scatter.setData(us, fs)
+        if n is not None:
+            c = np.mean(np.log(fs) - n * np.log(us))
+            xs = np.geomspace(us.min(), us.max(), 20)
+            self.fit_line.setData(xs, np.exp(c) * xs ** n)
+            self._set_fit_text(f"fit: drag \u221d U<sup>{n:.2f}</sup>")
+        else:
+            self.fit_line.setData([], [])
+            self._set_fit_text("fit: needs speeds 1.5\u00d7 apart" if len(us) else
+                               f"fit: hold a speed {History.SETTLE_STEPS} steps")
+        self.fitted_exponent = n
+        self._set_speed_ranges(us, fs)
+
+    def fit_text(self) -> str:
+        """The fit's entry in the legend (the exponent, or what the fit still needs)."""
+        for sample, label in self.legend.items:
+            if sample.item is self.fit_line:
+                return label.text
+        return ""
+
+    def _set_fit_text(self, text):
+        """The fit's result stands in the legend beside its line, not in the bar above the plot
+        (there it made the window at least 1175 pixels wide)."""
+        for sample, label in self.legend.items:
+            if sample.item is self.fit_line and label.text != text:
+                label.setText(text, bold=True, size="11pt")
+
+    def _set_speed_ranges(self, us, fs):
+        """Log-log ranges around the points (a factor 1.5 in speed, 2 in drag beyond them): with
+        one point or none, pyqtgraph's auto-range spans 1e-300 to 1e300."""
+        if not self._following():
+            return
+        us, fs = np.asarray(us, float), np.asarray(fs, float)
+        x = (us.min() / 1.5, us.max() * 1.5) if us.size else (0.01, 0.1)
+        y = (fs.min() / 2, fs.max() * 2) if fs.size else (1e-3, 1e-1)
+        self.plot.setXRange(math.log10(x[0]), math.log10(x[1]), padding=0)   # log mode: log10 values
+        self.plot.setYRange(math.log10(y[0]), math.log10(y[1]), padding=0)
+
+    # --- export ---------------------------------------------------------------------------
+    def csv_text(self) -> str:
+        sim = self.sim
+        h = sim.history
+        models = [m for m in FORCE_MODELS if m in h.forces]
+        out = io.StringIO()
+        w = csv.writer(out)
+        w.writerow(["step", "body_vx", "body_vy", "wind_x", "wind_y"]
+                   + [f"{m}_{q}" for m in models for q in ("fx", "fy", "drag", "lift")])
+        cols = []
+        for m in models:
+            _, drag, lift = h.drag_lift(m)
+            f = np.full((len(h), 2), np.nan)
+            s = np.asarray(h.forces[m], float)
+            f[len(h) - len(s):] = s
+            cols.append(np.c_[f, drag, lift])
+        for i in range(len(h)):
+            row = [h.time[i], *h.body_velocity[i], *h.wind[i]]
+            for c in cols:
+                row += [f"{v:.8g}" for v in c[i]]
+            w.writerow(row)
+        return out.getvalue()
+
+    def export_csv(self, path):
+        write_text_atomic(path, self.csv_text())
+
+    def export_png(self, path):
+        exporter = pyqtgraph.exporters.ImageExporter(self.plot.plotItem)
+        with atomic_path(path, suffix=".png") as tmp:
+            exporter.export(str(tmp))

@@ -1,0 +1,47 @@
+"""Lessons from the Presets menu. The physics of each is a scene file in scenes/presets/
+(app/scene.py format: grid, flow, body, motion script, force models); this table adds only how
+the window presents it: title, display mode, plot view, a note, and a wind-speed sweep where the
+lesson needs one (scene files have no time-varying wind)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from feelflow import SCENE_DIR
+
+PRESET_DIR = SCENE_DIR / "presets"
+
+
+@dataclass(frozen=True)
+class Lesson:
+    title: str
+    scene: str                 # file name in scenes/presets/
+    display: str = "speed"
+    plot_view: str = "time"
+    note: str = ""
+    wind_sweep: tuple = ()     # wind speeds held `hold_steps` each (body held still)
+    hold_steps: int = 2000
+    hold_still: bool = True
+
+    @property
+    def path(self) -> Path:
+        return PRESET_DIR / self.scene
+
+
+PRESETS = {
+    "drag_speed": Lesson("Drag grows with speed", "drag_speed.toml", plot_view="speed",
+                         wind_sweep=(0.02, 0.03, 0.045, 0.065, 0.09),
+                         note="The wind steps up from 0.02 to 0.09, 2000 steps each; the log-log plot fits drag ~ U^n "
+                              "to the steady samples."),
+    "shape_matters": Lesson("Shape matters: plate, wedges, cylinder", "shape_matters.toml", display="pressure",
+                            note="Switch Shape between plate, wedges and cylinder and compare C_D."),
+    "lift": Lesson("Lift on the half airfoil", "lift.toml", display="pressure",
+                   note="Flat side down: the blue lift arrow points up."),
+    "vortex_street": Lesson("Vortex street behind a cylinder", "vortex_street.toml", display="vorticity",
+                            note="Re 90 (the most this grid keeps stable here): the wake starts to swing after several thousand steps."),
+    "seed_protocol": Lesson("The seed's experiment: stopped, with, against the stream", "seed_protocol.toml",
+                            hold_still=False,
+                            note="Four phases of 2500 steps: stopped, with the stream, stopped, against it."),
+    "models": Lesson("Force models compared", "models_compared.toml",
+                     note="All three force models on one plot: dashed lines are lift."),
+}

@@ -1,0 +1,155 @@
+"""A session replaying in the window: what the viewport and the force plot read from
+`feelflow.app.model.simulation.Simulation` (config, params, body pose, history, field), fed by a
+`SessionPlayer` instead of the mouse. Read-only: the body follows the recording.
+
+Qt-free, so it is testable on its own; the window swaps it in for the live simulation while a
+session replays and swaps the live one back when the replay stops.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from feelflow.app.sessions import SessionPlayer
+from feelflow.app.model.simulation import FORCE_MODELS, History, Params, field_rgba
+from feelflow.solver import units
+
+
+class ReplaySimulation:
+    """A `SessionPlayer` dressed as the window's simulation. `advance(n)` replays about n steps
+    and adds one history sample per replayed force row (so the plot shows the replayed series
+    exactly), with the session step as its time."""
+
+    #: what the viewport asks of a live simulation; a replay has none of it
+    target = None
+    hold_still = False
+    polygon = None
+    capped = False
+    sweep = None
+
+    def __init__(self, session, backend: str | None = None, *, ctx=None, factory=None):
+        self.player = SessionPlayer(session, backend, ctx=ctx, factory=factory)
+        self.name = Path(session.source).name
+        self.history = History()
+        self.paused = False
+        self.last_steps = 0
+        self._last_forces: dict = {}
+        self.split_rows = True   # a force row longer than a frame's budget runs in parts (SessionPlayer)
+        self._params_cache = None  # (player.events_done, Params)
+
+    # --- what the window draws ----------------------------------------------------------
+    @property
+    def solver(self):
+        return self.player.solver
+
+    @property
+    def config(self):
+        return self.player.solver.config
+
+    @property
+    def shape(self):
+        """The body where the flow last felt it, or None when the session removed it."""
+        return self.player.shape
+
+    @property
+    def pos(self):
+        s = self.player.shape
+        return (s.x, s.y) if s is not None else (math.nan, math.nan)
+
+    @property
+    def angle(self) -> float:
+        s = self.player.shape
+        return s.angle if s is not None else 0.0
+
+    @property
+    def vel(self):
+        return self.player.velocity
+
+    @property
+    def step(self) -> int:
+        return self.player.step
+
+    @property
+    def total_steps(self) -> int:
+        return self.player.total_steps
+
+    @property
+    def done(self) -> bool:
+        return self.player.done
+
+    @property
+    def params(self) -> Params:
+        """The panel's view of the replayed scene now (wind, viscosity, grid, body, models);
+        rebuilt only when the player has applied events since (the viewport reads it many
+        times a frame)."""
+        key = self.player.events_done
+        cached = self._params_cache
+        if cached is None or cached[0] != key:
+            self._params_cache = cached = (key, self._build_params())
+        return cached[1]
+
+    def _build_params(self) -> Params:
+        from feelflow.app.model.bodies import params_for_shape
+
+        geometry = self.player.shape or self.player.geometry
+        kind, size = "cylinder", 0.0
+        if geometry is not None:
+            try:
+                kind, size, _ = params_for_shape(geometry)
+            except ValueError:
+                kind, size = "polygon", None
+            if size is None:   # a polygon: its extent
+                x0, y0, x1, y1 = geometry.bounding_box()
+                size = max(x1 - x0, y1 - y0)
+        models = [m for m in self.player.models if m in FORCE_MODELS] \
+            or [m for m in self.player.session.models if m in FORCE_MODELS] or ["momentum_exchange"]
+        cfg = self.config
+        return Params(grid=(cfg.nx, cfg.ny), shape=kind, size=float(size) or 1.0,
+                      angle_deg=math.degrees(self.angle), wind=self.player.inflow_speed,
+                      nu=self.player.solver.flow_config.nu, wall=cfg.y_boundary,
+                      force_model=models[0], compare_all=len(models) > 1)
+
+    def relative_wind(self):
+        vx, vy = self.player.velocity
+        return (self.player.inflow_speed - vx, -vy)
+
+    def reynolds(self) -> float:
+        p = self.params
+        return units.reynolds(p.wind, p.size, p.nu)
+
+    def mach(self) -> float:
+        return units.mach(self.player.inflow_speed)
+
+    def field_rgba(self):
+        return field_rgba(self.solver)
+
+    def script_phase(self):
+        return None
+
+    def sweep_stage(self):
+        return None
+
+    # --- running ------------------------------------------------------------------------
+    def advance(self, n: int) -> dict:
+        """Replay n steps (SessionPlayer.advance, a long force row in parts: a session recorded
+        with one row per 100 steps replays at the window's frame rate, not one frame per row);
+        returns {model: (fx, fy)} of the rows completed, averaged over them, like
+        Simulation.advance (the last ones while a row is still in parts). `last_steps` says how
+        many ran."""
+        first = len(self.player.rows)
+        self.last_steps = self.player.advance(max(1, int(n)), split_rows=self.split_rows)
+        rows = self.player.rows[first:]
+        acc: dict = {}
+        for row in rows:
+            vx, vy = (0.0, 0.0) if math.isnan(row.body[2]) else row.body[2:4]
+            self.history.add(row.step, (vx, vy), (row.inflow_speed - vx, -vy), row.forces)
+            for name, (fx, fy) in row.forces.items():
+                ax, ay = acc.get(name, (0.0, 0.0))
+                acc[name] = (ax + fx * row.n, ay + fy * row.n)
+        if rows:
+            steps = sum(r.n for r in rows)
+            self._last_forces = {k: (v[0] / steps, v[1] / steps) for k, v in acc.items()}
+        return self._last_forces
+
+    def close(self) -> None:
+        self.player.close()

@@ -1,0 +1,497 @@
+"""The running wind tunnel behind the window (Qt-free, so it is testable on its own):
+the solver, the body and its pose, the mouse coupling, the force models in use, and the
+force history the plot and readouts show. Lattice units (docs/algorithm.md).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from feelflow.app.model.coupling import AngleSpring, SpringDamper
+from feelflow.solver import units
+from feelflow.app.sessions import SessionSolver
+from feelflow.solver.backend import create_solver
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.inflow import ramp
+from feelflow.solver.motion import MotionRunner
+from feelflow.solver.stability_limit import inside, min_stable_viscosity
+
+#: grid presets offered in the side panel: label -> (nx, ny)
+GRID_PRESETS = {
+    "192 x 96 (fast)": (192, 96),
+    "256 x 128 (default)": (256, 128),
+    "384 x 192": (384, 192),
+    "512 x 256 (fine)": (512, 256),
+}
+DEFAULT_GRID = (256, 128)
+
+#: force models a student chooses between: registry name -> label
+FORCE_MODELS = {
+    "momentum_exchange": "Momentum exchange",
+    "macroscopic": "Macroscopic (drag equation)",
+    "pressure": "Pressure integration",
+}
+
+#: y-boundaries offered as "wall type": config value -> label
+WALLS = {"no_slip": "Solid walls (no slip)", "free_slip": "Slippery walls (free slip)",
+         "periodic": "No walls (periodic)"}
+
+def default_base_config(grid) -> FlowConfig:
+    """What the panel does not edit: TRT, float32, an outlet sponge with its absorbing layer,
+    and the wind blowing everywhere from the first step (initial velocity = inflow, no ramp).
+    Ramping the inlet up from fluid at rest excites a slow slosh of the whole tunnel, its
+    quarter-wave sound mode (mean u swings +-60 % of U with a 1000-step ramp, +-6 % with 2000,
+    measured at 256 x 128); starting in uniform flow keeps the mean within +-4 % from the start.
+    The absorbing layer (sponge_absorb, docs/algorithm.md step 3) lets that sound out: after a
+    1000-step ramp at 256 x 128 the mean u swings by 0.3 % of U instead of 46 % (a test,
+    tests/test_solver_boundaries.py), so a change of wind settles at once."""
+    nx, ny = grid
+    return FlowConfig(nx=nx, ny=ny, dtype="float32", inflow_ramp_steps=0, sponge_cells=32, sponge_absorb=0.1)
+
+
+#: distance (cells) the body's bounding box keeps from the domain edges
+EDGE_MARGIN = 8.0
+
+
+@dataclass
+class Params:
+    """What the side panel edits (lattice units; angle in degrees)."""
+
+    grid: tuple[int, int] = DEFAULT_GRID
+    shape: str = "cylinder"
+    size: float = 20.0
+    angle_deg: float = 0.0
+    wind: float = 0.05
+    nu: float = 0.02
+    wall: str = "no_slip"
+    force_model: str = "momentum_exchange"
+    compare_all: bool = False
+
+
+@dataclass
+class History:
+    """One sample per frame: step, body velocity, relative wind, force of each model in use, and
+    whether the sample is *settled*: the relative wind has stayed within `WIND_TOLERANCE` of its
+    value for at least `SETTLE_STEPS` steps. Only settled samples are steady drag; the
+    drag-against-speed view fits those (app/force_plot.py). SETTLE_STEPS was chosen from a probe
+    of the 'Drag grows with speed' lesson (fifth session, not a command: indicative only): 750
+    steps after a wind change had finished, the drag's 250-step means stayed within 5 % of the
+    hold's end value at every wind of the sweep, while the first few hundred steps carry the
+    acceleration's added-mass force and the flow's rearrangement (up to +60 %). What the choice
+    gives is measured by `feelflow report lessons` (README 'Lessons': the fitted exponent)."""
+
+    time: list = field(default_factory=list)
+    body_velocity: list = field(default_factory=list)
+    wind: list = field(default_factory=list)
+    forces: dict = field(default_factory=dict)  # model -> list of (Fx, Fy)
+    settled: list = field(default_factory=list)
+    _wind_ref: tuple = (math.nan, math.nan)      # relative wind when it last changed, and when
+    _since: float = 0.0
+
+    MAX = 20000
+    SETTLE_STEPS = 1000
+    WIND_TOLERANCE = 0.02
+
+    def add(self, time, body_velocity, wind, forces):
+        self.time.append(time)
+        self.body_velocity.append(body_velocity)
+        self.wind.append(wind)
+        self.settled.append(self._settled(time, wind))
+        for name, f in forces.items():
+            series = self.forces.setdefault(name, [])
+            series.extend([(math.nan, math.nan)] * (len(self.time) - 1 - len(series)))
+            series.append(f)
+        if len(self.time) > self.MAX:
+            cut = len(self.time) - self.MAX
+            del self.time[:cut], self.body_velocity[:cut], self.wind[:cut], self.settled[:cut]
+            for series in self.forces.values():
+                del series[:max(0, len(series) - self.MAX)]
+
+    def _settled(self, time, wind) -> bool:
+        ref = self._wind_ref
+        scale = max(math.hypot(*ref), math.hypot(*wind), 1e-9) if all(map(math.isfinite, ref)) else 0.0
+        if not scale or math.hypot(wind[0] - ref[0], wind[1] - ref[1]) > self.WIND_TOLERANCE * scale:
+            self._wind_ref, self._since = tuple(wind), time
+        return time - self._since >= self.SETTLE_STEPS
+
+    def clear(self):
+        self.time.clear(), self.body_velocity.clear(), self.wind.clear(), self.forces.clear()
+        self.settled.clear()
+        self._wind_ref, self._since = (math.nan, math.nan), 0.0
+
+    def __len__(self):
+        return len(self.time)
+
+    def drag_lift(self, model: str):
+        """(t, drag, lift) arrays: force along and across the relative wind (NaN where absent)."""
+        n = len(self.time)
+        series = self.forces.get(model, [])
+        f = np.full((n, 2), np.nan)
+        if series:
+            f[n - len(series):] = np.asarray(series[-n:], float)
+        w = np.asarray(self.wind, float).reshape(n, 2)
+        along = drag_direction(w)
+        drag = (f * along).sum(axis=1)
+        lift = f[:, 1] * along[:, 0] - f[:, 0] * along[:, 1]
+        return np.asarray(self.time, float), drag, lift
+
+
+def drag_direction(wind):
+    """Unit vectors along the relative wind (+x where the relative wind is ~0)."""
+    w = np.atleast_2d(np.asarray(wind, float))
+    s = np.hypot(w[:, 0], w[:, 1])
+    out = np.tile([1.0, 0.0], (len(w), 1))
+    ok = s > 1e-9
+    out[ok] = w[ok] / s[ok, None]
+    return out
+
+
+def wrap_degrees(degrees: float) -> float:
+    """An angle in [-180, 180): what the panel's angle box shows for any number of turns."""
+    return (degrees + 180.0) % 360.0 - 180.0
+
+
+def phase_name(velocity, wind: float) -> str:
+    """Plain words for a scripted phase (SEED-NOTES 'Experiments')."""
+    vx, vy = velocity
+    if vx == 0.0 and vy == 0.0:
+        return "stopped"
+    if wind and vy == 0.0:
+        return "moving with the stream" if vx * wind > 0 else "moving against the stream"
+    return f"moving at ({vx:.3f}, {vy:.3f})"
+
+
+def stable_params(params: Params, collision: str) -> tuple[Params, str | None]:
+    """`params` kept inside the measured stable region (solver/stability_limit.py): where the
+    wind and body size over the viscosity, U sqrt(d) / nu, exceed what the scheme survives, the viscosity
+    is raised to the limit (the wind is what the student sees and feels, and what the lessons
+    step through; viscosity is the scheme's stability lever). Returns (params, plain sentence
+    for the status bar, or None when nothing changed)."""
+    if inside(params.wind, params.nu, collision, params.size):
+        return params, None
+    nu = math.ceil(min_stable_viscosity(params.wind, collision, params.size) * 1e4 - 1e-6) / 1e4   # 4 decimals
+    return replace(params, nu=nu), (f"Viscosity raised to {nu:.4f}: at wind {params.wind:.3f} past a "
+                                    f"{params.size:g}-cell body a thinner fluid makes this grid unstable "
+                                    f"(lower the wind or the size to go thinner).")
+
+
+class Simulation:
+    """Owns the solver and the body; `advance(n)` runs n steps and records one force sample.
+    The wind and viscosity it is given stay inside the measured stable region (`stable_params`);
+    `guard_note` says what the last change had to adjust (None when nothing).
+
+    A wind sweep (`start_sweep`, the 'Drag grows with speed' lesson) spreads each change of wind
+    over `SWEEP_SLEW_STEPS`: a sudden change sends a pressure pulse (rho c_s dU) through the
+    tunnel that rings between the walls, across the stream, where the outlet's absorbing layer
+    cannot take it out; 500 steps is a little more than that ringing's period at the lessons'
+    128 rows (2 ny / c_s = 443 steps). Measured (`feelflow report lessons --compare`, README
+    'Lessons'): the drag's scatter over the second half of each hold falls severalfold."""
+
+    SWEEP_SLEW_STEPS = 500
+
+    def __init__(self, params: Params | None = None, backend: str = "numpy", ctx=None, shape_factory=None,
+                 base_config: FlowConfig | None = None):
+        from feelflow.app.model.bodies import make_shape
+
+        self.params = params or Params()
+        self.backend = backend
+        self.ctx = ctx
+        self.make_shape = shape_factory or make_shape
+        self.polygon = None          # vertices of the custom polygon (body frame), or None
+        self.history = History()
+        self.hold_still = False
+        self.target = None           # where the mouse pulls the body, or None
+        self.angle_target = math.radians(self.params.angle_deg)
+        self._asked = (None, None)   # (degrees, radians) of the last turn_to: see target_degrees
+        self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
+        self.base_config = base_config or default_base_config(self.params.grid)
+        self._wind_starts_everywhere = base_config is None   # default tunnel: no ramp, see below
+        self.params, self.guard_note = stable_params(self.params, self.base_config.collision)
+        self.sweep = None            # (wind speeds, steps each, first step): a wind-speed sweep
+        self.sweep_slew_steps = self.SWEEP_SLEW_STEPS
+        self.capped = False          # the Mach cap limited the body's speed in the last frame
+        self.solver = None
+        self._build(keep_flow=False)
+
+    # --- construction --------------------------------------------------------------------
+    def flow_config(self, params: Params | None = None) -> FlowConfig:
+        """The base configuration (scene or default) with what the panel edits."""
+        p = params or self.params
+        nx, ny = p.grid
+        base = self.base_config
+        extra = {"initial_velocity": (p.wind, 0.0)} if self._wind_starts_everywhere else {}
+        return replace(base, nx=nx, ny=ny, nu=p.nu, inflow_speed=p.wind, y_boundary=p.wall,
+                       sponge_cells=min(base.sponge_cells, nx // 4), **extra).validate()
+
+    def _build(self, keep_flow: bool):
+        config = self.flow_config()
+        same_grid = self.solver is not None and (self.solver.config.nx, self.solver.config.ny) == (config.nx, config.ny)
+        if self.solver is None:   # one SessionSolver for the life of the window (app/session.py)
+            backend = create_solver(self.backend, config, **({"ctx": self.ctx} if self.backend == "gl" else {}))
+            self.solver = SessionSolver(backend)
+        else:                     # recorded as a rebuild when a session is being recorded
+            self.solver.rebuild(config, keep_flow=keep_flow and same_grid)
+        if not (keep_flow and same_grid):
+            nx, ny = config.nx, config.ny
+            self.pos, self.vel = (nx * 0.3, ny * 0.5), (0.0, 0.0)
+            self.angle, self.rate = math.radians(self.params.angle_deg), 0.0
+            self.angle_target = self.angle
+            self.target = None
+            self.history.clear()
+        if self.runner is not None and not keep_flow:
+            self.runner = None
+        self.config = config
+        self.coupling = SpringDamper(max_speed=config.max_speed)
+        if not keep_flow or not hasattr(self, "shape"):
+            self.shape = self.make_shape(self.params, self.polygon, *self.pos, self.angle).validate(config.nx, config.ny)
+        self._clamp_pose()
+        self._enable_models()
+        self.solver.set_body(self.shape, self.vel, 0.0)
+
+    def _enable_models(self):
+        names = list(FORCE_MODELS) if self.params.compare_all else [self.params.force_model]
+        self.solver.enable_force_models(names)
+
+    # --- what the panel changes ------------------------------------------------------------
+    def set_shape(self, kind=None, size=None, angle_deg=None, polygon=None):
+        """Change the body; raises shapes' ShapeError (one line) and keeps the old body if invalid."""
+        params = replace(self.params, **{k: v for k, v in
+                                          (("shape", kind), ("size", size), ("angle_deg", angle_deg)) if v is not None})
+        poly = self.polygon if polygon is None else polygon
+        angle = math.radians(params.angle_deg) if angle_deg is not None else self.angle
+        shape = self.make_shape(params, poly, *self.pos, angle).validate(self.config.nx, self.config.ny)
+        self.params, self.polygon, self.shape = params, poly, shape
+        self.angle = self.angle_target = angle
+        self._clamp_pose()
+        self.solver.set_body(self.shape, self.vel, 0.0)
+        guarded, note = stable_params(self.params, self.base_config.collision)
+        if note:   # a larger body needs a thicker fluid at this wind
+            self.set_flow(nu=guarded.nu)
+        self.guard_note = note
+
+    def set_flow(self, wind=None, nu=None, wall=None):
+        """Change inflow speed, viscosity or walls, keeping the flow as it is (raises ConfigError)."""
+        params = replace(self.params, **{k: v for k, v in (("wind", wind), ("nu", nu), ("wall", wall)) if v is not None})
+        params, self.guard_note = stable_params(params, self.base_config.collision)
+        self.flow_config(params)  # validate first: a bad value leaves everything as it was
+        only_wind = (params.nu, params.wall) == (self.params.nu, self.params.wall)
+        self.params = params
+        if only_wind and hasattr(self.solver, "set_inflow_speed"):
+            self.solver.set_inflow_speed(params.wind)   # live, no rebuild
+        else:
+            self._build(keep_flow=True)
+
+    def set_grid(self, grid):
+        self.params = replace(self.params, grid=tuple(grid))
+        self._build(keep_flow=False)
+
+    def set_force_models(self, selected=None, compare_all=None):
+        self.params = replace(self.params, **{k: v for k, v in
+                                              (("force_model", selected), ("compare_all", compare_all)) if v is not None})
+        self._enable_models()
+
+    def reset_flow(self):
+        """The flow from its initial state again (time 0), body where it was, at rest; history cleared."""
+        self.solver.reset()
+        self.runner = self.sweep = None
+        self.vel, self.rate, self.target = (0.0, 0.0), 0.0, None
+        self.angle_target = self.angle
+        self.shape = self.shape.moved(*self.pos, self.angle)
+        self.solver.set_body(self.shape, (0.0, 0.0), 0.0)
+        self.history.clear()
+
+    def start_sweep(self, speeds, hold_steps: int):
+        """Hold each wind speed `hold_steps` steps in turn (the 'drag grows with speed' lesson);
+        the first one from the end of the inlet's start-up ramp, if it is still rising."""
+        start = max(self.solver.time, self.config.inflow_ramp_steps)
+        self.sweep = (tuple(speeds), int(hold_steps), start)
+        self.set_flow(wind=speeds[0])
+
+    def sweep_end(self):
+        """The step at which the sweep ends (None without a sweep)."""
+        if self.sweep is None:
+            return None
+        speeds, hold, start = self.sweep
+        return start + len(speeds) * hold
+
+    def sweep_stage(self):
+        if self.sweep is None:
+            return None
+        speeds, hold, start = self.sweep
+        k = max(0, self.solver.time - start) // hold
+        return k if k < len(speeds) else None
+
+    def sweep_wind(self):
+        """The sweep's wind now: each step to the next speed is spread over `SWEEP_SLEW_STEPS`
+        (linear), not made at once; None when the sweep is over."""
+        k = self.sweep_stage()
+        if k is None:
+            return None
+        speeds, hold, start = self.sweep
+        if k == 0 or self.sweep_slew_steps <= 0:
+            return speeds[k]
+        frac = min(1.0, (self.solver.time - start - k * hold) / self.sweep_slew_steps)
+        return speeds[k - 1] + frac * (speeds[k] - speeds[k - 1])
+
+    def start_script(self, script):
+        """Drive the body through a solver.motion.MotionScript (mouse and hold-still ignored)."""
+        self.shape = self.shape.moved(*self.pos, self.angle)
+        self.runner = MotionRunner(self.solver, self.shape, script)
+
+    def script_phase(self):
+        """(phase index, count, words) of the running script, or None."""
+        r = self.runner
+        if r is None:
+            return None
+        start = 0
+        for k, phase in enumerate(r.script.phases):
+            if r.t < start + phase.steps:
+                return k, len(r.script.phases), phase_name(phase.velocity, self.params.wind)
+            start += phase.steps
+        return None
+
+    def load_scene(self, scene):
+        """Take grid, flow, body, pose and motion from an app.scene.Scene."""
+        from feelflow.app.model.bodies import params_for_shape
+
+        kind, size, verts = params_for_shape(scene.body)
+        cfg = scene.config
+        models = [m for m in scene.force_models if m in FORCE_MODELS] or [self.params.force_model]
+        self.base_config = cfg
+        self._wind_starts_everywhere = False
+        self.params = replace(self.params, grid=(cfg.nx, cfg.ny), shape=kind, size=size or self.params.size,
+                              angle_deg=math.degrees(scene.body.angle), wind=cfg.inflow_speed, nu=cfg.nu,
+                              wall=cfg.y_boundary, force_model=models[0], compare_all=len(models) > 1)
+        self.params, self.guard_note = stable_params(self.params, cfg.collision)
+        self.polygon = verts
+        self.runner = None
+        self.sweep = None
+        self._build(keep_flow=False)
+        self.pos = (scene.body.x, scene.body.y)
+        self.shape = self.shape.moved(*self.pos, self.angle)
+        self._clamp_pose()
+        self.solver.set_body(self.shape, (0.0, 0.0), 0.0)
+        if scene.motion.phases:
+            self.start_script(scene.motion)
+
+    # --- mouse ----------------------------------------------------------------------------
+    def hit(self, x: float, y: float, tolerance: float = 2.0) -> bool:
+        """Is the lattice point (x, y) on the body (or within `tolerance` cells of it)?"""
+        px = x + np.array([0, -1, 1, 0, 0]) * tolerance
+        py = y + np.array([0, 0, 0, -1, 1]) * tolerance
+        return bool(np.any(self.shape.contains(px, py)))
+
+    def turn_to(self, degrees: float):
+        """Ask for the angle `degrees` (any turn count: 190 turns 20 from 170, not 340 back):
+        the body swings there through the angle spring (rate capped below the Mach limit), and
+        the panel's angle (params.angle_deg, wrapped to [-180, 180)) says where it is going."""
+        self.angle_target = math.radians(degrees)
+        self.params = replace(self.params, angle_deg=wrap_degrees(degrees))
+        self._asked = (degrees, self.angle_target)
+
+    def target_degrees(self) -> float:
+        """The angle the body is asked to turn to, in degrees (any number of turns), exactly as it
+        was asked (by `turn_to` or the panel) where it was: radians -> degrees -> radians is not
+        exact in floating point, and an undo must give back the very angle it took away."""
+        asked, radians = self._asked
+        if radians == self.angle_target:
+            return asked
+        if math.radians(self.params.angle_deg) == self.angle_target:
+            return self.params.angle_deg
+        return math.degrees(self.angle_target)
+
+    # --- running --------------------------------------------------------------------------
+    def relative_wind(self):
+        """The wind the body meets: the inlet's speed now (on its start-up ramp, solver/inflow.py)
+        less the body's velocity."""
+        wind = self.params.wind * ramp(self.solver.time, self.config.inflow_ramp_steps)
+        return (wind - self.vel[0], -self.vel[1])
+
+    def advance(self, n: int):
+        """Run n steps, moving the body in chunks of at most half a cell; record a sample."""
+        n = max(1, int(n))
+        if self.sweep is not None:
+            wind = self.sweep_wind()
+            if wind is None:
+                self.sweep = None
+            elif wind != self.params.wind:
+                self.set_flow(wind=wind)
+        done = 0
+        acc = {}
+        self.capped = False
+        if self.runner is not None:
+            acc = {k: (fx * n, fy * n) for k, (fx, fy) in self.runner.advance(n).items()}
+            r = self.runner
+            self.pos, self.shape = r.position, r.shape
+            self.vel = r.script.velocity_at(r.t - 1)
+            if r.t >= r.script.total_steps:
+                self.runner = None
+                self.vel = (0.0, 0.0)
+            done = n
+        while done < n:
+            speed = math.hypot(*self.vel)
+            chunk = n - done if speed < 1e-9 else max(1, min(n - done, int(0.5 / speed)))
+            self._move_body(chunk)
+            self.solver.step(chunk)   # raises solver.backend.SolverDiverged when the flow blows up
+            self.capped |= bool(getattr(self.solver, "speed_capped", False))
+            for name, (fx, fy) in self.solver.forces().items():
+                ax, ay = acc.get(name, (0.0, 0.0))
+                acc[name] = (ax + fx * chunk, ay + fy * chunk)
+            done += chunk
+        forces = {k: (v[0] / n, v[1] / n) for k, v in acc.items()}
+        self.history.add(self.solver.time, self.vel, self.relative_wind(), forces)
+        return forces
+
+    def _move_body(self, steps: int):
+        old = (self.pos, self.angle)
+        if self.hold_still:
+            self.vel = (0.0, 0.0)
+        else:
+            self.pos, self.vel, capped = self.coupling.advance(self.pos, self.vel, self.target, steps)
+            self.capped |= capped
+        omega_before = self.rate
+        if not self.hold_still:
+            self.angle, self.rate = AngleSpring().advance(self.angle, self.rate, self.angle_target, steps) \
+                if (self.angle != self.angle_target or self.rate) else (self.angle, 0.0)
+        if self._clamp_pose():
+            self.vel = (0.0 if self._clamped_x else self.vel[0], 0.0 if self._clamped_y else self.vel[1])
+        if (self.pos, self.angle) != old or omega_before:
+            self.shape = self.shape.moved(*self.pos, self.angle)
+            self.solver.set_body(self.shape, self.vel, self.rate)
+
+    def _clamp_pose(self) -> bool:
+        """Keep the body EDGE_MARGIN cells inside the domain; True if it had to be pushed back."""
+        shape = self.shape.moved(*self.pos, self.angle)
+        x0, y0, x1, y1 = shape.bounding_box()
+        nx, ny = self.config.nx, self.config.ny
+        dx = max(0.0, EDGE_MARGIN - x0) - max(0.0, x1 - (nx - 1 - EDGE_MARGIN))
+        dy = max(0.0, EDGE_MARGIN - y0) - max(0.0, y1 - (ny - 1 - EDGE_MARGIN))
+        self._clamped_x, self._clamped_y = dx != 0, dy != 0
+        if dx or dy:
+            self.pos = (self.pos[0] + dx, self.pos[1] + dy)
+            self.shape = shape.moved(*self.pos, self.angle)
+            return True
+        return False
+
+    # --- what the window shows -----------------------------------------------------------
+    def reynolds(self) -> float:
+        """Re of the wind over the body size (solver/units.py)."""
+        return units.reynolds(self.params.wind, self.params.size, self.params.nu)
+
+    def mach(self) -> float:
+        return units.mach(self.params.wind)
+
+    def field_rgba(self) -> np.ndarray:
+        return field_rgba(self.solver)
+
+
+def field_rgba(solver) -> np.ndarray:
+    """(ny, nx, 4) float32: rho, ux, uy, vorticity of `solver`'s flow (numpy path; the gl
+    backend has a texture)."""
+    rho, ux, uy = solver.macroscopic()
+    out = np.empty(rho.shape + (4,), np.float32)
+    out[..., 0], out[..., 1], out[..., 2] = rho, ux, uy
+    out[..., 3] = np.gradient(uy, axis=1) - np.gradient(ux, axis=0)
+    return out

@@ -1,0 +1,150 @@
+"""Recording a session: the scene, every input, every parameter change and the force series,
+stamped with the session step (docs/sessions.md). `SessionSolver` (driver.py) feeds a
+recorder as a side effect of being driven. Qt-free."""
+from __future__ import annotations
+
+import json
+import math
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+
+from feelflow.app.sessions.format import (FORMAT, PARAMETER_NAMES, VERSION, Session, config_to_dict,
+                                          feelflow_version, force_columns, save_session)
+from feelflow.solver.config import FlowConfig
+
+
+# --- recording --------------------------------------------------------------------------------
+
+class SessionRecorder:
+    """Collects a session: the scene, inputs, parameter changes and the force series.
+
+    Events are stamped with the recorder's clock `step` (session steps so far); `record_forces`
+    advances it. The optional `step=` arguments are checks: they must equal the clock (inputs,
+    parameters) or the clock + n (forces). Normally `SessionSolver` feeds a recorder; a caller
+    that drives its own solver may call the record_* methods in the order it drives it.
+    """
+
+    def __init__(self, config: FlowConfig, body=None, force_models=(), *, backend: str = "numpy",
+                 renderer: str | None = None, scene_toml: str | None = None,
+                 scene_source: str | None = None, scene_dict: dict | None = None):
+        self.config = config.validate()
+        self.body = body
+        self.force_models = tuple(force_models)
+        self.backend = backend
+        self.renderer = renderer or ("none (numpy on the CPU)" if backend == "numpy" else "unknown")
+        self.scene_toml = scene_toml
+        self.scene_source = scene_source
+        self.scene_dict = scene_dict
+        self.created = datetime.now(timezone.utc).isoformat(timespec="seconds")
+        self.step = 0
+        self._seq = 0
+        self._inputs: list[tuple] = []   # (seq, step, x, y, angle, vx, vy, omega)
+        self._parameters: list[dict] = []
+        self._forces: list[tuple] = []   # (seq, step, n, (x, y, vx, vy), {model: (fx, fy)})
+        self._models: list[str] = list(self.force_models)
+        #: set by SessionSolver.start_recording: how the running flow was when recording began
+        self.start: dict | None = None
+        self.state: np.ndarray | None = None  # its populations f (9, ny, nx)
+
+    @classmethod
+    def from_scene(cls, scene, *, scene_toml: str | None = None, backend: str | None = None,
+                   renderer: str | None = None) -> "SessionRecorder":
+        """A recorder for an `feelflow.app.model.scene.Scene` (anything with config, body, force_models,
+        backend, source)."""
+        return cls(scene.config, scene.body, scene.force_models, backend=backend or scene.backend,
+                   renderer=renderer, scene_toml=scene_toml, scene_source=getattr(scene, "source", None))
+
+    def _stamp(self, step) -> tuple[int, int]:
+        if step is not None and int(step) != self.step:
+            raise ValueError(f"event at step {step}, but the recorder is at step {self.step}")
+        seq = self._seq
+        self._seq += 1
+        return seq, self.step
+
+    def record_input(self, x, y, angle=0.0, vx=0.0, vy=0.0, omega=0.0, *, step=None) -> None:
+        """A body pose (x, y, angle) and commanded motion (vx, vy, omega), lattice units."""
+        values = tuple(float(v) for v in (x, y, angle, vx, vy, omega))
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError(f"input sample {values} is not finite")
+        seq, t = self._stamp(step)
+        self._inputs.append((seq, t) + values)
+
+    def record_parameter(self, name: str, value=None, *, step=None) -> None:
+        """A parameter change (PARAMETER_NAMES; docs/sessions.md says what each value is)."""
+        if name not in PARAMETER_NAMES:
+            raise ValueError(f"unknown parameter {name!r}; one of {', '.join(PARAMETER_NAMES)}")
+        if name == "body" and value is not None and not isinstance(value, dict):
+            value = value.to_dict()
+        if name == "force_models":
+            value = list(value)
+        json.dumps(value, allow_nan=False)  # must be plain JSON
+        seq, t = self._stamp(step)
+        self._parameters.append({"seq": seq, "step": t, "name": name, "value": value})
+
+    def record_forces(self, n: int, forces: dict, body=(math.nan,) * 4, *, step=None) -> None:
+        """`forces` {model: (fx, fy)} averaged over the last n steps; body (x, y, vx, vy) then."""
+        n = int(n)
+        if n < 1:
+            raise ValueError(f"a force row covers at least one step, got n = {n}")
+        if step is not None and int(step) != self.step + n:
+            raise ValueError(f"force row at step {step}, but the recorder is at {self.step} + {n}")
+        seq = self._seq
+        self._seq += 1
+        self.step += n
+        for name in forces:
+            if name not in self._models:
+                self._models.append(name)
+        self._forces.append((seq, self.step, n, tuple(float(v) for v in body),
+                             {k: (float(v[0]), float(v[1])) for k, v in forces.items()}))
+
+    def rows(self, start: int = 0) -> list[tuple]:
+        """Force rows recorded so far, from the `start`-th: (step, n, body, {model: (fx, fy)})."""
+        return [(step, n, body, dict(forces)) for _, step, n, body, forces in self._forces[start:]]
+
+    # --- output ---------------------------------------------------------------
+    def session(self) -> "Session":
+        """The recording so far as a `Session` (what `load_session` would return)."""
+        ni, nf = len(self._inputs), len(self._forces)
+        inp = np.array(self._inputs, dtype=np.float64).reshape(ni, 8)
+        values = np.full((nf, 2 * len(self._models)), np.nan)
+        for r, (_, _, _, _, forces) in enumerate(self._forces):
+            for name, (fx, fy) in forces.items():
+                k = self._models.index(name)
+                values[r, 2 * k:2 * k + 2] = fx, fy
+        return Session(
+            manifest=self._manifest(),
+            config=self.config, body=self.body, backend=self.backend,
+            force_models=self.force_models,
+            inputs={"seq": np.array([r[0] for r in self._inputs], dtype=np.int64),
+                    "step": np.array([r[1] for r in self._inputs], dtype=np.int64),
+                    "pose": np.ascontiguousarray(inp[:, 2:5]), "velocity": np.ascontiguousarray(inp[:, 5:8])},
+            parameters=[dict(p) for p in self._parameters],
+            forces={"seq": np.array([r[0] for r in self._forces], dtype=np.int64),
+                    "step": np.array([r[1] for r in self._forces], dtype=np.int64),
+                    "n": np.array([r[2] for r in self._forces], dtype=np.int64),
+                    "body": np.array([r[3] for r in self._forces], dtype=np.float64).reshape(nf, 4),
+                    "values": values},
+            models=tuple(self._models), start=self.start, state=self.state,
+        )
+
+    def _manifest(self) -> dict:
+        scene = {"source": self.scene_source, "toml": self.scene_toml,
+                 "config": config_to_dict(self.config),
+                 "body": self.body.to_dict() if self.body is not None else None,
+                 "force_models": list(self.force_models)}
+        if self.scene_dict is not None:
+            scene["dict"] = json.loads(json.dumps(self.scene_dict, default=str))
+        return {
+            "format": FORMAT, "version": VERSION, "feelflow_version": feelflow_version(),
+            "created": self.created, "backend": self.backend, "renderer": self.renderer,
+            "scene": scene, "start": self.start,
+            "forces": {"models": list(self._models), "columns": force_columns(self._models)},
+            "counts": {"inputs": len(self._inputs), "parameters": len(self._parameters),
+                       "forces": len(self._forces), "steps": self.step},
+        }
+
+    def save(self, path) -> Path:
+        """Write the session file atomically; SessionError (one line) if it cannot."""
+        return save_session(self.session(), path)
