@@ -1,9 +1,9 @@
 """The wind tunnel view: a QOpenGLWidget whose moderngl context colours the flow field
 (shaders/display*.glsl, colormaps from pyqtgraph), with the body, its force arrows, tracers,
-the colour bar, the polygon editor's handles and the rotation handle (app/turn_handle.py)
+the colour bar, the polygon editor's handles and the rotation handle (app/gui/turn_handle.py)
 painted on top with QPainter.
 
-GL pitfalls handled here (shared/notes/gl-qt-on-this-machine.md): detect_framebuffer in every
+GL pitfalls handled here: detect_framebuffer in every
 paintGL, enable_only(NOTHING) before any pass, every texture bound before every draw.
 """
 from __future__ import annotations
@@ -20,6 +20,7 @@ from PySide6.QtOpenGLWidgets import QOpenGLWidget
 from PySide6.QtWidgets import QToolTip
 
 from feelflow.app.gui import turn_handle
+from feelflow.app.model.tunnel import TunnelModel
 from feelflow import SHADER_DIR
 from feelflow.solver import units
 from feelflow.solver.lattice import glsl_constants
@@ -61,10 +62,14 @@ def load_shader(name: str) -> str:
 
 
 class Viewport(QOpenGLWidget):
-    """Shows `sim` (an app.simulation.Simulation, set by the window once the context exists)."""
+    """Shows `sim`, a `TunnelModel` (the live tunnel or a replay, set by the window once the
+    context exists). It never changes the model: the mouse's requests leave as signals
+    (`bodyPulled`, `turnRequested`, `wheelTurned`, `polygonEdited`) for the window's
+    controllers (app/gui/window/)."""
 
     contextReady = Signal(object)   # the moderngl.Context, once initializeGL ran
     bodyGrabbed = Signal(bool)
+    bodyPulled = Signal(object)     # a drag pulls the body to (x, y) lattice cells; None lets go
     polygonEdited = Signal(object)  # new vertex list (body frame) from the editor handles
     inputRefused = Signal()         # a press or wheel turn while `locked` (a replay shows)
     turnRequested = Signal(float)   # the rotation handle asks for this body angle (degrees, any turns)
@@ -74,7 +79,7 @@ class Viewport(QOpenGLWidget):
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        self.sim = None
+        self.sim: TunnelModel | None = None
         self.ctx = None
         self.mode = "speed"
         self.show_arrows = True
@@ -537,6 +542,10 @@ class Viewport(QOpenGLWidget):
         return None
 
     # --- mouse --------------------------------------------------------------------------------
+    def cancel_drag(self):
+        """Forget a drag of the body in progress (a replay takes over the view)."""
+        self._grab = None
+
     def mousePressEvent(self, ev):
         if self.sim is None:
             return
@@ -566,7 +575,7 @@ class Viewport(QOpenGLWidget):
             return
         if ev.button() == Qt.LeftButton and self.sim.hit(x, y):
             self._grab = (self.sim.pos[0] - x, self.sim.pos[1] - y)
-            self.sim.target = (x + self._grab[0], y + self._grab[1])
+            self.bodyPulled.emit((x + self._grab[0], y + self._grab[1]))
             self.bodyGrabbed.emit(True)
             self._set_hover(hover)
             self.update()
@@ -585,7 +594,7 @@ class Viewport(QOpenGLWidget):
             self._edit_preview[self._edit_vertex] = self.world_to_body(x, y)
             self.update()
         elif self._grab is not None:
-            self.sim.target = (x + self._grab[0], y + self._grab[1])
+            self.bodyPulled.emit((x + self._grab[0], y + self._grab[1]))
         elif not ev.buttons():
             self._set_hover(self._hover_at(ev.position()))
 
@@ -601,7 +610,7 @@ class Viewport(QOpenGLWidget):
             self.polygonEdited.emit(verts)
         elif self._grab is not None:
             self._grab = None
-            self.sim.target = None
+            self.bodyPulled.emit(None)
             self.bodyGrabbed.emit(False)
             self._set_hover(self._hover_at(ev.position()))
 

@@ -54,7 +54,7 @@ def replay_when_ready(window, path) -> None:
     (`MainWindow.start_replay` needs it; a bad file is its one-line dialog)."""
     def start():
         window.simulationReady.disconnect(start)
-        window.start_replay(path)
+        window.replays.start(path)
     window.simulationReady.connect(start)
 
 
