@@ -62,7 +62,7 @@ def test_space_presses_a_tabbed_to_check_box_and_pauses_after_a_click(window, qt
     assert not panel.hold_still.isChecked()
     assert not panel.hold_still.hasFocus()
     QTest.keyClick(QApplication.focusWidget(), Qt.Key_Space)
-    assert window.loop.paused                                        # Space is Pause / run again
+    assert window.loop.paused                                   # Space is Pause / run again
 
 
 def test_editing_the_polygon_says_how_in_the_status_bar(window):

@@ -177,7 +177,7 @@ def test_gl_window_replays_in_its_own_context(qtbot, tmp_path, monkeypatch):
         if done:
             split_ends.append(driver.clock)
         return done
-    driver.step_part = counting_step_part   # before the first frame: start_replay only queued it
+    driver.step_part = counting_step_part   # before the first frame: replays.start only queued it
     qtbot.waitUntil(lambda: replay.done, timeout=30000)
     assert w.viewport.field_texture is replay.solver.field_texture()
     values = replayed_values(replay.history, session.models)

@@ -189,7 +189,7 @@ def test_a_burst_of_wheel_notches_is_one_undo_step(window, qtbot):
     from feelflow.app.gui.turn_handle import BURST_S
 
     sim = at_57_degrees(window)
-    window.loop.set_paused(True)                                        # paused: each notch turns it at once
+    window.loop.set_paused(True)                                   # paused: each notch turns it at once
     mask, steps = solid_mask(sim), window.undo.count()
     for _ in range(5):
         wheel(window, 1)

@@ -177,7 +177,7 @@ def test_vertex_handles_move_add_delete_and_undo(window, qtbot):
 def test_screenshot_shows_the_body_where_it_is(window, qtbot, tmp_path):
     from PySide6.QtGui import QImage
 
-    from feelflow.app.gui.viewport import BODY_FILL
+    from feelflow.app.gui.overlay import BODY_FILL
 
     sim = window.sim
     window.panel.hold_still.setChecked(True)
@@ -352,7 +352,7 @@ def test_haptic_device_moves_the_body_feels_the_force_and_unplugging_falls_back_
     qtbot.waitUntil(lambda: window.sim.target is not None and dev.loop.status().samples > 5, timeout=20000)
     assert dev.loop.status().running
     assert dev.loop.status().running
-    window.inputs.stop_device_force()             # Esc: the force goes to zero at once
+    window.inputs.stop_device_force()      # Esc: the force goes to zero at once
     qtbot.waitUntil(lambda: dev.loop.status().state == "stopped" and dev.loop.status().force == (0.0, 0.0),
                     timeout=5000)
     dev.loop.simulate_unplug()             # the real disconnect path of the simulated board

@@ -34,7 +34,8 @@ make_none_immortal()  # before any Qt object: see app/gui/qt_runtime.py
 
 from feelflow.app.gui.force_plot import ForcePlot  # noqa: E402
 from feelflow.app.gui.side_panel import SidePanel  # noqa: E402
-from feelflow.app.gui.viewport import DISPLAY_MODES, MOUSE_HINT, Viewport  # noqa: E402
+from feelflow.app.gui.display_modes import DISPLAY_MODES  # noqa: E402
+from feelflow.app.gui.viewport import MOUSE_HINT, Viewport  # noqa: E402
 from feelflow.app.gui.window.bodies import BodyController  # noqa: E402
 from feelflow.app.gui.window.exports import ExportController  # noqa: E402
 from feelflow.app.gui.window.flow import FlowController  # noqa: E402

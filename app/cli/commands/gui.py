@@ -51,7 +51,7 @@ def set_surface_format():
 
 def replay_when_ready(window, path) -> None:
     """Replay the session at `path` once, when the window's live simulation first runs
-    (`MainWindow.start_replay` needs it; a bad file is its one-line dialog)."""
+    (`ReplayController.start`, app/gui/window/replay.py, needs it; a bad file is its one-line dialog)."""
     def start():
         window.simulationReady.disconnect(start)
         window.replays.start(path)

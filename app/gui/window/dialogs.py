@@ -13,7 +13,3 @@ def attempt(parent: QWidget, fn, title: str):
     except (OSError, ValueError) as exc:
         QMessageBox.warning(parent, title, str(exc))
         return None
-
-
-def warn(parent: QWidget, title: str, message) -> None:
-    QMessageBox.warning(parent, title, str(message))

@@ -13,7 +13,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QMenu, QToolBar
 
-from feelflow.app.gui.viewport import DISPLAY_MODES
+from feelflow.app.gui.display_modes import DISPLAY_MODES
 from feelflow.app.model.presets import PRESETS
 
 if TYPE_CHECKING:
