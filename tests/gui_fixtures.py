@@ -38,8 +38,8 @@ def window(qtbot, tmp_path):
     qtbot.waitUntil(lambda: w.sim is not None, timeout=20000)
     qtbot.waitUntil(lambda: w.sim.solver.time > 20, timeout=20000)
     yield w
-    w.timer.stop()
-    w.slow_timer.stop()
+    w.loop.timer.stop()
+    w.loop.slow_timer.stop()
 
 
 def solid_mask(sim):

@@ -33,7 +33,7 @@ def test_spin_boxes_show_their_units(window):
 def test_force_readouts_are_plain_decimals(window, qtbot):
     panel, sim = window.panel, window.sim
     qtbot.waitUntil(lambda: len(sim.history) > 30, timeout=20000)
-    window.refresh_readouts()
+    window.loop.refresh_readouts()
     for label in (panel.drag, panel.lift):
         number = label.text().split()[0]
         assert "e" not in number.lower(), label.text()
@@ -54,7 +54,7 @@ def test_space_presses_a_tabbed_to_check_box_and_pauses_after_a_click(window, qt
     assert panel.hold_still.hasFocus()
     QTest.keyClick(panel.hold_still, Qt.Key_Space)
     assert panel.hold_still.isChecked() and window.sim.hold_still
-    assert not window.paused
+    assert not window.loop.paused
 
     window.viewport.setFocus(Qt.MouseFocusReason)
     box = panel.hold_still
@@ -62,7 +62,7 @@ def test_space_presses_a_tabbed_to_check_box_and_pauses_after_a_click(window, qt
     assert not panel.hold_still.isChecked()
     assert not panel.hold_still.hasFocus()
     QTest.keyClick(QApplication.focusWidget(), Qt.Key_Space)
-    assert window.paused                                        # Space is Pause / run again
+    assert window.loop.paused                                   # Space is Pause / run again
 
 
 def test_editing_the_polygon_says_how_in_the_status_bar(window):

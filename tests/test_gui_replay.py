@@ -23,7 +23,7 @@ def record_in_window(window, qtbot, path, monkeypatch):
 
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(path), ""))
     vp, sim = window.viewport, window.sim
-    window.record_action.trigger()
+    window.actions.record.trigger()
     t0 = sim.solver.time
     send_mouse(vp, "press", vp.to_widget(*sim.pos))
     send_mouse(vp, "move", vp.to_widget(sim.pos[0] + 15, sim.pos[1] + 4))
@@ -32,7 +32,7 @@ def record_in_window(window, qtbot, path, monkeypatch):
     window.panel.wind.setValue(0.06)
     t1 = sim.solver.time
     qtbot.waitUntil(lambda: sim.solver.time > t1 + 40, timeout=20000)
-    window.record_action.trigger()
+    window.actions.record.trigger()
     assert path.exists()
 
 
@@ -58,10 +58,10 @@ def test_replay_in_the_window_and_stop_returns_to_the_live_tunnel(window, qtbot,
     before = (dataclasses.replace(live.params), live.shape, live.shape.to_dict(), live.config, live.pos)
     history_before = list(live.history.time)
     monkeypatch.setattr(QFileDialog, "getOpenFileName", lambda *a, **k: (str(path), ""))
-    window.replay_action.trigger()
-    replay = window.replay
+    window.actions.replay.trigger()
+    replay = window.replays.replay
     assert replay is not None and window.viewport.sim is replay and window.plot.sim is replay
-    assert window.viewport.locked and window.replay_toolbar.isVisible()
+    assert window.viewport.locked and window.actions.replay_toolbar.isVisible()
 
     # while it runs: progress in the status bar, the body at the recorded pose of the last row
     seen = []
@@ -73,8 +73,8 @@ def test_replay_in_the_window_and_stop_returns_to_the_live_tunnel(window, qtbot,
         return len(seen) >= 3
     qtbot.waitUntil(poses_follow_the_recording, timeout=20000)
     assert all(a == b for a, b in seen), seen[:3]
-    assert window.replay_label.text().startswith("Replaying lesson.ffsession: step ")
-    assert f"/ {session.steps}" in window.replay_label.text()
+    assert window.replays.label.text().startswith("Replaying lesson.ffsession: step ")
+    assert f"/ {session.steps}" in window.replays.label.text()
     t_live = live.solver.time
 
     # input is refused: the mouse, the panel, the reset key
@@ -89,13 +89,13 @@ def test_replay_in_the_window_and_stop_returns_to_the_live_tunnel(window, qtbot,
     assert window.panel.wind.value() == pytest.approx(before[0].wind) and live.params.wind == before[0].wind
     window.panel.shape.setCurrentIndex(window.panel.shape.findData("plate"))
     assert live.shape is before[1] and window.panel.shape.currentData() == before[0].shape
-    window.reset_flow()
+    window.flow.reset()
     assert live.solver.time == t_live                     # the live flow waits, untouched
 
     # the end: paused on the last frame, with a message; the plot holds the replayed forces
     qtbot.waitUntil(lambda: replay.done, timeout=30000)
     assert replay.step == session.steps
-    assert "finished" in window.replay_label.text() and window.pause_action.isChecked()
+    assert "finished" in window.replays.label.text() and window.actions.pause.isChecked()
     assert (replay.shape.x, replay.shape.y) == tuple(session.forces["body"][-1][:2])
     h = replay.history
     assert h.time == [int(t) for t in session.forces["step"]]
@@ -105,7 +105,7 @@ def test_replay_in_the_window_and_stop_returns_to_the_live_tunnel(window, qtbot,
     # forces are averaged over the parts: equal up to rounding)
     np.testing.assert_allclose(values, session.forces["values"], rtol=1e-12, atol=1e-15)
     curve = window.plot.curves[(session.models[0], "drag")]
-    window.refresh_readouts()
+    window.loop.refresh_readouts()
     x, y = curve.getData()
     np.testing.assert_array_equal(x, h.time)                        # the plot shows the replay
     assert np.isfinite(y).all()
@@ -117,8 +117,8 @@ def test_replay_in_the_window_and_stop_returns_to_the_live_tunnel(window, qtbot,
     vp.setFocus()
     qtbot.waitUntil(vp.hasFocus, timeout=5000)
     QTest.keyClick(vp, Qt.Key_Escape)
-    assert window.replay is None and window.viewport.sim is live and window.plot.sim is live
-    assert not window.viewport.locked and not window.replay_toolbar.isVisible()
+    assert window.replays.replay is None and window.viewport.sim is live and window.plot.sim is live
+    assert not window.viewport.locked and not window.actions.replay_toolbar.isVisible()
     p, shape, shape_dict, config, pos = before
     assert live.params == p and live.shape is shape and live.shape.to_dict() == shape_dict
     assert live.config == config and live.pos == pos
@@ -137,12 +137,12 @@ def test_a_bad_session_file_is_one_line_and_changes_nothing(window, tmp_path, mo
     bad = tmp_path / "broken.ffsession"
     bad.write_bytes(b"this is not a zip archive")
     live = window.sim
-    assert not window.start_replay(str(bad))
+    assert not window.replays.start(str(bad))
     assert len(warnings) == 1
     title, text = warnings[0]
     assert title == "Could not replay the session" and "not a FeelFlow session file" in text and "\n" not in text
-    assert window.replay is None and window.viewport.sim is live and not window.viewport.locked
-    assert not window.replay_label.isVisible()
+    assert window.replays.replay is None and window.viewport.sim is live and not window.viewport.locked
+    assert not window.replays.label.isVisible()
 
 
 @pytest.mark.gl
@@ -166,8 +166,8 @@ def test_gl_window_replays_in_its_own_context(qtbot, tmp_path, monkeypatch):
     record_in_window(w, qtbot, path, monkeypatch)
     session = load_session(path)
     live_texture = w.sim.solver.field_texture()
-    assert w.start_replay(str(path))
-    replay = w.replay
+    assert w.replays.start(str(path))
+    replay = w.replays.replay
     assert replay.solver.name == "gl" and replay.solver.ctx is w.viewport.ctx
     split_ends = []   # the session steps at which a row run in parts (longer than a frame) ended
     driver, step_part = replay.solver, replay.solver.step_part
@@ -177,7 +177,7 @@ def test_gl_window_replays_in_its_own_context(qtbot, tmp_path, monkeypatch):
         if done:
             split_ends.append(driver.clock)
         return done
-    driver.step_part = counting_step_part   # before the first frame: start_replay only queued it
+    driver.step_part = counting_step_part   # before the first frame: replays.start only queued it
     qtbot.waitUntil(lambda: replay.done, timeout=30000)
     assert w.viewport.field_texture is replay.solver.field_texture()
     values = replayed_values(replay.history, session.models)
@@ -188,12 +188,12 @@ def test_gl_window_replays_in_its_own_context(qtbot, tmp_path, monkeypatch):
     np.testing.assert_allclose(values[~split], recorded[~split], rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(values[split], recorded[split], rtol=1e-6, atol=1e-12)
     print(f"\n  rows run in parts: {int(split.sum())} of {split.size}", end="")
-    w.stop_replay()
+    w.replays.stop()
     assert w.viewport.field_texture is live_texture
     t = w.sim.solver.time
     qtbot.waitUntil(lambda: w.sim.solver.time > t + 10, timeout=20000)
-    w.timer.stop()
-    w.slow_timer.stop()
+    w.loop.timer.stop()
+    w.loop.slow_timer.stop()
 
 
 def test_a_haptic_device_is_paused_and_refused_during_a_replay(window, qtbot, tmp_path, monkeypatch):
@@ -204,18 +204,18 @@ def test_a_haptic_device_is_paused_and_refused_during_a_replay(window, qtbot, tm
     record_in_window(window, qtbot, path, monkeypatch)
     panel = window.panel
     panel.input.setCurrentIndex(panel.input.findData("sim://diyhid"))
-    dev = window.input_device
+    dev = window.inputs.device
     qtbot.waitUntil(lambda: dev.target() is not None and dev.loop.status().samples > 5, timeout=20000)
-    assert window.start_replay(str(path))
+    assert window.replays.start(str(path))
     qtbot.waitUntil(lambda: dev.loop.status().state == "paused", timeout=5000)
     x, y = dev.target()
     monkeypatch.setattr(dev, "target", lambda: (x + 10.0, y))   # the student pushes the handle
     qtbot.waitUntil(lambda: "the device does not move the body" in window.statusBar().currentMessage(),
                     timeout=5000)
-    replay = window.replay
+    replay = window.replays.replay
     qtbot.waitUntil(lambda: replay.done, timeout=30000)
     assert window.sim.target is None or window.sim.target != (x + 10.0, y)
-    window.stop_replay()
+    window.replays.stop()
     qtbot.waitUntil(lambda: dev.loop.status().state != "paused", timeout=5000)
     qtbot.waitUntil(lambda: window.sim.target == (x + 10.0, y), timeout=5000)   # live again
 
@@ -235,8 +235,8 @@ def test_an_impossible_event_mid_replay_is_one_line_and_back_to_live(window, qtb
     save_session(s, tmp_path / "edge.ffsession")
     warnings = []
     monkeypatch.setattr(QMessageBox, "warning", lambda *a, **k: warnings.append(a[2]))
-    assert window.start_replay(str(tmp_path / "edge.ffsession"))
-    qtbot.waitUntil(lambda: window.replay is None, timeout=30000)
+    assert window.replays.start(str(tmp_path / "edge.ffsession"))
+    qtbot.waitUntil(lambda: window.replays.replay is None, timeout=30000)
     assert len(warnings) == 1 and "cannot be replayed" in warnings[0] and "\n" not in warnings[0]
     assert window.viewport.sim is window.sim and not window.viewport.locked
     t = window.sim.solver.time
@@ -249,10 +249,10 @@ def test_the_replay_line_is_not_drawn_under_a_passing_message(window, qtbot, tmp
     path = tmp_path / "lesson.ffsession"
     record_in_window(window, qtbot, path, monkeypatch)
     window.statusBar().showMessage("Drag the body to move it.", 20000)
-    assert window.start_replay(str(path))
-    assert window.replay_label.isVisible()
+    assert window.replays.start(str(path))
+    assert window.replays.label.isVisible()
     assert window.statusBar().currentMessage() == ""
-    window.stop_replay()
+    window.replays.stop()
 
 
 def test_selftest_measures_a_cli_recorded_replay_rows_whole_and_in_parts(tmp_path):

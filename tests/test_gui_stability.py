@@ -28,7 +28,7 @@ def test_lowest_viscosity_at_highest_wind_runs_finite_and_says_so(window, qtbot)
     assert message.startswith(f"Viscosity raised to {nu:.4f}") and message.count(". ") == 0, message
     t = sim.solver.time
     qtbot.waitUntil(lambda: sim.solver.time > t + 2000, timeout=90000)
-    assert not window.paused
+    assert not window.loop.paused
     rgba = sim.field_rgba()
     assert np.isfinite(rgba).all()
     assert np.hypot(rgba[..., 1], rgba[..., 2]).max() < 0.3

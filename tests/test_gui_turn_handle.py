@@ -82,7 +82,7 @@ def test_shift_snaps_to_15_degrees_and_paused_turns_at_once(window):
     from PySide6.QtCore import Qt
 
     sim = plate(window)
-    window.set_paused(True)
+    window.loop.set_paused(True)
     upright, steps = solid_mask(sim), window.undo.count()
     drag_handle(window, 50, modifiers=Qt.ShiftModifier)
     assert sim.angle == pytest.approx(math.radians(45), abs=1e-12)    # 50 snaps to 45, at once while paused
@@ -110,8 +110,8 @@ def test_the_handle_is_refused_while_a_replay_shows(window, qtbot, tmp_path, mon
     record_in_window(window, qtbot, path, monkeypatch)
     live, vp = window.sim, window.viewport
     angle, steps = live.angle_target, window.undo.count()
-    assert window.start_replay(str(path))
-    replay = window.replay
+    assert window.replays.start(str(path))
+    replay = window.replays.replay
     send_mouse(vp, "hover", vp.to_widget(*replay.pos))
     assert not vp.handle_shown()                                   # no handle on a replayed body
     centre, knob, _ = vp.handle_geometry()
@@ -122,7 +122,7 @@ def test_the_handle_is_refused_while_a_replay_shows(window, qtbot, tmp_path, mon
     send_mouse(vp, "release", knob)
     assert vp._turn is None
     assert "the mouse does not move the body" in window.statusBar().currentMessage()
-    assert not window.turn_body(45.0)
+    assert not window.bodies.turn_body(45.0)
     assert live.angle_target == angle and window.undo.count() == steps
     assert replay.angle == replay_angle
 
@@ -131,7 +131,7 @@ def test_the_handle_is_refused_while_a_script_or_a_device_drives_the_body(window
     from feelflow.app.gui.selftest import send_mouse
 
     vp = window.viewport
-    assert window.apply_preset("seed_protocol")
+    assert window.lessons.apply("seed_protocol")
     sim = window.sim
     assert sim.runner is not None
     angle = sim.angle_target
@@ -141,10 +141,10 @@ def test_the_handle_is_refused_while_a_script_or_a_device_drives_the_body(window
     assert vp._turn is None and sim.angle_target == angle
     assert "A motion script drives the body" in window.statusBar().currentMessage()
 
-    window.reset_flow()                                            # the script ends: the mouse turns it again
+    window.flow.reset()                                            # the script ends: the mouse turns it again
     panel = window.panel
     panel.input.setCurrentIndex(panel.input.findData("sim://diyhid"))
-    assert window.input_device is not None
+    assert window.inputs.device is not None
     _, knob = knob_after_hover(window)
     send_mouse(vp, "press", knob)
     send_mouse(vp, "release", knob)
@@ -152,7 +152,7 @@ def test_the_handle_is_refused_while_a_script_or_a_device_drives_the_body(window
     assert "The haptic device drives the body" in window.statusBar().currentMessage()
 
     panel.input.setCurrentIndex(panel.input.findData("mouse"))
-    assert window.input_device is None and vp.turn_blocker() is None
+    assert window.inputs.device is None and vp.turn_blocker() is None
     _, knob = knob_after_hover(window)
     send_mouse(vp, "press", knob)
     assert vp._turn is not None
@@ -189,7 +189,7 @@ def test_a_burst_of_wheel_notches_is_one_undo_step(window, qtbot):
     from feelflow.app.gui.turn_handle import BURST_S
 
     sim = at_57_degrees(window)
-    window.set_paused(True)                                        # paused: each notch turns it at once
+    window.loop.set_paused(True)                                   # paused: each notch turns it at once
     mask, steps = solid_mask(sim), window.undo.count()
     for _ in range(5):
         wheel(window, 1)
@@ -209,7 +209,7 @@ def test_a_burst_of_wheel_notches_is_one_undo_step(window, qtbot):
 
 def test_a_burst_of_wheel_notches_across_180_degrees_is_one_undo_step(window):
     sim = plate(window)
-    window.set_paused(True)
+    window.loop.set_paused(True)
     window.panel.angle.setValue(177)
     steps = window.undo.count()
     for _ in range(3):
@@ -250,18 +250,18 @@ def test_the_wheel_is_refused_while_a_replay_shows(window, qtbot, tmp_path, monk
     record_in_window(window, qtbot, path, monkeypatch)
     live = window.sim
     angle, steps = live.angle_target, window.undo.count()
-    assert window.start_replay(str(path))
-    replay_angle = window.replay.angle
+    assert window.replays.start(str(path))
+    replay_angle = window.replays.replay.angle
     wheel(window, 3)
     assert "the mouse does not move the body" in window.statusBar().currentMessage()
     assert live.angle_target == angle and window.undo.count() == steps
-    assert window.replay.angle == replay_angle
+    assert window.replays.replay.angle == replay_angle
 
 
 def test_the_wheel_and_the_angle_box_are_refused_while_a_script_drives_the_body(window):
     """A motion script ignores the angle until it ends (then the body would swing to whatever was
     asked meanwhile): the wheel and the Angle box are refused like the handle, with no undo step."""
-    assert window.apply_preset("seed_protocol")
+    assert window.lessons.apply("seed_protocol")
     sim = window.sim
     assert sim.runner is not None
     angle, steps, shown = sim.angle_target, window.undo.count(), window.panel.angle.value()
@@ -271,15 +271,15 @@ def test_the_wheel_and_the_angle_box_are_refused_while_a_script_drives_the_body(
     assert "the Angle box cannot rotate it" in window.statusBar().currentMessage()
     assert sim.angle_target == angle and window.undo.count() == steps
     assert window.panel.angle.value() == shown
-    window.reset_flow()                      # the script ends: the wheel turns the body again
+    window.flow.reset()                      # the script ends: the wheel turns the body again
     wheel(window, 3)
     assert sim.angle_target != angle and window.undo.count() == steps + 1
 
 
 def test_a_paused_wheel_burst_over_180_degrees_and_back_leaves_no_undo_step(window):
     sim = window.sim
-    window.set_paused(True)
-    window.set_angle(179.0)
+    window.loop.set_paused(True)
+    window.bodies.set_angle(179.0)
     steps = window.undo.count()
     wheel(window, 1)
     wheel(window, -1)
@@ -291,5 +291,5 @@ def test_loading_a_lesson_clears_the_undo_history(window):
     angle asked for before it (during a motion script it would swing there when the script ends)."""
     wheel(window, 5)
     assert window.undo.count() > 0
-    assert window.apply_preset("seed_protocol")
+    assert window.lessons.apply("seed_protocol")
     assert window.undo.count() == 0

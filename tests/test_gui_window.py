@@ -50,11 +50,11 @@ def test_wind_and_viscosity_change_re_and_ma(window):
     panel, sim = window.panel, window.sim
     panel.wind.setValue(0.08)
     assert sim.params.wind == pytest.approx(0.08)
-    window.refresh_readouts()
+    window.loop.refresh_readouts()
     assert panel.reynolds.text() == f"Re = {0.08 * 12 / sim.params.nu:.0f}"
     assert "Ma = 0.139" in panel.mach.text()
     panel.viscosity.setValue(0.04)
-    window.refresh_readouts()
+    window.loop.refresh_readouts()
     assert sim.config.nu == pytest.approx(0.04)
     assert panel.reynolds.text() == f"Re = {0.08 * 12 / 0.04:.0f}"
 
@@ -73,7 +73,7 @@ def test_force_model_selector_drives_plot_and_readouts(window, qtbot):
     panel.model.setCurrentIndex(panel.model.findData("pressure"))
     n0 = len(sim.history)
     qtbot.waitUntil(lambda: len(sim.history) > n0 + 5, timeout=10000)
-    window.refresh_readouts()
+    window.loop.refresh_readouts()
     assert set(sim.solver.forces()) == {"pressure"}
     _, drag, _ = sim.history.drag_lift("pressure")
     assert np.isfinite(drag[-3:]).all()
@@ -128,7 +128,7 @@ def test_polygon_edit_undo_redo_and_invalid_refused(window, monkeypatch):
     sim = _polygon_window(window)
     first = list(sim.polygon)
     moved = [(x * 1.5, y) for x, y in first]
-    assert window.edit_polygon(moved)
+    assert window.bodies.edit_polygon(moved)
     assert sim.shape.vertices == tuple(moved)
     window.undo.undo()
     assert list(sim.polygon) == first and sim.shape.vertices == tuple(first)
@@ -137,7 +137,7 @@ def test_polygon_edit_undo_redo_and_invalid_refused(window, monkeypatch):
     warnings = []
     monkeypatch.setattr(QMessageBox, "warning", lambda *a, **k: warnings.append(a[2]))
     bow_tie = [(-5, -5), (5, 5), (5, -5), (-5, 5)]
-    assert not window.edit_polygon(bow_tie)
+    assert not window.bodies.edit_polygon(bow_tie)
     assert warnings and "kept" in warnings[0]
     assert sim.shape.vertices == tuple(moved)     # previous shape kept
     assert window.undo.count() == 1
@@ -177,7 +177,7 @@ def test_vertex_handles_move_add_delete_and_undo(window, qtbot):
 def test_screenshot_shows_the_body_where_it_is(window, qtbot, tmp_path):
     from PySide6.QtGui import QImage
 
-    from feelflow.app.gui.viewport import BODY_FILL
+    from feelflow.app.gui.overlay import BODY_FILL
 
     sim = window.sim
     window.panel.hold_still.setChecked(True)
@@ -186,7 +186,7 @@ def test_screenshot_shows_the_body_where_it_is(window, qtbot, tmp_path):
     window.sim.set_shape()
     window.viewport.update()
     path = tmp_path / "shot.png"
-    window.save_screenshot(str(path))
+    window.exports.save_screenshot(str(path))
     image = QImage(str(path))
     origin = window.viewport.mapTo(window, window.viewport.rect().topLeft())
     centre = window.viewport.to_widget(*sim.pos)
@@ -209,7 +209,7 @@ def test_nan_pauses_says_so_and_resets(window, qtbot, monkeypatch):
     assert "unstable" in asked[0]
     qtbot.waitUntil(lambda: window.sim.solver.time > 5, timeout=10000)
     assert np.isfinite(window.sim.field_rgba()).all()
-    assert not window.paused
+    assert not window.loop.paused
 
 
 def test_space_pauses_and_r_resets(window, qtbot):
@@ -220,33 +220,33 @@ def test_space_pauses_and_r_resets(window, qtbot):
     window.viewport.setFocus()
     qtbot.waitUntil(window.viewport.hasFocus, timeout=5000)
     QTest.keyClick(window.viewport, Qt.Key_Space)
-    assert window.paused
+    assert window.loop.paused
     t = window.sim.solver.time
     qtbot.wait(200)
     assert window.sim.solver.time == t
     QTest.keyClick(window.viewport, Qt.Key_R)
     assert window.sim.solver.time == 0 and len(window.sim.history) == 0
     QTest.keyClick(window.viewport, Qt.Key_Space)
-    assert not window.paused
+    assert not window.loop.paused
 
 
 def test_shape_save_and_load_round_trip(window, tmp_path, monkeypatch):
     from PySide6.QtWidgets import QMessageBox
 
     sim = _polygon_window(window)
-    window.edit_polygon([(x * 1.2, y * 0.8) for x, y in sim.polygon])
+    window.bodies.edit_polygon([(x * 1.2, y * 0.8) for x, y in sim.polygon])
     verts = sim.shape.vertices
     path = tmp_path / "body.json"
-    window.save_shape(str(path))
+    window.exports.save_shape(str(path))
     window.panel.shape.setCurrentIndex(window.panel.shape.findData("cylinder"))
     assert sim.shape.kind == "cylinder"
-    assert window.load_shape(str(path))
+    assert window.exports.load_shape(str(path))
     assert sim.shape.kind == "polygon" and np.allclose(sim.shape.vertices, verts)
     bad = tmp_path / "bad.json"
     bad.write_text("{not json")
     warnings = []
     monkeypatch.setattr(QMessageBox, "warning", lambda *a, **k: warnings.append(a[2]))
-    assert not window.load_shape(str(bad))
+    assert not window.exports.load_shape(str(bad))
     assert warnings and np.allclose(sim.shape.vertices, verts)
 
 
@@ -275,17 +275,17 @@ def test_settings_are_remembered(qtbot, tmp_path):
     w.panel.display.setCurrentIndex(w.panel.display.findData("vorticity"))
     w.panel.shape.setCurrentIndex(w.panel.shape.findData("polygon"))
     edited = [(x * 1.3, y) for x, y in w.sim.polygon]
-    assert w.edit_polygon(edited)
-    w.save_settings()
+    assert w.bodies.edit_polygon(edited)
+    w.store.save(w)
     w2 = MainWindow(backend="numpy", settings=QSettings(path, QSettings.IniFormat))
     qtbot.addWidget(w2)
-    assert w2.params.wind == pytest.approx(0.07) and w2.display_mode == "vorticity"
+    assert w2.params.wind == pytest.approx(0.07) and w2.loop.display_mode == "vorticity"
     assert w2.panel.wind.value() == pytest.approx(0.07) and w2.params.grid == GRID
-    w.timer.stop()
+    w.loop.timer.stop()
     w2.show()                                   # the custom polygon comes back too
     qtbot.waitUntil(lambda: w2.sim is not None, timeout=20000)
     assert w2.sim.params.shape == "polygon" and np.allclose(w2.sim.shape.vertices, edited)
-    w2.timer.stop()
+    w2.loop.timer.stop()
 
 
 def test_without_a_display_one_line_and_exit_2():
@@ -300,12 +300,12 @@ def test_each_lesson_preset_loads_its_scene_and_runs(window, qtbot, key):
     from feelflow.app.model.presets import PRESETS
     from feelflow.app.model.scene import load_scene
 
-    assert window.apply_preset(key)
+    assert window.lessons.apply(key)
     scene = load_scene(PRESETS[key].path)
     sim = window.sim
     assert (sim.config.nx, sim.config.ny) == (scene.config.nx, scene.config.ny)
     assert sim.shape.kind == scene.body.kind and sim.config.nu == pytest.approx(scene.config.nu)
-    assert window.display_mode == PRESETS[key].display
+    assert window.loop.display_mode == PRESETS[key].display
     qtbot.waitUntil(lambda: sim.solver.time > 30, timeout=20000)
     if key == "seed_protocol":
         assert sim.runner is not None and sim.script_phase()[2] == "stopped"
@@ -314,7 +314,7 @@ def test_each_lesson_preset_loads_its_scene_and_runs(window, qtbot, key):
 
 
 def test_seed_protocol_moves_the_body_with_the_stream(window, qtbot):
-    assert window.apply_preset("seed_protocol")
+    assert window.lessons.apply("seed_protocol")
     sim = window.sim
     x0 = sim.pos[0]
     sim.runner.t = 2500 - 5           # skip the first (stopped) phase: the script is a plain object
@@ -339,7 +339,7 @@ def test_gl_backend_runs_in_the_widgets_own_context(qtbot, tmp_path):
     assert w.viewport.field_texture is w.sim.solver.field_texture()
     ok, why = field_is_alive(w)
     assert ok, why
-    w.timer.stop()
+    w.loop.timer.stop()
 
 
 def test_haptic_device_moves_the_body_feels_the_force_and_unplugging_falls_back_to_mouse(window, qtbot):
@@ -347,16 +347,16 @@ def test_haptic_device_moves_the_body_feels_the_force_and_unplugging_falls_back_
     i = panel.input.findData("sim://diyhid")
     assert i > 0, [panel.input.itemData(k) for k in range(panel.input.count())]
     panel.input.setCurrentIndex(i)
-    dev = window.input_device
+    dev = window.inputs.device
     assert dev is not None and dev.url == "sim://diyhid"
     qtbot.waitUntil(lambda: window.sim.target is not None and dev.loop.status().samples > 5, timeout=20000)
     assert dev.loop.status().running
     assert dev.loop.status().running
-    window.stop_device_force()             # Esc: the force goes to zero at once
+    window.inputs.stop_device_force()      # Esc: the force goes to zero at once
     qtbot.waitUntil(lambda: dev.loop.status().state == "stopped" and dev.loop.status().force == (0.0, 0.0),
                     timeout=5000)
     dev.loop.simulate_unplug()             # the real disconnect path of the simulated board
-    qtbot.waitUntil(lambda: window.input_device is None, timeout=10000)
+    qtbot.waitUntil(lambda: window.inputs.device is None, timeout=10000)
     assert panel.input.currentData() == "mouse"
     assert "disconnected" in panel.input_note.text()
 
@@ -369,7 +369,7 @@ def test_recording_a_session_saves_inputs_parameters_and_forces(window, qtbot, t
 
     path = tmp_path / "lesson.ffsession"
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(path), ""))
-    window.record_action.trigger()
+    window.actions.record.trigger()
     assert window.sim.solver.recorder is not None
     t0 = window.sim.solver.time
     vp, sim = window.viewport, window.sim
@@ -380,7 +380,7 @@ def test_recording_a_session_saves_inputs_parameters_and_forces(window, qtbot, t
     window.panel.wind.setValue(0.06)
     t1 = sim.solver.time
     qtbot.waitUntil(lambda: sim.solver.time > t1 + 50, timeout=20000)
-    window.record_action.trigger()
+    window.actions.record.trigger()
     assert window.sim.solver.recorder is None and path.exists()
     session = load_session(path)
     names = [p["name"] for p in session.parameters]
@@ -415,7 +415,7 @@ def test_the_outlet_zone_is_marked_where_the_sponge_begins(window, qtbot, tmp_pa
     x = view.outlet_zone_x()
     assert x == pytest.approx(view.to_widget(cfg.nx - cfg.sponge_cells - 0.5, 0.0).x())
     path = tmp_path / "shot.png"
-    window.save_screenshot(str(path))
+    window.exports.save_screenshot(str(path))
     image = QImage(str(path))
     origin = view.mapTo(window, view.rect().topLeft())
     r = view.lattice_rect()

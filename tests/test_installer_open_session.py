@@ -44,8 +44,8 @@ def test_gui_with_a_session_file_opens_the_window_replaying_it(qapp, tmp_path):
         """Once the window replays, note what it shows and close it (app.exec() then returns)."""
         for w in QApplication.topLevelWidgets():
             if isinstance(w, MainWindow) and w.isVisible():
-                if w.replay is not None:
-                    seen.update(label=w.replay_label.text(), shown=w.viewport.sim is w.replay,
+                if w.replays.replay is not None:
+                    seen.update(label=w.replays.label.text(), shown=w.viewport.sim is w.replays.replay,
                                 live=w.sim is not None)
                     w.close()
                 elif w.startup_error:

@@ -47,6 +47,7 @@ def test_recording_started_mid_flow_replays(tmp_path, dtype):
 def test_gui_simulation_through_a_session_solver(tmp_path):
     """feelflow.app.model.simulation drives its solver by set_body/step/forces/set_inflow_speed; wrapped in a
     SessionSolver, a mouse drag recorded mid-run replays to the same forces."""
+    from feelflow.app.model.body_input import BodyInput
     from feelflow.app.model.simulation import Params, Simulation
 
     sim = Simulation(Params(grid=(192, 96), size=16.0))
@@ -58,7 +59,7 @@ def test_gui_simulation_through_a_session_solver(tmp_path):
     rec = sim.solver.start_recording()
     x0, y0 = sim.pos
     for k in range(8):
-        sim.target = (x0 + 2.0 * k, y0 + 0.5 * k)  # the mouse drags the body
+        sim.drive(BodyInput.pull(x0 + 2.0 * k, y0 + 0.5 * k, "mouse"))  # the mouse drags the body
         sim.advance(4)
         if k == 4:
             sim.set_flow(wind=0.04)

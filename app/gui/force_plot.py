@@ -17,6 +17,7 @@ from PySide6.QtWidgets import (QCheckBox, QComboBox, QHBoxLayout, QLabel, QPushB
 from feelflow.app.files import atomic_path, write_text_atomic
 from feelflow.app.model.power_law import fit_power_law
 from feelflow.app.model.simulation import FORCE_MODELS, History, drag_direction
+from feelflow.app.model.tunnel import TunnelModel
 from feelflow.solver.lattice import CS2
 
 #: the impulsive start's pressure pulse (the flow begins at full speed around a body that was not
@@ -39,7 +40,7 @@ class ForcePlot(QWidget):
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        self.sim = None
+        self.sim: TunnelModel | None = None   # what the plot shows (the window sets it)
         self.paused = False
         self._frozen = None
         self.view = QComboBox()

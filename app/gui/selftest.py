@@ -46,7 +46,7 @@ def field_is_alive(window) -> tuple[bool, str]:
     sim = window.sim
     if window.backend == "gl":
         nx, ny = sim.config.nx, sim.config.ny
-        window._make_current()
+        window.make_current()
         f = np.frombuffer(sim.solver.field_texture().read(), np.float32).reshape(ny, nx, 4)
     else:
         f = sim.field_rgba()
@@ -109,7 +109,7 @@ class SelfTest:
         nodes = sim.config.nx * sim.config.ny
         self.results.update(grid=f"{sim.config.nx}x{sim.config.ny}", fps=frames / dt, steps_per_s=steps / dt,
                             mlups=steps * nodes / dt / 1e6, steps_per_frame=steps / max(1, frames),
-                            step_ms=1e3 * w._step_cost, rest_of_frame_ms=1e3 * w._other_cost)
+                            step_ms=1e3 * w.loop.step_cost, rest_of_frame_ms=1e3 * w.loop.other_cost)
         ok, why = field_is_alive(w)
         if not ok:
             self.failures.append(why)
@@ -137,16 +137,16 @@ class SelfTest:
         fresh = drag[n0:]
         if len(fresh) == 0 or not np.isfinite(fresh).any():
             self.failures.append("the plot got no data from the pressure model")
-        w.refresh_readouts()
+        w.loop.refresh_readouts()
         self._save_screenshot()
 
     def _replay_script(self):
         """The replay's frame rate and steps per second, and that it moves on."""
         w = self.window
-        while w.replay is None:
+        while w.replays.replay is None:
             yield
         yield from self._wait(1.0)
-        r = w.replay
+        r = w.replays.replay
         self.results["grid"] = f"{r.config.nx}x{r.config.ny}"
         for split in (False, True):   # rows whole (as before the fifth session), then long rows in parts
             r.split_rows = split
@@ -164,7 +164,7 @@ class SelfTest:
 
     def _save_screenshot(self):
         if self.screenshot:
-            self.window.save_screenshot(self.screenshot)
+            self.window.exports.save_screenshot(self.screenshot)
             self.results["screenshot"] = self.screenshot
 
     def _finish(self):

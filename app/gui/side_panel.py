@@ -12,7 +12,7 @@ from PySide6.QtWidgets import (QCheckBox, QComboBox, QDoubleSpinBox, QFormLayout
 
 from feelflow.app.model.bodies import SHAPE_LABELS
 from feelflow.app.model.simulation import FORCE_MODELS, GRID_PRESETS, WALLS
-from feelflow.app.gui.viewport import DISPLAY_MODES
+from feelflow.app.gui.display_modes import DISPLAY_MODES
 
 
 def _combo(items: dict) -> QComboBox:

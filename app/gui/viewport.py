@@ -1,54 +1,32 @@
 """The wind tunnel view: a QOpenGLWidget whose moderngl context colours the flow field
-(shaders/display*.glsl, colormaps from pyqtgraph), with the body, its force arrows, tracers,
-the colour bar, the polygon editor's handles and the rotation handle (app/turn_handle.py)
-painted on top with QPainter.
+(shaders/display*.glsl, colormaps from pyqtgraph), with the overlay (app/gui/overlay.py: body,
+force arrows, tracers, colour bar, notes, the polygon editor's handles and the rotation handle)
+painted on top with QPainter; and the mouse: dragging the body, the polygon editor, the
+rotation handle (app/gui/turn_handle.py) and the wheel, each a signal to the window.
 
-GL pitfalls handled here (shared/notes/gl-qt-on-this-machine.md): detect_framebuffer in every
-paintGL, enable_only(NOTHING) before any pass, every texture bound before every draw.
+GL pitfalls handled here: detect_framebuffer in every paintGL, enable_only(NOTHING) before any
+pass, every texture bound before every draw.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import moderngl
 import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import QEvent, QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QBrush, QColor, QFont, QLinearGradient, QPainter, QPen, QPolygonF
+from PySide6.QtGui import QPainter, QPolygonF
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
 from PySide6.QtWidgets import QToolTip
 
-from feelflow.app.gui import turn_handle
 from feelflow import SHADER_DIR
+from feelflow.app.gui import turn_handle
+from feelflow.app.gui.display_modes import COLOUR_BAR_MARGIN, DISPLAY_MODES
+from feelflow.app.gui.overlay import Overlay
+from feelflow.app.model.tunnel import TunnelModel
 from feelflow.solver import units
 from feelflow.solver.lattice import glsl_constants
 
-
-
-@dataclass(frozen=True)
-class DisplayMode:
-    label: str
-    colormap: str
-    shader_mode: int
-    range: tuple[float, float]
-    unit: str           # what the colour bar's numbers mean
-
-
-DISPLAY_MODES = {
-    "speed": DisplayMode("Speed", "viridis", 0, (0.0, 1.6), "speed\n\u00f7 wind speed"),
-    "vorticity": DisplayMode("Vorticity", "CET-D1", 1, (-4.0, 4.0), "vorticity\n\u00d7 D \u00f7 U"),
-    "pressure": DisplayMode("Pressure", "CET-D1", 2, (-1.5, 1.5), "pressure\ncoefficient Cp"),
-    "tracers": DisplayMode("Tracers", "viridis", 3, (0.0, 1.6), "speed\n\u00f7 wind speed"),
-}
-
-BODY_FILL = QColor(225, 225, 225)
-BODY_EDGE = QColor(20, 20, 20)
-DRAG_COLOUR = QColor(230, 40, 40)
-LIFT_COLOUR = QColor(40, 120, 255)
-COLOUR_BAR_MARGIN = 132  # pixels on the right kept for the colour bar
-#: the dashed line where the outlet zone (the sponge, docs/algorithm.md step 3) begins
-OUTLET_LINE = QColor(255, 255, 255, 150)
 WHEEL_DEG_PER_NOTCH = 2.0  # one notch of the mouse wheel (120 eighths of a degree) turns the body this far
 MOUSE_HINT = ("Drag the body to move it; drag its round handle or turn the mouse wheel to rotate it "
               "(hold Shift for 15\u00b0 steps).")
@@ -61,10 +39,14 @@ def load_shader(name: str) -> str:
 
 
 class Viewport(QOpenGLWidget):
-    """Shows `sim` (an app.simulation.Simulation, set by the window once the context exists)."""
+    """Shows `sim`, a `TunnelModel` (the live tunnel or a replay, set by the window once the
+    context exists). It never changes the model: the mouse's requests leave as signals
+    (`bodyPulled`, `turnRequested`, `wheelTurned`, `polygonEdited`) for the window's
+    controllers (app/gui/window/)."""
 
     contextReady = Signal(object)   # the moderngl.Context, once initializeGL ran
     bodyGrabbed = Signal(bool)
+    bodyPulled = Signal(object)     # a drag pulls the body to (x, y) lattice cells; None lets go
     polygonEdited = Signal(object)  # new vertex list (body frame) from the editor handles
     inputRefused = Signal()         # a press or wheel turn while `locked` (a replay shows)
     turnRequested = Signal(float)   # the rotation handle asks for this body angle (degrees, any turns)
@@ -74,7 +56,7 @@ class Viewport(QOpenGLWidget):
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        self.sim = None
+        self.sim: TunnelModel | None = None
         self.ctx = None
         self.mode = "speed"
         self.show_arrows = True
@@ -92,6 +74,7 @@ class Viewport(QOpenGLWidget):
         self.driver = None             # what else drives the body ("The haptic device"), set by the window
         self._turn = None              # the handle's drag in progress (turn_handle.Turn)
         self._hover = None             # "handle", "body" or "near" (the handle shows), or None
+        self.overlay = Overlay(self)
         self.setMinimumSize(480, 260)
         self.setMouseTracking(True)    # the handle appears when the pointer comes near the body
         self.setFocusPolicy(Qt.StrongFocus)
@@ -177,7 +160,7 @@ class Viewport(QOpenGLWidget):
             # cache assumes the default 4 (garbled text otherwise): a 1-texel write restores it
             self._align_texture.write(b"\0\0\0\0", alignment=4)
             painter.endNativePainting()
-        self._paint_overlay(painter)
+        self.overlay.paint(painter)
         painter.end()
         self.frames += 1
 
@@ -221,21 +204,7 @@ class Viewport(QOpenGLWidget):
             return 1.0 / units.dynamic_pressure(u)   # C_p = (p - p0) / (rho U^2 / 2)
         return 1.0 / u
 
-    # --- overlay ------------------------------------------------------------------------------
-    def _paint_overlay(self, p: QPainter):
-        if self.sim is None:
-            return
-        p.setRenderHint(QPainter.Antialiasing)
-        if self.mode == "tracers" and self.tracers is not None:
-            self._paint_tracers(p)
-        self._paint_outlet_zone(p)
-        self._paint_body(p)
-        self._paint_turn_handle(p)
-        if self.show_arrows and self.arrow_forces and self.sim.shape is not None:
-            self._paint_arrows(p)
-        self._paint_colour_bar(p)
-        self._paint_notes(p)
-
+    # --- geometry the overlay and the mouse share -----------------------------------------------
     def body_outline_points(self, outline=None):
         """The outline in widget pixels: `to_widget` with the lattice rectangle computed once,
         not once per point (this runs in every paint)."""
@@ -244,130 +213,6 @@ class Viewport(QOpenGLWidget):
         nx, ny = self.sim.config.nx, self.sim.config.ny
         left, bottom, w, h = r.left(), r.bottom(), r.width(), r.height()
         return QPolygonF([QPointF(left + (x + 0.5) / nx * w, bottom - (y + 0.5) / ny * h) for x, y in pts])
-
-    def _paint_body(self, p: QPainter):
-        sim = self.sim
-        if sim.shape is None:   # a replayed session that removed its body
-            return
-        if sim.target is not None and not sim.hold_still:
-            a, b = self.to_widget(*sim.pos), self.to_widget(*sim.target)
-            p.setPen(QPen(QColor(255, 255, 255, 200), 2, Qt.DashLine))
-            p.drawLine(a, b)
-            p.setBrush(Qt.NoBrush)
-            p.drawEllipse(b, 6, 6)
-        p.setPen(QPen(BODY_EDGE, 2.5))
-        p.setBrush(QBrush(BODY_FILL))
-        p.drawPolygon(self.body_outline_points())
-        if self.editing and sim.polygon is not None:
-            verts = self._edit_preview if self._edit_preview is not None else sim.polygon
-            world = self.body_to_world(verts)
-            p.setPen(QPen(QColor(255, 200, 0), 1.5, Qt.DashLine))
-            p.setBrush(Qt.NoBrush)
-            p.drawPolygon(self.body_outline_points(world))
-            p.setPen(QPen(Qt.black, 1.5))
-            p.setBrush(QBrush(QColor(255, 200, 0)))
-            for x, y in world:
-                c = self.to_widget(x, y)
-                p.drawRect(QRectF(c.x() - 5, c.y() - 5, 10, 10))
-
-    def _arrow(self, p, start: QPointF, vec, colour, label):
-        length = math.hypot(*vec)
-        if length < 3:
-            return
-        end = QPointF(start.x() + vec[0], start.y() + vec[1])
-        p.setPen(QPen(QColor(0, 0, 0, 160), 7, Qt.SolidLine, Qt.RoundCap))
-        p.drawLine(start, end)
-        p.setPen(QPen(colour, 4, Qt.SolidLine, Qt.RoundCap))
-        p.drawLine(start, end)
-        ux, uy = vec[0] / length, vec[1] / length
-        head = min(16.0, 0.45 * length)
-        tip = QPolygonF([end, QPointF(end.x() - head * ux + 0.6 * head * uy, end.y() - head * uy - 0.6 * head * ux),
-                         QPointF(end.x() - head * ux - 0.6 * head * uy, end.y() - head * uy + 0.6 * head * ux)])
-        p.setPen(QPen(Qt.black, 1.5))
-        p.setBrush(QBrush(colour))
-        p.drawPolygon(tip)
-        if length < 30:   # too short to carry a label without covering the body
-            return
-        self._label(p, QPointF(end.x() + 10 * ux - 4, end.y() + 10 * uy + (16 if uy > 0.5 else -8 if uy < -0.5 else 5)),
-                    label, QColor(255, 255, 255), box=colour.darker(130))
-
-    def _label(self, p, at: QPointF, text, colour=QColor(255, 255, 255), size=15, box=QColor(0, 0, 0, 160)):
-        """Bold text on a dark translucent box, readable on any colour of the field."""
-        font = QFont(self.font())
-        font.setPixelSize(size)
-        font.setBold(True)
-        p.setFont(font)
-        rect = p.fontMetrics().boundingRect(text).adjusted(-4, -2, 4, 2).translated(int(at.x()), int(at.y()))
-        p.setPen(Qt.NoPen)
-        p.setBrush(box)
-        p.drawRoundedRect(QRectF(rect), 4, 4)
-        p.setPen(colour)
-        p.drawText(at, text)
-
-    def _paint_arrows(self, p: QPainter):
-        """Drag (along the relative wind) and lift (across it), length = coefficient x size / 2."""
-        sim = self.sim
-        centre = self.to_widget(*sim.pos)
-        px_per_cell = self.lattice_rect().width() / sim.config.nx
-        u = max(sim.params.wind, sim.config.max_speed / 2)
-        ref = 0.5 * u * u * sim.params.size
-        cap = 2.5 * sim.params.size
-        for key, colour in (("drag", DRAG_COLOUR), ("lift", LIFT_COLOUR)):
-            fx, fy = self.arrow_forces[key]
-            coeff_len = math.hypot(fx, fy) / ref * sim.params.size * 0.5
-            if coeff_len > cap:
-                fx, fy = fx * cap / coeff_len, fy * cap / coeff_len
-                coeff_len = cap
-            if not math.isfinite(coeff_len):
-                continue
-            vec = (fx / ref * sim.params.size * 0.5 * px_per_cell, -fy / ref * sim.params.size * 0.5 * px_per_cell)
-            self._arrow(p, centre, vec, colour, key)
-
-    def _paint_colour_bar(self, p: QPainter):
-        """The colour bar, drawn once per mode and size into a pixmap, then blitted each frame."""
-        key = (self.mode, self.width(), self.height(), self.sim.config.nx, self.sim.config.ny)
-        if getattr(self, "_bar_key", None) != key:
-            from PySide6.QtGui import QPixmap
-
-            pixmap = QPixmap(COLOUR_BAR_MARGIN, self.height())
-            pixmap.fill(QColor(41, 43, 48))
-            painter = QPainter(pixmap)
-            painter.setRenderHint(QPainter.Antialiasing)
-            painter.translate(-(self.width() - COLOUR_BAR_MARGIN), 0)
-            self._draw_colour_bar(painter)
-            painter.end()
-            self._bar_pixmap, self._bar_key = pixmap, key
-        p.drawPixmap(self.width() - COLOUR_BAR_MARGIN, 0, self._bar_pixmap)
-
-    def _draw_colour_bar(self, p: QPainter):
-        mode = DISPLAY_MODES[self.mode]
-        r = self.lattice_rect()
-        x = self.width() - COLOUR_BAR_MARGIN + 22
-        top, bottom = max(40.0, r.top() + 30), min(self.height() - 20.0, r.bottom() - 10)
-        if bottom - top < 60:
-            top, bottom = 30.0, self.height() - 10.0
-        bar = QRectF(x, top, 20, bottom - top)
-        grad = QLinearGradient(0, bottom, 0, top)
-        table = pg.colormap.get(mode.colormap).getLookupTable(0.0, 1.0, 17, alpha=False)
-        for k, (r_, g_, b_) in enumerate(table.tolist()):
-            if mode.shader_mode == 3:  # the faded speed map of the tracer view (display.glsl)
-                r_, g_, b_ = (int(0.7 * 245 + 0.3 * c) for c in (r_, g_, b_))
-            grad.setColorAt(k / 16.0, QColor(int(r_), int(g_), int(b_)))
-        p.setPen(QPen(QColor(230, 230, 230), 1))
-        p.setBrush(QBrush(grad))
-        p.drawRect(bar)
-        font = QFont(self.font())
-        font.setPixelSize(15)
-        p.setFont(font)
-        lo, hi = mode.range
-        for v in np.linspace(lo, hi, 5):
-            y = bottom - (v - lo) / (hi - lo) * (bottom - top)
-            p.drawLine(QPointF(x + 20, y), QPointF(x + 25, y))
-            p.drawText(QPointF(x + 28, y + 5), f"{v:g}".replace("-", "\u2212"))
-        font.setBold(True)
-        p.setFont(font)
-        p.drawText(QRectF(x - 22, 4, COLOUR_BAR_MARGIN - 2, top - 8), Qt.AlignLeft | Qt.AlignBottom | Qt.TextWordWrap,
-                   mode.unit)
 
     def outlet_zone_x(self):
         """Widget x where the outlet zone begins, None without one. In the zone (the sponge's last
@@ -378,46 +223,6 @@ class Viewport(QOpenGLWidget):
         if cfg.x_boundary != "tunnel" or cfg.sponge_cells <= 0:
             return None
         return self.to_widget(cfg.nx - cfg.sponge_cells - 0.5, 0.0).x()
-
-    def _paint_outlet_zone(self, p: QPainter):
-        x = self.outlet_zone_x()
-        if x is None:
-            return
-        r = self.lattice_rect()
-        p.setPen(QPen(OUTLET_LINE, 1.5, Qt.DashLine))
-        p.drawLine(QPointF(x, r.top()), QPointF(x, r.bottom()))
-        self._label(p, QPointF(x + 6, r.bottom() - 8), "outlet zone", QColor(230, 230, 230), size=12,
-                    box=QColor(0, 0, 0, 110))
-
-    def _paint_notes(self, p: QPainter):
-        sim = self.sim
-        r = self.lattice_rect()
-        notes = [(self.banner, QColor(255, 230, 120))] if self.banner else []
-        if sim.capped:
-            notes.append(("speed limit reached (Mach %.2f)" % sim.config.mach_limit, QColor(255, 170, 40)))
-        if sim.hold_still:
-            notes.append(("holding still", QColor(255, 255, 255)))
-        phase = sim.script_phase()
-        if phase is not None:
-            k, count, words = phase
-            notes.append((f"scripted motion: {words} (phase {k + 1} of {count})", QColor(255, 255, 255)))
-        stage = sim.sweep_stage()
-        if stage is not None:
-            notes.append((f"wind {sim.params.wind:.3f} (speed {stage + 1} of {len(sim.sweep[0])})", QColor(255, 255, 255)))
-        for i, (text, colour) in enumerate(notes):
-            self._label(p, QPointF(r.left() + 10, r.top() + 24 + 20 * i), text, colour, size=15)
-
-    def _paint_tracers(self, p: QPainter):
-        pts, prev = self.tracers
-        p.setPen(QPen(QColor(20, 40, 120), 1.6, Qt.SolidLine, Qt.FlatCap))
-        r = self.lattice_rect()
-        nx, ny = self.sim.config.nx, self.sim.config.ny
-        sx, sy = r.width() / nx, r.height() / ny
-        x0, y0 = r.left() + 0.5 * sx, r.bottom() - 0.5 * sy
-        lines = [QPointF(x0 + a * sx, y0 - b * sy) for a, b in np.stack([prev, pts], 1).reshape(-1, 2).tolist()]
-        p.setRenderHint(QPainter.Antialiasing, False)   # ~900 short streaks: plain lines are much cheaper
-        p.drawLines(lines)
-        p.setRenderHint(QPainter.Antialiasing, True)
 
     # --- rotation handle ------------------------------------------------------------------------
     def turn_blocker(self):
@@ -478,22 +283,6 @@ class Viewport(QOpenGLWidget):
     def _pointer_degrees(self, pos: QPointF) -> float:
         return turn_handle.pointer_degrees(self.sim.pos, self.to_lattice(pos))
 
-    def _paint_turn_handle(self, p: QPainter):
-        if not self.handle_shown():
-            return
-        centre, knob, reach = self.handle_geometry()
-        turn = self._turn
-        if turn is not None and abs(math.radians(turn.target) - self.sim.angle) > 1e-3:
-            target = turn_handle.knob_position(centre, reach, math.radians(turn.target))
-            turn_handle.paint_turn_target(p, centre, target)
-        state = "refused" if self.turn_blocker() else "active" if turn is not None or self._hover == "handle" else "idle"
-        turn_handle.paint_handle(p, centre, knob, state)
-        if turn is not None:
-            shown = (turn.target + 180.0) % 360.0 - 180.0
-            ux, uy = (knob.x() - centre.x()) / reach, (knob.y() - centre.y()) / reach
-            at = QPointF(knob.x() + 16 * ux - (38 if ux < -0.3 else 0 if ux > 0.3 else 18), knob.y() + 16 * uy + 6)
-            self._label(p, at, f"{shown:.0f}\u00b0".replace("-", "\u2212"))   # beyond the knob, off the stalk
-
     def leaveEvent(self, ev):
         if self._turn is None:
             self._set_hover(None)
@@ -537,6 +326,10 @@ class Viewport(QOpenGLWidget):
         return None
 
     # --- mouse --------------------------------------------------------------------------------
+    def cancel_drag(self):
+        """Forget a drag of the body in progress (a replay takes over the view)."""
+        self._grab = None
+
     def mousePressEvent(self, ev):
         if self.sim is None:
             return
@@ -566,7 +359,7 @@ class Viewport(QOpenGLWidget):
             return
         if ev.button() == Qt.LeftButton and self.sim.hit(x, y):
             self._grab = (self.sim.pos[0] - x, self.sim.pos[1] - y)
-            self.sim.target = (x + self._grab[0], y + self._grab[1])
+            self.bodyPulled.emit((x + self._grab[0], y + self._grab[1]))
             self.bodyGrabbed.emit(True)
             self._set_hover(hover)
             self.update()
@@ -585,7 +378,7 @@ class Viewport(QOpenGLWidget):
             self._edit_preview[self._edit_vertex] = self.world_to_body(x, y)
             self.update()
         elif self._grab is not None:
-            self.sim.target = (x + self._grab[0], y + self._grab[1])
+            self.bodyPulled.emit((x + self._grab[0], y + self._grab[1]))
         elif not ev.buttons():
             self._set_hover(self._hover_at(ev.position()))
 
@@ -601,7 +394,7 @@ class Viewport(QOpenGLWidget):
             self.polygonEdited.emit(verts)
         elif self._grab is not None:
             self._grab = None
-            self.sim.target = None
+            self.bodyPulled.emit(None)
             self.bodyGrabbed.emit(False)
             self._set_hover(self._hover_at(ev.position()))
 

@@ -1,6 +1,7 @@
-"""A session replaying in the window: what the viewport and the force plot read from
-`feelflow.app.model.simulation.Simulation` (config, params, body pose, history, field), fed by a
-`SessionPlayer` instead of the mouse. Read-only: the body follows the recording.
+"""A session replaying in the window: a `TunnelModel` (app/model/tunnel.py), as the live
+`feelflow.app.model.simulation.Simulation` is (config, params, body pose, history, field), fed
+by a `SessionPlayer` instead of the mouse. Read-only: the body follows the recording, and
+`drive` refuses every body input.
 
 Qt-free, so it is testable on its own; the window swaps it in for the live simulation while a
 session replays and swaps the live one back when the replay stops.
@@ -10,22 +11,25 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from feelflow.app.model.body_input import BodyInput
 from feelflow.app.sessions import SessionPlayer
-from feelflow.app.model.simulation import FORCE_MODELS, History, Params, field_rgba
+from feelflow.app.model.simulation import FORCE_MODELS, History, Params, field_rgba, shape_hit
 from feelflow.solver import units
 
 
 class ReplaySimulation:
-    """A `SessionPlayer` dressed as the window's simulation. `advance(n)` replays about n steps
+    """A `SessionPlayer` as a `TunnelModel`. `advance(n)` replays about n steps
     and adds one history sample per replayed force row (so the plot shows the replayed series
     exactly), with the session step as its time."""
 
-    #: what the viewport asks of a live simulation; a replay has none of it
+    #: what a live tunnel may have and a replay has not: no pull, no editor, no cap, no
+    #: sweep, no motion script (the recording holds their effects)
     target = None
     hold_still = False
     polygon = None
     capped = False
     sweep = None
+    runner = None
 
     def __init__(self, session, backend: str | None = None, *, ctx=None, factory=None):
         self.player = SessionPlayer(session, backend, ctx=ctx, factory=factory)
@@ -108,6 +112,18 @@ class ReplaySimulation:
                       angle_deg=math.degrees(self.angle), wind=self.player.inflow_speed,
                       nu=self.player.solver.flow_config.nu, wall=cfg.y_boundary,
                       force_model=models[0], compare_all=len(models) > 1)
+
+    def drive(self, request: BodyInput) -> bool:
+        """Body input: refused (False), the body follows the recording."""
+        return False
+
+    def hit(self, x: float, y: float, tolerance: float = 2.0) -> bool:
+        """Is the lattice point (x, y) on the replayed body, within `tolerance` cells?"""
+        return shape_hit(self.player.shape, x, y, tolerance)
+
+    def target_degrees(self) -> float:
+        """The replayed body's angle in degrees (a replay is asked for no angle)."""
+        return math.degrees(self.angle)
 
     def relative_wind(self):
         vx, vy = self.player.velocity

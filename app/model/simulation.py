@@ -9,6 +9,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from feelflow.app.model.body_input import BodyInput
 from feelflow.app.model.coupling import AngleSpring, SpringDamper
 from feelflow.solver import units
 from feelflow.app.sessions import SessionSolver
@@ -202,7 +203,7 @@ class Simulation:
         self.polygon = None          # vertices of the custom polygon (body frame), or None
         self.history = History()
         self.hold_still = False
-        self.target = None           # where the mouse pulls the body, or None
+        self._target = None          # where an input pulls the body (`drive`), or None
         self.angle_target = math.radians(self.params.angle_deg)
         self._asked = (None, None)   # (degrees, radians) of the last turn_to: see target_degrees
         self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
@@ -238,7 +239,7 @@ class Simulation:
             self.pos, self.vel = (nx * 0.3, ny * 0.5), (0.0, 0.0)
             self.angle, self.rate = math.radians(self.params.angle_deg), 0.0
             self.angle_target = self.angle
-            self.target = None
+            self._target = None
             self.history.clear()
         if self.runner is not None and not keep_flow:
             self.runner = None
@@ -296,7 +297,7 @@ class Simulation:
         """The flow from its initial state again (time 0), body where it was, at rest; history cleared."""
         self.solver.reset()
         self.runner = self.sweep = None
-        self.vel, self.rate, self.target = (0.0, 0.0), 0.0, None
+        self.vel, self.rate, self._target = (0.0, 0.0), 0.0, None
         self.angle_target = self.angle
         self.shape = self.shape.moved(*self.pos, self.angle)
         self.solver.set_body(self.shape, (0.0, 0.0), 0.0)
@@ -376,12 +377,28 @@ class Simulation:
         if scene.motion.phases:
             self.start_script(scene.motion)
 
-    # --- mouse ----------------------------------------------------------------------------
+    # --- body input -----------------------------------------------------------------------
+    @property
+    def target(self):
+        """Where an input pulls the body, (x, y) cells, or None: set only through `drive`."""
+        return self._target
+
+    def drive(self, request: BodyInput) -> bool:
+        """The one way in for body input (mouse, haptic device, script: app/model/body_input.py).
+        A pull moves the target of the spring-damper that moves the body (coupling.py); a turn
+        asks the angle spring for an angle (`turn_to`). While the body holds still or a motion
+        script runs, the pose ignores both until that ends, as it always has. Returns True."""
+        if request.let_go:
+            self._target = None
+        elif request.target is not None:
+            self._target = request.target
+        if request.angle_deg is not None:
+            self.turn_to(request.angle_deg)
+        return True
+
     def hit(self, x: float, y: float, tolerance: float = 2.0) -> bool:
         """Is the lattice point (x, y) on the body (or within `tolerance` cells of it)?"""
-        px = x + np.array([0, -1, 1, 0, 0]) * tolerance
-        py = y + np.array([0, 0, 0, -1, 1]) * tolerance
-        return bool(np.any(self.shape.contains(px, py)))
+        return shape_hit(self.shape, x, y, tolerance)
 
     def turn_to(self, degrees: float):
         """Ask for the angle `degrees` (any turn count: 190 turns 20 from 170, not 340 back):
@@ -449,7 +466,7 @@ class Simulation:
         if self.hold_still:
             self.vel = (0.0, 0.0)
         else:
-            self.pos, self.vel, capped = self.coupling.advance(self.pos, self.vel, self.target, steps)
+            self.pos, self.vel, capped = self.coupling.advance(self.pos, self.vel, self._target, steps)
             self.capped |= capped
         omega_before = self.rate
         if not self.hold_still:
@@ -485,6 +502,16 @@ class Simulation:
 
     def field_rgba(self) -> np.ndarray:
         return field_rgba(self.solver)
+
+
+def shape_hit(shape, x: float, y: float, tolerance: float = 2.0) -> bool:
+    """Is the lattice point (x, y) on `shape` or within `tolerance` cells of it (the point and
+    its four neighbours at that distance)? False without a shape."""
+    if shape is None:
+        return False
+    px = x + np.array([0, -1, 1, 0, 0]) * tolerance
+    py = y + np.array([0, 0, 0, -1, 1]) * tolerance
+    return bool(np.any(shape.contains(px, py)))
 
 
 def field_rgba(solver) -> np.ndarray:

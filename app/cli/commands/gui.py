@@ -51,10 +51,10 @@ def set_surface_format():
 
 def replay_when_ready(window, path) -> None:
     """Replay the session at `path` once, when the window's live simulation first runs
-    (`MainWindow.start_replay` needs it; a bad file is its one-line dialog)."""
+    (`ReplayController.start`, app/gui/window/replay.py, needs it; a bad file is its one-line dialog)."""
     def start():
         window.simulationReady.disconnect(start)
-        window.start_replay(path)
+        window.replays.start(path)
     window.simulationReady.connect(start)
 
 

@@ -1,0 +1,209 @@
+"""Editing the body: its kind and size, holding it still, the polygon editor (undoable edits on
+the window's QUndoStack) and turning it with the viewport's handle, the mouse wheel or the
+panel's angle box (each turn one undo step; app/gui/turn_handle.py, app/gui/shape_editor.py).
+
+A turn while the flow runs is body input: it reaches the model as `BodyInput.turn`, and the
+body swings there through the angle spring. Paused or held still, the body turns at once, as
+an edit of its shape.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+from PySide6.QtWidgets import QMessageBox
+
+from feelflow.app.gui.shape_editor import SetPolygon
+from feelflow.app.gui.turn_handle import TurnBody
+from feelflow.app.model.bodies import default_polygon
+from feelflow.app.model.body_input import BodyInput
+from feelflow.app.model.simulation import wrap_degrees
+from feelflow.shapes.base import ShapeError
+from feelflow.solver.config import ConfigError
+
+if TYPE_CHECKING:
+    from feelflow.app.gui.main_window import MainWindow
+
+
+class BodyController:
+    """Changes the live body; every change is refused while a replay shows."""
+
+    def __init__(self, window: "MainWindow"):
+        self.w = window
+
+    def _refused(self) -> bool:
+        return self.w.sim is None or self.w.replays.refuse("the body follows the recording")
+
+    # --- kind, size, hold still -------------------------------------------------------------------
+    def apply_shape(self, **changes) -> bool:
+        """`Simulation.set_shape(**changes)`; a shape that cannot be used is a dialog and changes
+        nothing."""
+        w = self.w
+        if self._refused():
+            return False
+        w.make_current()
+        try:
+            w.sim.set_shape(**changes)
+        except (ShapeError, ConfigError, ValueError) as exc:
+            w.flow.refuse_dialog("This shape cannot be used", exc)
+            return False
+        w.panel.show_params(w.sim.params, w.loop.display_mode)
+        if w.flow.say_guard():
+            w.flow.after_rebuild()
+        w.viewport.update()
+        return True
+
+    def set_shape_kind(self, kind):
+        if self._refused():
+            return
+        if kind == "polygon" and self.w.sim.polygon is None:
+            self.install_default_polygon()
+            return
+        self.apply_shape(kind=kind)
+        if kind != "polygon":
+            self.set_editing(False)
+
+    def install_default_polygon(self):
+        w = self.w
+        verts = default_polygon(w.sim.params.size)
+        w.make_current()
+        try:
+            w.sim.set_shape(kind="polygon", polygon=verts)
+        except (ShapeError, ValueError) as exc:
+            w.flow.refuse_dialog("This shape cannot be used", exc)
+        w.panel.show_params(w.sim.params, w.loop.display_mode)
+
+    def install_loaded_shape(self, shape):
+        """A shape read from a file (app/gui/window/exports.py): a polygon is an undoable edit."""
+        from feelflow.app.model.bodies import params_for_shape
+
+        sim = self.w.sim
+        kind, size, verts = params_for_shape(shape)
+        if kind == "polygon":
+            if sim.params.shape != "polygon":
+                self.w.make_current()
+                sim.params = replace(sim.params, shape="polygon")
+            return self.edit_polygon(verts, "load shape")
+        return self.apply_shape(kind=kind, size=size)
+
+    def set_hold_still(self, on):
+        w = self.w
+        if w.replays.refuse("the body follows the recording"):
+            return
+        if w.sim is not None:
+            w.sim.hold_still = bool(on)
+        w.panel.hold_still.setChecked(bool(on))
+
+    # --- turning ----------------------------------------------------------------------------------
+    def turn_body(self, degrees: float) -> bool:
+        """Turn the body to `degrees` (any number of turns). While the flow runs it swings there
+        through the angle spring, as with the wheel; paused or held still it turns at once, as
+        with the panel's angle box. The panel shows the angle asked for."""
+        w = self.w
+        sim = w.sim
+        if self._refused():
+            return False
+        if w.loop.paused or sim.hold_still:
+            if sim.angle != math.radians(wrap_degrees(degrees)):
+                w.make_current()
+                try:
+                    sim.set_shape(angle_deg=wrap_degrees(degrees))
+                except (ShapeError, ConfigError, ValueError) as exc:   # no dialog in the middle of a drag
+                    w.statusBar().showMessage(f"The body cannot turn there: {exc}", 4000)
+                    return False
+        else:
+            sim.drive(BodyInput.turn(degrees, source="mouse"))
+        w.panel.show_angle(sim.params.angle_deg)
+        w.viewport.update()
+        return True
+
+    def turn_done(self, before: float, after: float):
+        """One drag of the handle: one undo step (the body is already at `after`)."""
+        if self.w.sim is not None and self.w.replays.replay is None:
+            self.w.undo.push(TurnBody(self.turn_body, before, after))
+
+    def _script_refuses_turn(self, how: str) -> bool:
+        """A motion script drives the pose (it ignores the angle until it ends, when the body would
+        swing to the last asked angle): refuse the turn with a status message."""
+        if getattr(self.w.sim, "runner", None) is None:
+            return False
+        self.turn_refused("A motion script", how)
+        return True
+
+    def turn_by_wheel(self, degrees: float) -> bool:
+        """The mouse wheel turns the body like the handle does; a burst of notches is one undo step."""
+        sim = self.w.sim
+        if sim is None or self._script_refuses_turn("the mouse wheel"):
+            return False
+        before = sim.target_degrees()
+        if not self.turn_body(before + degrees):
+            return False
+        self.w.undo.push(TurnBody(self.turn_body, before, before + degrees, "turn the body (wheel)", burst="wheel"))
+        return True
+
+    def set_angle(self, degrees: float) -> bool:
+        """The panel's angle box turns the body at once; a burst of edits (typed digits, arrow
+        steps) is one undo step, whose undo puts the body back at once too."""
+        sim = self.w.sim
+        if sim is None:
+            return False
+        if self._script_refuses_turn("the Angle box"):
+            self.w.panel.show_angle(sim.params.angle_deg)   # the box goes back to the angle the body keeps
+            return False
+        before = sim.target_degrees()
+        if not self._turn_at_once(degrees):
+            return False
+        self.w.undo.push(TurnBody(self._turn_at_once, before, degrees, "set the angle", burst="angle box"))
+        return True
+
+    def _turn_at_once(self, degrees: float) -> bool:
+        return self.apply_shape(angle_deg=wrap_degrees(degrees))
+
+    def turn_refused(self, driver: str, what: str = "the handle"):
+        """`driver` (viewport.turn_blocker's words) drives the body, so `what` may not turn it."""
+        how = "choose Mouse under Input" if self.w.inputs.device is not None \
+            else "wait for it to end or reset the flow (R)"
+        self.w.statusBar().showMessage(f"{driver} drives the body: {what} cannot rotate it now ({how}).", 6000)
+
+    # --- polygon editor ---------------------------------------------------------------------------
+    def set_editing(self, on):
+        w = self.w
+        if on and w.replays.refuse("the body follows the recording"):
+            return
+        w.viewport.editing = bool(on) and w.sim is not None and w.sim.params.shape == "polygon"
+        w.panel.edit.setChecked(w.viewport.editing)
+        if w.viewport.editing:
+            self.set_hold_still(True)
+            w.statusBar().showMessage(f"Editing the polygon (the body holds still): {w.panel.edit.toolTip()}; "
+                                      "Ctrl+Z undoes an edit.", 20000)
+        elif on is False and w.statusBar().currentMessage().startswith("Editing the polygon"):
+            w.statusBar().clearMessage()
+        w.viewport.update()
+
+    def check_polygon(self, verts):
+        """Build and validate the polygon without installing it; raises ShapeError."""
+        sim = self.w.sim
+        shape = sim.make_shape(replace(sim.params, shape="polygon"), verts, *sim.pos, sim.angle)
+        return shape.validate(sim.config.nx, sim.config.ny)
+
+    def edit_polygon(self, verts, text="edit polygon"):
+        """Push an undoable polygon edit, or refuse it with a dialog (the previous shape stays)."""
+        w = self.w
+        if w.replays.refuse("the body follows the recording"):
+            return False
+        try:
+            self.check_polygon(verts)
+        except (ShapeError, ValueError) as exc:
+            QMessageBox.warning(w, "This polygon cannot be used", f"{exc}\nThe previous shape is kept.")
+            w.viewport.update()
+            return False
+        w.undo.push(SetPolygon(self._install_polygon, w.sim.polygon, verts, text))
+        return True
+
+    def _install_polygon(self, verts):
+        w = self.w
+        w.make_current()
+        w.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in verts])
+        w.panel.show_params(w.sim.params, w.loop.display_mode)
+        w.viewport.update()

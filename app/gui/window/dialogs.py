@@ -1,0 +1,15 @@
+"""The window's one-line dialogs: bad input or a failed file operation is one plain sentence,
+never a traceback (DESIGN.md, house rules)."""
+from __future__ import annotations
+
+from PySide6.QtWidgets import QMessageBox, QWidget
+
+
+def attempt(parent: QWidget, fn, title: str):
+    """fn()'s result, or None after a one-line dialog when it raised OSError or ValueError
+    (ValueError: ShapeError, SessionError, ConfigError, each one line)."""
+    try:
+        return fn()
+    except (OSError, ValueError) as exc:
+        QMessageBox.warning(parent, title, str(exc))
+        return None

@@ -1,0 +1,89 @@
+"""Files the window writes and reads besides sessions: the forces as CSV, the plot as PNG, a
+screenshot of the whole window, and shape files (shapes/io.py). Every write is atomic
+(app/files.py, or the plot's own exporter); a failure is one dialog line."""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from PySide6.QtCore import QPoint
+from PySide6.QtGui import QImage, QPainter
+from PySide6.QtWidgets import QFileDialog, QMessageBox
+
+from feelflow.app.gui.window.dialogs import attempt
+from feelflow.shapes.base import ShapeError
+
+if TYPE_CHECKING:
+    from feelflow.app.gui.main_window import MainWindow
+
+
+class ExportController:
+    """The File menu's exports and shape files."""
+
+    def __init__(self, window: "MainWindow"):
+        self.w = window
+
+    # --- forces, plot, screenshot -----------------------------------------------------------------
+    def export_csv_dialog(self, _=None):
+        path, _ = QFileDialog.getSaveFileName(self.w, "Export forces", "forces.csv", "CSV (*.csv)")
+        if path:
+            attempt(self.w, lambda: self.w.plot.export_csv(path), "Could not export the forces")
+
+    def export_png_dialog(self, _=None):
+        path, _ = QFileDialog.getSaveFileName(self.w, "Export plot", "forces.png", "PNG (*.png)")
+        if path:
+            attempt(self.w, lambda: self.w.plot.export_png(path), "Could not export the plot")
+
+    def screenshot_dialog(self, _=None):
+        path, _ = QFileDialog.getSaveFileName(self.w, "Save screenshot", "feelflow.png", "PNG (*.png)")
+        if path:
+            attempt(self.w, lambda: self.save_screenshot(path), "Could not save the screenshot")
+
+    def window_image(self) -> QImage:
+        """The whole window as shown: QWidget.grab() misses the QPainter overlay of the GL view,
+        so the viewport's own rendering is painted over its place."""
+        w = self.w
+        image = w.grab().toImage()
+        painter = QPainter(image)
+        painter.drawImage(w.viewport.mapTo(w, QPoint(0, 0)), w.viewport.grabFramebuffer())
+        painter.end()
+        return image
+
+    def save_screenshot(self, path):
+        from feelflow.app.files import atomic_path
+
+        image = self.window_image()
+        with atomic_path(path, suffix=".png") as tmp:
+            if not image.save(str(tmp), "PNG"):
+                raise OSError(f"cannot write {path}")
+
+    # --- shape files ------------------------------------------------------------------------------
+    def save_shape_dialog(self, _=None):
+        path, _ = QFileDialog.getSaveFileName(self.w, "Save shape", "shape.json", "Shapes (*.json)")
+        if path:
+            self.save_shape(path)
+
+    def save_shape(self, path):
+        from feelflow.shapes import io as shape_io
+
+        try:
+            shape_io.save_shape(path, self.w.sim.shape)
+        except (OSError, ShapeError, ValueError) as exc:
+            QMessageBox.warning(self.w, "Could not save the shape", str(exc))
+
+    def load_shape_dialog(self, _=None):
+        path, _ = QFileDialog.getOpenFileName(self.w, "Load shape", "", "Shapes (*.json)")
+        if path:
+            self.load_shape(path)
+
+    def load_shape(self, path):
+        """Read a shape file and make it the body (a polygon as an undoable edit)."""
+        from feelflow.shapes import io as shape_io
+
+        if self.w.replays.refuse("the body follows the recording"):
+            return False
+        try:
+            shape = shape_io.load_shape(path)
+        except (OSError, ShapeError, ValueError) as exc:
+            QMessageBox.warning(self.w, "Could not load the shape", f"{exc}\nThe previous shape is kept.")
+            return False
+        return self.w.bodies.install_loaded_shape(shape)

@@ -1,0 +1,89 @@
+"""The flow's settings from the side panel: wind, viscosity, walls, grid and force models, and
+Reset flow. Values outside the measured stable region are moved inside it by the model
+(app/model/simulation.py `stable_params`), and the status bar says what changed.
+"""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from PySide6.QtWidgets import QMessageBox
+
+from feelflow.shapes.base import ShapeError
+from feelflow.solver.config import ConfigError
+
+if TYPE_CHECKING:
+    from feelflow.app.gui.main_window import MainWindow
+
+
+class FlowController:
+    """Changes the live tunnel's flow; refused while a replay shows."""
+
+    def __init__(self, window: "MainWindow"):
+        self.w = window
+
+    def apply(self, **changes):
+        """`Simulation.set_flow(**changes)` (wind, nu, wall); a bad value is a dialog."""
+        w = self.w
+        if w.sim is None or w.replays.refuse("the flow follows the recording"):
+            return
+        w.make_current()
+        try:
+            w.sim.set_flow(**changes)
+        except ConfigError as exc:
+            self.refuse_dialog("This flow setting cannot be used", exc)
+            return
+        if self.say_guard():
+            w.panel.show_params(w.sim.params, w.loop.display_mode)
+        self.after_rebuild()
+
+    def set_grid(self, grid):
+        w = self.w
+        if w.sim is None or w.replays.refuse("the grid is the recording's"):
+            return
+        w.make_current()
+        try:
+            w.sim.set_grid(grid)
+        except (ConfigError, ShapeError) as exc:
+            self.refuse_dialog("This grid cannot be used", exc)
+            return
+        w.viewport.tracers = None
+        self.after_rebuild()
+
+    def set_force_models(self, selected=None, compare_all=None):
+        w = self.w
+        if w.sim is not None and not w.replays.refuse("the scene cannot be changed"):
+            w.make_current()
+            w.sim.set_force_models(selected=selected, compare_all=compare_all)
+            w.loop.refresh_readouts()
+            w.plot.refresh(force=True)
+
+    def reset(self, _=None):
+        """Reset flow (R): the flow from its initial state, the body where it is."""
+        w = self.w
+        if w.sim is None or w.replays.refuse("the flow follows the recording"):
+            return
+        w.make_current()
+        w.sim.reset_flow()
+        w.viewport.tracers = None
+        w.loop.upload_field()
+        w.loop.refresh_readouts()
+
+    def say_guard(self) -> bool:
+        """Show in the status bar what the stability guard changed (simulation.stable_params)."""
+        note = self.w.sim.guard_note if self.w.sim is not None else None
+        if note:
+            self.w.statusBar().showMessage(note, 10000)
+        return bool(note)
+
+    def after_rebuild(self):
+        """After the tunnel changed: the device's workspace, the field, the readouts, a redraw."""
+        w = self.w
+        w.inputs.tunnel_changed()
+        w.loop.upload_field()
+        w.loop.refresh_readouts()
+        w.viewport.update()
+
+    def refuse_dialog(self, title, exc):
+        """A change the model refused: one-line dialog, the panel back at the model's values."""
+        QMessageBox.warning(self.w, title, str(exc))
+        self.w.panel.show_params(self.w.sim.params, self.w.loop.display_mode)

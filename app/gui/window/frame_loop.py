@@ -1,0 +1,287 @@
+"""The frame loop: each frame runs as many solver steps as keep the window at >= 30 fps
+(adaptive stepping: the cost of a step and of the rest of the frame, each smoothed), uploads
+the field, moves the tracers, sets the force arrows and redraws; twice a second the readouts
+follow. Pause, the display mode and the unstable-flow dialog live here too.
+
+A frame advances the model shown (`MainWindow.shown`, a `TunnelModel`): the live tunnel, or
+a replay at the same steps-per-frame budget.
+"""
+from __future__ import annotations
+
+import math
+import time
+from typing import TYPE_CHECKING
+
+import numpy as np
+from PySide6.QtCore import QTimer
+from PySide6.QtWidgets import QMessageBox
+
+from feelflow.solver.backend import SolverDiverged
+
+if TYPE_CHECKING:
+    from feelflow.app.gui.main_window import MainWindow
+
+TARGET_FRAME_S = 1.0 / 31.5    # aim just above 30 fps: every spare millisecond goes to the solver
+MAX_STEPS_PER_FRAME = 200
+MIN_STEPS_PER_FRAME = 2   # the flow keeps moving even where drawing alone takes 1/30 s
+N_TRACERS = 900
+READOUT_MS = 500
+
+
+class FrameLoop:
+    """Owns the frame timer, pause, the display mode and the steps-per-frame budget."""
+
+    def __init__(self, window: "MainWindow"):
+        self.w = window
+        self.paused = False
+        self.display_mode = "speed"
+        self.steps_per_frame = 4
+        self.step_cost = 2e-3       # seconds per solver step (running estimate)
+        self.other_cost = 5e-3      # seconds per frame outside stepping
+        self._last_tick = None
+        self._last_step_s = 0.0
+        self._rate_window = [time.perf_counter(), 0, 0]   # start, steps, frames
+        self.rates = {"steps_per_s": 0.0, "fps": 0.0, "mlups": 0.0}
+        self.tracer_rng = np.random.default_rng(1)
+        self.timer = QTimer(window)
+        self.timer.setInterval(0)
+        self.timer.timeout.connect(self.tick)
+        self.slow_timer = QTimer(window)
+        self.slow_timer.setInterval(READOUT_MS)
+        self.slow_timer.timeout.connect(self.refresh_readouts)
+
+    def start(self):
+        self.timer.start()
+        self.slow_timer.start()
+
+    def stop(self):
+        self.timer.stop()
+        self.slow_timer.stop()
+
+    def forget_last_frame(self):
+        """The next frame starts afresh (the model shown changed): no frame time to smooth."""
+        self._last_tick = None
+
+    # --- pause and display --------------------------------------------------------------------
+    def toggle_pause(self, _=None):
+        self.set_paused(not self.paused)
+
+    def set_paused(self, paused: bool):
+        w = self.w
+        replay = w.replays.replay
+        if replay is not None:   # Space pauses the replay; the live tunnel keeps its own state
+            replay.paused = paused
+            w.actions.pause.setChecked(paused or replay.done)
+            w.replays.show_progress()
+            return
+        if w.sim is not None and paused != self.paused:
+            w.sim.solver.pause() if paused else w.sim.solver.resume()
+        self.paused = paused
+        self.timer.setInterval(30 if paused else 0)   # paused: redraw at ~30 Hz, no busy loop
+        w.inputs.pause(paused)
+        w.actions.pause.setChecked(paused)
+        w.statusBar().showMessage("Paused (space to run)" if paused else "Running", 2000)
+
+    def set_display_mode(self, mode):
+        w = self.w
+        self.display_mode = mode
+        w.viewport.mode = mode
+        if mode != "tracers":
+            w.viewport.tracers = None
+        w.panel.show_params(w.params_now(), mode)
+        w.viewport.update()
+
+    # --- the field ----------------------------------------------------------------------------
+    def upload_field(self):
+        """The shown model's field into the viewport; the numpy path returns its (ny, nx, 4) array."""
+        w = self.w
+        model = w.shown
+        if model is None:
+            return None
+        if w.backend == "gl":
+            w.viewport.use_texture(model.solver.field_texture())
+            return None
+        rgba = model.field_rgba()
+        w.viewport.makeCurrent()
+        w.viewport.upload_field(rgba)
+        return rgba
+
+    def _field_array(self) -> np.ndarray:
+        """gl backend: the field texture `upload_field` computed this frame, read back (ny, nx,
+        4) float32, instead of running the field pass again."""
+        tex = self.w.viewport.field_texture
+        return np.frombuffer(tex.read(), np.float32).reshape(tex.height, tex.width, 4)
+
+    # --- one frame ------------------------------------------------------------------------------
+    def tick(self):
+        now = time.perf_counter()
+        w = self.w
+        sim = w.sim
+        if sim is None:
+            return
+        if w.replays.replay is not None:
+            self._tick_replay(now)
+            return
+        if self.paused:
+            w.viewport.update()
+            self._last_tick = None
+            return
+        n = self.steps_per_frame
+        w.make_current()
+        t0 = time.perf_counter()
+        try:
+            forces = sim.advance(n)
+        except SolverDiverged:
+            self._on_nan()
+            return
+        t1 = time.perf_counter()
+        rgba = self.upload_field()
+        # a blow-up in the field raises SolverDiverged from the solver's own check (both
+        # backends, docs/algorithm.md 'Divergence'); the forces are checked here, cheaply
+        if not all(math.isfinite(v) for f in forces.values() for v in f):
+            self._on_nan()
+            return
+        w.inputs.after_frame(forces)
+        self._frame_done(now, t0, t1, n, forces, rgba)
+
+    def _tick_replay(self, now):
+        """One frame of the replay, at the live tunnel's steps-per-frame budget."""
+        from feelflow.app.sessions import SessionError
+
+        w = self.w
+        r = w.replays.replay
+        w.inputs.watch_during_replay()
+        if r.paused or r.done:
+            w.viewport.update()
+            self._last_tick = None
+            return
+        w.make_current()
+        t0 = time.perf_counter()
+        try:
+            forces = r.advance(self.steps_per_frame)
+        except SessionError as exc:   # the file asks for something impossible: one line
+            w.replays.stop()
+            QMessageBox.warning(w, "Could not replay the session", str(exc))
+            return
+        t1 = time.perf_counter()
+        rgba = self.upload_field()
+        self._frame_done(now, t0, t1, max(1, r.last_steps), forces, rgba)
+        w.replays.show_progress()
+        if r.done:
+            w.actions.pause.setChecked(True)
+
+    def _frame_done(self, now, t0, t1, n, forces, rgba):
+        """After n steps took t1 - t0 s: tracers, arrows, redraw, and the next frame's budget."""
+        vp = self.w.viewport
+        if self.display_mode == "tracers":
+            self._advance_tracers(rgba, n)
+        if self.display_mode == "pressure" and vp.frames % 5 == 0:
+            vp.rho_ref = self._free_stream_density(rgba)
+        self._arrows(forces)
+        vp.update()
+        # adaptive stepping: cost per step and the rest of the frame, smoothed
+        self.step_cost = 0.8 * self.step_cost + 0.2 * (t1 - t0) / n
+        if self._last_tick is not None:
+            other = max(0.0, (now - self._last_tick) - self._last_step_s)
+            self.other_cost = 0.8 * self.other_cost + 0.2 * min(other, 0.2)
+        self._last_tick, self._last_step_s = now, t1 - t0
+        budget = TARGET_FRAME_S - self.other_cost
+        self.steps_per_frame = int(max(MIN_STEPS_PER_FRAME, min(MAX_STEPS_PER_FRAME, budget / max(self.step_cost, 1e-6))))
+        rw = self._rate_window
+        rw[1] += n
+        rw[2] += 1
+        if now - rw[0] >= 1.0:
+            dt = now - rw[0]
+            cfg = self.w.shown.config
+            self.rates = {"steps_per_s": rw[1] / dt, "fps": rw[2] / dt, "mlups": rw[1] * cfg.nx * cfg.ny / dt / 1e6}
+            self._rate_window = [now, 0, 0]
+
+    def _free_stream_density(self, rgba) -> float:
+        """Median density of the fluid: the reference of the pressure coefficient (the lattice's
+        mean density drifts by a fraction of a percent, which alone is Cp ~ 1 at U = 0.05)."""
+        if rgba is None:
+            rgba = self._field_array()
+        rho = rgba[::2, ::2, 0]
+        rho = rho[np.isfinite(rho)]
+        return float(np.median(rho)) if rho.size else 1.0
+
+    def _on_nan(self):
+        w = self.w
+        self.set_paused(True)
+        w.viewport.update()
+        answer = QMessageBox.question(
+            w, "The simulation became unstable",
+            "The flow became unstable and stopped (the numbers grew without bound).\n"
+            "This happens when the flow is too fast for the grid or the viscosity is too low.\n\n"
+            "Reset the flow and continue?", QMessageBox.Reset | QMessageBox.Cancel, QMessageBox.Reset)
+        if answer == QMessageBox.Reset:
+            w.flow.reset()
+            self.set_paused(False)
+
+    def _arrows(self, forces):
+        """Drag along the relative wind and lift across it, for the viewport's arrows."""
+        model, vp = self.w.shown, self.w.viewport
+        f = forces.get(model.params.force_model)
+        if f is None or not all(math.isfinite(v) for v in f):
+            vp.arrow_forces = None
+            return
+        wx, wy = model.relative_wind()
+        s = math.hypot(wx, wy)
+        ax, ay = (wx / s, wy / s) if s > 1e-9 else (1.0, 0.0)
+        drag = f[0] * ax + f[1] * ay
+        lift = -f[0] * ay + f[1] * ax
+        vp.arrow_forces = {"drag": (drag * ax, drag * ay), "lift": (-lift * ay, lift * ax)}
+
+    def _advance_tracers(self, rgba, n):
+        """Move the tracers n steps through the field; those that leave or hit the body restart
+        at the inlet."""
+        model, vp = self.w.shown, self.w.viewport
+        nx, ny = model.config.nx, model.config.ny
+        if rgba is None:
+            rgba = self._field_array()
+        rng = self.tracer_rng
+        if vp.tracers is None or len(vp.tracers[0]) != N_TRACERS:
+            pts = np.c_[rng.uniform(0, nx - 1, N_TRACERS), rng.uniform(0, ny - 1, N_TRACERS)]
+        else:
+            pts = vp.tracers[0]
+        ix = np.clip(np.rint(pts[:, 0]).astype(int), 0, nx - 1)
+        iy = np.clip(np.rint(pts[:, 1]).astype(int), 0, ny - 1)
+        u = rgba[iy, ix, 1:3].astype(float)
+        pts = pts + u * n
+        bad = (pts[:, 0] < 0) | (pts[:, 0] > nx - 1) | (pts[:, 1] < 0) | (pts[:, 1] > ny - 1) \
+            | ~np.isfinite(pts).all(axis=1)
+        if model.shape is not None:
+            bad |= model.shape.contains(pts[:, 0], pts[:, 1])
+        k = int(bad.sum())
+        if k:
+            pts[bad] = np.c_[rng.uniform(0, 3, k), rng.uniform(0, ny - 1, k)]
+        tail = pts - u * 30   # a short streak: where the particle was 30 steps ago
+        vp.tracers = (pts, tail)
+
+    # --- readouts -----------------------------------------------------------------------------
+    def refresh_readouts(self):
+        """The panel's numbers, the plot and the status bar, from the model shown."""
+        w = self.w
+        model = w.shown
+        if model is None:
+            return
+        p, panel = model.params, w.panel
+        live = model is w.sim
+        if live and (abs(panel.wind.value() - p.wind) > 5e-4   # a sweep, a lesson or the guard
+                     or abs(panel.viscosity.value() - p.nu) > 5e-5):
+            panel.show_params(p, self.display_mode)
+        elif live and not panel.angle.hasFocus():   # the wheel or the handle turned the body
+            panel.show_angle(p.angle_deg)
+        panel.show_numbers(model.reynolds(), model.mach(), model.config.mach_limit)
+        t, drag, lift = model.history.drag_lift(p.force_model)
+        if len(t) and p.force_model in model.history.forces:
+            panel.show_forces(float(np.nanmean(drag[-30:])), float(np.nanmean(lift[-30:])))
+        else:
+            panel.show_forces(None, None)
+        w.plot.refresh()
+        r = self.rates
+        w.status["steps"].setText(f"{r['steps_per_s']:.0f} steps/s")
+        w.status["mlups"].setText(f"{r['mlups']:.1f} MLUPS")
+        w.status["fps"].setText(f"{r['fps']:.0f} fps")
+        w.status["re"].setText(f"Re {model.reynolds():.0f}")
+        w.status["ma"].setText(f"Ma {model.mach():.3f}")

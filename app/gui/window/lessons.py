@@ -1,0 +1,49 @@
+"""The Presets menu: a lesson loads its scene file (scenes/presets/) and sets the window up as
+the lesson needs (app/model/presets.py): hold still or not, a wind sweep, the display mode and
+the plot's view."""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from feelflow.app.model.presets import PRESETS
+from feelflow.shapes.base import ShapeError
+from feelflow.solver.config import ConfigError
+
+if TYPE_CHECKING:
+    from feelflow.app.gui.main_window import MainWindow
+
+
+class LessonController:
+    """Starts lessons in the live tunnel."""
+
+    def __init__(self, window: "MainWindow"):
+        self.w = window
+
+    def apply(self, key) -> bool:
+        """Load the lesson's scene file and set the window up as the lesson needs."""
+        from feelflow.app.errors import UserError
+        from feelflow.app.model.scene import load_scene
+
+        w = self.w
+        lesson = PRESETS[key]
+        if w.sim is None or w.replays.refuse("lessons run in the live tunnel"):
+            return False
+        try:
+            scene = load_scene(lesson.path)
+            w.make_current()
+            w.sim.load_scene(scene)
+        except (UserError, ConfigError, ShapeError, ValueError) as exc:
+            w.flow.refuse_dialog("This lesson cannot run here", exc)
+            return False
+        w.undo.clear()   # the lesson replaces the body and its pose: earlier edits and turns do not apply
+        w.bodies.set_hold_still(lesson.hold_still and w.sim.runner is None)
+        if lesson.wind_sweep:
+            w.sim.start_sweep(lesson.wind_sweep, lesson.hold_steps)
+        w.loop.set_display_mode(lesson.display)
+        w.plot.view.setCurrentIndex(w.plot.view.findData(lesson.plot_view))
+        w.viewport.tracers = None
+        w.panel.show_params(w.sim.params, w.loop.display_mode)
+        w.flow.after_rebuild()
+        w.loop.set_paused(False)
+        w.statusBar().showMessage(f"{lesson.title}: {lesson.note}", 20000)
+        return True

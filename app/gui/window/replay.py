@@ -1,0 +1,173 @@
+"""Recording a session of the live tunnel, and replaying a recorded one in the window.
+
+While a session replays, an `feelflow.app.model.replay_simulation.ReplaySimulation` takes the
+live simulation's place in the viewport and the plot (both are `TunnelModel`s,
+app/model/tunnel.py) at the same steps-per-frame budget; the live one waits untouched, and Stop
+replay (Esc) brings it back as it was. Requests that would change the live tunnel meanwhile
+are refused with one status-bar sentence (`refuse`).
+"""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from PySide6.QtWidgets import QFileDialog, QLabel, QMessageBox
+
+from feelflow.app.gui.window.dialogs import attempt
+
+if TYPE_CHECKING:
+    from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.model.replay_simulation import ReplaySimulation
+
+
+class ReplayController:
+    """Owns the replay (None while the live tunnel shows) and its status-bar label."""
+
+    def __init__(self, window: "MainWindow"):
+        self.w = window
+        self.replay: ReplaySimulation | None = None
+        self.label = QLabel()   # "Replaying <name>: step N / M" (hidden by passing messages)
+        window.statusBar().addWidget(self.label, 1)
+        self.label.hide()
+
+    # --- recording ----------------------------------------------------------------------------
+    def toggle_recording(self, _=None):
+        w = self.w
+        if w.sim is None:
+            return
+        solver = w.sim.solver
+        if self.refuse("recording is for the live tunnel"):
+            w.actions.record.setChecked(solver.recorder is not None)
+            return
+        if solver.recorder is None:
+            solver.start_recording(renderer=w.viewport.renderer())
+            w.actions.record.setChecked(True)
+            w.statusBar().showMessage("Recording a session: inputs, parameter changes and forces.", 5000)
+            return
+        w.actions.record.setChecked(False)
+        recorder = solver.stop_recording()
+        path, _ = QFileDialog.getSaveFileName(w, "Save session", "lesson.ffsession", "Sessions (*.ffsession)")
+        if path:
+            attempt(w, lambda: recorder.save(path), "Could not save the session")
+
+    # --- replaying ----------------------------------------------------------------------------
+    def open_dialog(self, _=None):
+        if self.w.sim is None:
+            return
+        path, _ = QFileDialog.getOpenFileName(self.w, "Replay session", "", "Sessions (*.ffsession)")
+        if path:
+            self.start(path)
+
+    def start(self, path) -> bool:
+        """Replay the session file at `path` in the window; a bad file is a one-line dialog and
+        changes nothing. The live tunnel waits, untouched, until `stop`."""
+        w = self.w
+        if w.sim is None:
+            return False
+        if w.sim.solver.recorder is not None:
+            QMessageBox.warning(w, "Could not replay the session",
+                                "A session is being recorded: stop the recording (File > Record session) first.")
+            return False
+        replay = attempt(w, lambda: self._open(path), "Could not replay the session")
+        if replay is None:
+            return False
+        if self.replay is not None:
+            self.stop()
+        w.bodies.set_editing(False)
+        w.viewport.cancel_drag()
+        w.inputs.replay_started()    # lets go of the body; a device's force fades, its moves are refused
+        self.replay = replay
+        w.actions.undo.setEnabled(False)
+        w.actions.redo.setEnabled(False)
+        self._show(replay)
+        w.actions.pause.setChecked(False)
+        w.actions.stop_replay.setEnabled(True)
+        w.actions.replay_toolbar.show()
+        w.statusBar().clearMessage()   # a passing message (the mouse hint) would be drawn over the label
+        self.label.show()
+        w.loop.timer.setInterval(0)
+        self.show_progress()
+        return True
+
+    def _open(self, path):
+        """A ReplaySimulation of the file on the window's backend; SessionError (one line)."""
+        from feelflow.app.model.replay_simulation import ReplaySimulation
+        from feelflow.app.sessions import load_session
+
+        session = load_session(path)
+        w = self.w
+        w.make_current()
+        return ReplaySimulation(session, w.backend, ctx=w.viewport.ctx if w.backend == "gl" else None)
+
+    def stop(self, _=None):
+        """Back to the live tunnel exactly as it was when the replay began."""
+        replay, self.replay = self.replay, None
+        if replay is None:
+            return
+        w = self.w
+        w.make_current()
+        self._show(w.sim)
+        replay.close()
+        w.viewport.banner = None
+        self.label.hide()
+        w.actions.replay_toolbar.hide()
+        w.actions.stop_replay.setEnabled(False)
+        w.actions.undo.setEnabled(w.undo.canUndo())
+        w.actions.redo.setEnabled(w.undo.canRedo())
+        paused = w.loop.paused
+        w.actions.pause.setChecked(paused)
+        w.loop.timer.setInterval(30 if paused else 0)
+        w.inputs.replay_stopped(paused)
+        w.panel.show_params(w.sim.params, w.loop.display_mode)
+        w.flow.after_rebuild()
+        w.statusBar().showMessage("Replay stopped: back to the live tunnel.", 4000)
+
+    def close(self):
+        """The window closes: the replay's solver goes with it."""
+        if self.replay is not None:
+            self.w.make_current()
+            self.replay.close()
+
+    def _show(self, model):
+        """Point the viewport and the plot at `model` (live or replay) and draw it."""
+        w = self.w
+        w.viewport.sim = w.plot.sim = model
+        w.viewport.locked = model is self.replay
+        w.viewport.tracers = w.viewport.arrow_forces = None
+        w.loop.forget_last_frame()
+        w.loop.upload_field()
+        w.plot.refresh(force=True)
+        w.viewport.update()
+
+    def show_progress(self):
+        r = self.replay
+        if r is None:
+            return
+        where = f"step {r.step} / {r.total_steps}"
+        if r.done:
+            text = f"Replay of {r.name} finished at {where}: Stop replay (Esc) returns to the live tunnel."
+            self.w.viewport.banner = f"replay finished ({where})"
+        else:
+            text = f"Replaying {r.name}: {where}" + (" (paused: space to run)" if r.paused else "")
+            self.w.viewport.banner = f"replay: {where}" + (", paused" if r.paused else "")
+        if r.player.diverged_at is not None:
+            text += f"; the flow diverged at step {r.player.diverged_at}"
+        self.label.setText(text)
+
+    def refuse(self, why: str) -> bool:
+        """During a replay: say in the status bar why a request is refused, put the controls back
+        as they were and return True; otherwise False."""
+        r = self.replay
+        if r is None:
+            return False
+        w = self.w
+        w.statusBar().showMessage(f"Replaying {r.name}: {why}. Stop replay (Esc) to return to the live tunnel.",
+                                  6000)
+        p = w.panel
+        if w.sim is not None:
+            p.show_params(w.sim.params, w.loop.display_mode)
+            for box, on in ((p.hold_still, w.sim.hold_still), (p.edit, w.viewport.editing)):
+                box.blockSignals(True)
+                box.setChecked(on)
+                box.blockSignals(False)
+        w.inputs.show_selected()
+        return True

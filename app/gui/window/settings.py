@@ -1,0 +1,76 @@
+"""What the window remembers between runs (QSettings): the panel's parameters, the custom
+polygon, the display mode and the window's geometry. Unreadable values fall back to the
+defaults one by one."""
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING
+
+from PySide6.QtCore import QSettings
+
+from feelflow.app.model.simulation import Params
+
+if TYPE_CHECKING:
+    from feelflow.app.gui.main_window import MainWindow
+
+PARAM_KEYS = ("shape", "size", "angle_deg", "wind", "nu", "wall", "force_model")
+
+
+class WindowSettings:
+    """Reads and writes the window's QSettings."""
+
+    def __init__(self, settings: QSettings):
+        self.qsettings = settings
+
+    def params(self) -> Params:
+        d = Params()
+        s = self.qsettings
+
+        def get(key, default, kind):
+            try:
+                return kind(s.value(key, default))
+            except (TypeError, ValueError):
+                return default
+        grid = str(s.value("grid", f"{d.grid[0]}x{d.grid[1]}"))
+        try:
+            grid = tuple(int(v) for v in grid.split("x"))
+        except ValueError:
+            grid = d.grid
+        return Params(grid=grid if len(grid) == 2 else d.grid, shape=get("shape", d.shape, str),
+                      size=get("size", d.size, float), angle_deg=get("angle_deg", d.angle_deg, float),
+                      wind=get("wind", d.wind, float), nu=get("nu", d.nu, float), wall=get("wall", d.wall, str),
+                      force_model=get("force_model", d.force_model, str),
+                      compare_all=str(s.value("compare_all", "false")).lower() == "true")
+
+    def polygon(self):
+        """The remembered polygon's vertices (body frame), or None."""
+        try:
+            verts = json.loads(str(self.qsettings.value("polygon", "null")))
+            return [(float(x), float(y)) for x, y in verts] if verts else None
+        except (TypeError, ValueError):
+            return None
+
+    def display_mode(self, modes) -> str:
+        """The remembered display mode if it is one of `modes`, else "speed"."""
+        mode = self.qsettings.value("display_mode", "speed")
+        return mode if mode in modes else "speed"
+
+    def restore_geometry(self, window: "MainWindow"):
+        geometry = self.qsettings.value("geometry")
+        if geometry is not None:
+            window.restoreGeometry(geometry)
+        else:
+            window.resize(1280, 820)
+
+    def save(self, window: "MainWindow"):
+        """Everything above, as the window shows it now."""
+        s, p = self.qsettings, window.params_now()
+        s.setValue("grid", f"{p.grid[0]}x{p.grid[1]}")
+        for key in PARAM_KEYS:
+            s.setValue(key, getattr(p, key))
+        s.setValue("compare_all", "true" if p.compare_all else "false")
+        if window.sim is not None and window.sim.polygon is not None:
+            s.setValue("polygon", json.dumps([list(v) for v in window.sim.polygon]))
+        s.setValue("display_mode", window.loop.display_mode)
+        s.setValue("geometry", window.saveGeometry())
+        s.sync()

@@ -1,0 +1,74 @@
+"""The declared interface between the window and the tunnel it shows: `TunnelModel`, what the
+window, the viewport, the side panel and the force plot read and call on the model. Both the
+live `Simulation` (app/model/simulation.py) and a replaying session's `ReplaySimulation`
+(app/model/replay_simulation.py) implement it, so the window swaps one for the other without
+knowing which it holds; tests/test_tunnel_model.py checks both against it, member by member.
+
+Changing the live tunnel (body, flow, grid, lessons, recording) is not part of it: those calls
+go to the live `Simulation` only, which a replay never replaces. Lattice units throughout
+(docs/algorithm.md).
+"""
+from __future__ import annotations
+
+from typing import Any, Protocol, runtime_checkable
+
+from feelflow.app.model.body_input import BodyInput
+
+
+@runtime_checkable
+class TunnelModel(Protocol):
+    """What the window drives: one frame at a time (`advance`), body input through one way in
+    (`drive`), and what is drawn and read out."""
+
+    config: Any          # solver.config.FlowConfig: grid size, Mach cap, sponge
+    params: Any          # simulation.Params: what the side panel shows
+    history: Any         # simulation.History: one force sample per frame, for the plot
+    solver: Any          # the backend behind the field (numpy arrays or the gl field texture)
+    shape: Any           # the body (shapes.base.Shape) where the flow feels it, or None
+    pos: tuple[float, float]    # the body's reference point (cells)
+    angle: float         # the body's angle (radians)
+    vel: tuple[float, float]    # the body's velocity (cells per step)
+    target: tuple[float, float] | None   # where an input pulls the body, or None
+    hold_still: bool     # the body ignores pulls and turns (the polygon editor, some lessons)
+    polygon: Any         # the custom polygon's vertices (body frame), or None
+    capped: bool         # the Mach cap limited the body's speed in the last frame
+    sweep: Any           # a lesson's wind sweep (speeds, steps each, first step), or None
+    runner: Any          # a motion script driving the pose (solver.motion.MotionRunner), or None
+
+    def advance(self, n: int) -> dict:
+        """Run about n steps; {force model: (Fx, Fy)} averaged over them."""
+        ...
+
+    def drive(self, request: BodyInput) -> bool:
+        """Body input from the mouse, a device or a script; False when the model refuses it."""
+        ...
+
+    def hit(self, x: float, y: float, tolerance: float = 2.0) -> bool:
+        """Is the lattice point (x, y) on the body, within `tolerance` cells?"""
+        ...
+
+    def target_degrees(self) -> float:
+        """The angle the body is asked to turn to (degrees, any number of turns)."""
+        ...
+
+    def relative_wind(self) -> tuple[float, float]:
+        """The wind the body meets: the inflow less the body's velocity."""
+        ...
+
+    def reynolds(self) -> float:
+        ...
+
+    def mach(self) -> float:
+        ...
+
+    def field_rgba(self) -> Any:
+        """(ny, nx, 4) float32: rho, ux, uy, vorticity (the numpy path's field)."""
+        ...
+
+    def script_phase(self) -> tuple[int, int, str] | None:
+        """(phase index, count, words) of a running motion script, or None."""
+        ...
+
+    def sweep_stage(self) -> int | None:
+        """Which speed of a wind sweep holds now, or None."""
+        ...
