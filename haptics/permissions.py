@@ -49,16 +49,9 @@ def serial_fix(port: str) -> str:
             "then log out and in again")
 
 
-def hid_fix(path: str | None = None) -> str | None:
-    """The fix when hidapi could not open a device: None where nothing points at permissions
-    (the node is accessible, or none exists)."""
-    if path:
-        nodes = [path] if path.startswith("/dev/") or os.path.exists(path) else []
-    else:
-        try:
-            nodes = sorted("/dev/" + n for n in os.listdir("/dev") if n.startswith("hidraw"))
-        except OSError:
-            nodes = []
+def hid_fix(nodes: list[str]) -> str | None:
+    """The fix when hidapi could not open a device at these nodes (hidapi's Linux paths are
+    /dev/hidraw*): None where none of them is refused to this user."""
     denied = [n for n in nodes if os.path.exists(n) and not os.access(n, os.R_OK | os.W_OK)]
     if not denied:
         return None
