@@ -23,6 +23,7 @@ from feelflow.app.gui.qt_runtime import make_none_immortal
 
 make_none_immortal()  # before any Qt object: see app/qt_runtime.py
 
+from feelflow.app.gui import first_start  # noqa: E402
 from feelflow.app.gui.force_plot import ForcePlot  # noqa: E402
 from feelflow.app.model.presets import PRESETS
 from feelflow.app.model.bodies import default_polygon
@@ -94,7 +95,7 @@ class MainWindow(QMainWindow):
         self.panel.show_params(self.params, self.display_mode)
         self._connect_panel()
         self.viewport.contextReady.connect(self._on_context)
-        self.viewport.contextFailed.connect(self._cannot_start)
+        first_start.watch_gl(self)   # no OpenGL 3.3: a dialog, then the numpy solver on the CPU
         self.startup_error = None
         self.viewport.polygonEdited.connect(self.edit_polygon)
         self.viewport.inputRefused.connect(lambda: self._refuse_in_replay("the mouse does not move the body"))

@@ -19,7 +19,8 @@ from PySide6.QtGui import QBrush, QColor, QFont, QLinearGradient, QPainter, QPen
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
 from PySide6.QtWidgets import QToolTip
 
-from feelflow.app.gui import turn_handle
+from feelflow.app.gui import cpu_field, turn_handle
+from feelflow.app.gui.first_start import required_gl
 from feelflow import SHADER_DIR
 from feelflow.solver import units
 from feelflow.solver.lattice import glsl_constants
@@ -101,9 +102,9 @@ class Viewport(QOpenGLWidget):
 
     def initializeGL(self):
         try:
-            self.ctx = moderngl.create_context(require=330)
+            self.ctx = moderngl.create_context(require=required_gl())
         except Exception as exc:   # moderngl.Error and friends: say so, never a traceback
-            self.ctx = None
+            self.ctx = None        # paintGL then draws on the CPU (app/gui/cpu_field.py)
             self.contextFailed.emit(f"OpenGL 3.3 is not available here ({str(exc).splitlines()[0]})")
             return
         self._init_programs()
@@ -133,6 +134,9 @@ class Viewport(QOpenGLWidget):
 
     def upload_field(self, rgba: np.ndarray):
         """numpy path: copy (ny, nx, 4) float32 (rho, ux, uy, vorticity) into the field texture."""
+        if self.ctx is None:       # no OpenGL 3.3: paintGL colours it on the CPU
+            self.cpu_rgba = rgba
+            return
         ny, nx = rgba.shape[:2]
         tex = self.field_texture
         if tex is None or tex.size != (nx, ny) or getattr(self, "_own_texture", False) is False:
@@ -167,6 +171,7 @@ class Viewport(QOpenGLWidget):
 
     def paintGL(self):
         if self.ctx is None:
+            cpu_field.paint(self, getattr(self, "cpu_rgba", None))
             return
         painter = QPainter(self)
         painter.beginNativePainting()   # Qt's GL state is saved; moderngl draws the field
