@@ -1,6 +1,7 @@
 """A calm first start in a real window under Xvfb: OpenGL 3.3 refused (the requirement raised
-past what llvmpipe offers, FEELFLOW_REQUIRE_GL) gives a dialog and a window that runs on the CPU;
-a first start opens the lesson chooser, and only the first."""
+past what llvmpipe offers, FEELFLOW_REQUIRE_GL) or no OpenGL at all (Qt's xcb plugin without
+GLX and EGL, QT_XCB_GL_INTEGRATION=none) gives a dialog and a window that runs on the CPU; a
+first start opens the lesson chooser, and only the first."""
 from __future__ import annotations
 
 import os
@@ -98,11 +99,53 @@ def test_first_start_offers_the_lessons_once(qtbot, tmp_path):
     again.slow_timer.stop()
 
 
-def test_selftest_passes_without_gl_on_the_cpu(tmp_path):
-    """`feelflow --selftest` end to end where OpenGL 3.3 is refused."""
-    env = {**os.environ, "FEELFLOW_REQUIRE_GL": "990"}
-    r = subprocess.run([sys.executable, "-m", "feelflow.app", "--selftest", "--seconds", "4"], env=env,
-                       capture_output=True, text=True, timeout=300, cwd=tmp_path)
+NO_GL = {"gl 3.3 refused": {"FEELFLOW_REQUIRE_GL": "990"}, "no gl at all": {"QT_XCB_GL_INTEGRATION": "none"}}
+
+
+@pytest.mark.parametrize("case", list(NO_GL))
+def test_selftest_passes_without_gl_on_the_cpu(tmp_path, case):
+    """`feelflow --selftest` end to end (the field lives, a drag moves the body)."""
+    r = subprocess.run([sys.executable, "-m", "feelflow.app", "--selftest", "--seconds", "4"],
+                       env={**os.environ, **NO_GL[case]}, capture_output=True, text=True, timeout=300, cwd=tmp_path)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "renderer no GL, solver backend numpy" in r.stdout
     assert r.stdout.rstrip().endswith("selftest: ok")
+
+
+SCREEN_CHECK = """
+import sys
+from feelflow.app.cli.commands.gui import set_surface_format
+from feelflow.app.gui.qt_runtime import make_none_immortal
+make_none_immortal(); set_surface_format()
+from PySide6.QtCore import QSettings, QTimer
+from PySide6.QtWidgets import QApplication
+app = QApplication([])
+from feelflow.app.gui.main_window import MainWindow
+w = MainWindow(backend="gl", settings=QSettings(sys.argv[1], QSettings.IniFormat))
+w.resize(1000, 700)
+w.show()
+def look():
+    shown = w.centralWidget()
+    r = shown.rect().adjusted(20, 20, -150, -20)
+    top_left = shown.mapToGlobal(r.topLeft())
+    image = app.primaryScreen().grabWindow(0, top_left.x(), top_left.y(), r.width(), r.height()).toImage()
+    colours = {image.pixel(x, y) for x in range(0, image.width(), 9) for y in range(0, image.height(), 9)}
+    print(w.backend, w.viewport.frames, len(colours), w.gl_missing)
+    app.quit()
+QTimer.singleShot(4000, look)
+app.exec()
+"""
+
+
+@pytest.mark.parametrize("case", list(NO_GL))
+def test_the_cpu_picture_reaches_the_screen(tmp_path, case):
+    """The X server's own pixels (QScreen.grabWindow), not the widget's: where Qt has no OpenGL
+    a QOpenGLWidget left in the window would keep the whole window black."""
+    r = subprocess.run([sys.executable, "-c", SCREEN_CHECK, str(tmp_path / "settings.ini")],
+                       env={**os.environ, **NO_GL[case]}, capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    backend, frames, colours, missing = r.stdout.strip().split(" ", 3)
+    assert backend == "numpy" and int(frames) > 10
+    assert int(colours) > 20, r.stdout            # a coloured flow field, not a black or flat window
+    assert missing.startswith("OpenGL 3.3 is not available here (" if case == "gl 3.3 refused"
+                              else "OpenGL is not available here at all")

@@ -2,8 +2,9 @@
 
 - no screen (no DISPLAY, or no X server answering it): one line before Qt starts, instead of
   Qt's abort (`display_problem`, used by `feelflow gui`);
-- no OpenGL 3.3 core context (an old driver, a remote desktop): a dialog says what is missing
-  and the window runs on the CPU (numpy solver, app/gui/cpu_field.py draws the field);
+- no OpenGL 3.3 core context, or no OpenGL at all (an old driver, a remote desktop): a dialog
+  says what is missing and the window runs on the CPU (numpy solver; app/gui/cpu_field.py
+  draws the field);
 - the first start offers the Presets menu's lessons (`offer_lessons`), not an empty tunnel.
 Device permissions have their one-line fixes in feelflow.haptics.permissions.
 """
@@ -81,17 +82,39 @@ def no_gl_text(detail: str) -> str:
 
 
 def watch_gl(window) -> None:
-    """Hook: where the viewport gets no OpenGL 3.3, the window runs on numpy and says why."""
+    """Hook (before the window is shown): where the viewport gets no OpenGL 3.3, the window runs
+    on numpy and says why. Where Qt has no OpenGL at all the viewport's initializeGL never runs:
+    a context made here first finds that out, and a CPU canvas takes the viewport's place."""
+    from PySide6.QtCore import QTimer
+    from PySide6.QtGui import QOpenGLContext
+
     window.gl_missing = None
     window.viewport.contextFailed.connect(lambda detail: run_on_cpu(window, detail))
+    if QOpenGLContext().create():
+        return
+    from feelflow.app.gui.cpu_field import CpuCanvas
+
+    viewport = window.takeCentralWidget()   # out of the window, which then needs no OpenGL to show
+    viewport.setParent(None)
+    window.setCentralWidget(CpuCanvas(viewport, stand_in=True))
+    QTimer.singleShot(0, lambda: run_on_cpu(window, "OpenGL is not available here at all "
+                                                    "(Qt could not create an OpenGL context)"))
 
 
 def run_on_cpu(window, detail: str) -> None:
     from PySide6.QtCore import QTimer
     from PySide6.QtWidgets import QMessageBox
 
+    from feelflow.app.gui.cpu_field import CpuCanvas
+
+    if window.gl_missing is not None:
+        return
     window.gl_missing = detail
     window.backend = "numpy"
+    viewport = window.viewport
+    canvas = getattr(viewport, "cpu_canvas", None) or CpuCanvas(viewport)
+    # the window's screenshots read the viewport's framebuffer: the canvas holds the picture now
+    viewport.grabFramebuffer = lambda: canvas.grab().toImage()
     box = QMessageBox(QMessageBox.Warning, "FeelFlow runs without OpenGL 3.3", no_gl_text(detail),
                       QMessageBox.Ok, window)
     box.setObjectName("no-gl-dialog")
