@@ -93,6 +93,12 @@ def test_selftest_and_a_session_in_the_window(bundle, tmp_path):
     r = feelflow(bundle, tmp_path, "--selftest", "--seconds", "5")
     assert r.returncode == 0, r.stdout + r.stderr
     assert r.stdout.rstrip().endswith("selftest: ok")
+    # Qt without OpenGL (X forwarding, a remote desktop): the window runs on the CPU
+    env = {**clean_env(tmp_path), "QT_XCB_GL_INTEGRATION": "none"}
+    r = subprocess.run([str(bundle / "feelflow"), "--selftest", "--seconds", "4"], cwd=tmp_path, env=env,
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "renderer no GL, solver backend numpy" in r.stdout and r.stdout.rstrip().endswith("selftest: ok")
     rec = feelflow(bundle, tmp_path, "run", ROOT / "scenes" / "default.toml", "--steps", "600", "--out", "f.csv",
                    "--record", "lesson.ffsession")
     assert rec.returncode == 0, rec.stderr
@@ -115,3 +121,15 @@ def test_desktop_install_from_the_bundle_and_uninstall(bundle, tmp_path):
     r = subprocess.run(["bash", str(script), "--uninstall"], env=env, capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
     assert list(home.iterdir()) == []
+    # the udev rule, written by the bundle's own program
+    from feelflow.haptics.permissions import RULES_FILE, udev_rules
+
+    rules = tmp_path / "rules.d"
+    rules.mkdir()
+    env["FEELFLOW_UDEV_DIR"] = str(rules)
+    for args, present in ((["--udev"], True), (["--udev", "--uninstall"], False)):
+        r = subprocess.run(["bash", str(script), *args], env=env, capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0, r.stderr
+        assert (rules / RULES_FILE).exists() == present
+        if present:
+            assert (rules / RULES_FILE).read_text() == udev_rules()
