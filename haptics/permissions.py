@@ -9,7 +9,6 @@ installs it as RULES_FILE).
 from __future__ import annotations
 
 import errno
-import grp
 import os
 import stat
 import sys
@@ -31,8 +30,10 @@ def _group_of(path: str) -> tuple[str | None, int]:
     except OSError:
         return None, 0
     try:
+        import grp   # POSIX only: this module is imported on Windows too
+
         name = grp.getgrgid(st.st_gid).gr_name
-    except KeyError:
+    except (ImportError, KeyError):
         name = str(st.st_gid)
     return name, stat.S_IMODE(st.st_mode)
 

@@ -18,7 +18,7 @@ pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Li
 
 CHILD = textwrap.dedent("""
     import os, sys
-    import hid, serial, serial.serialposix   # loaded before the privileges go
+    import grp, hid, serial, serial.serialposix   # loaded before the privileges go (root's Python)
     from feelflow.haptics.errors import DeviceError
     from feelflow.haptics.transport import HidTransport, SerialTransport
     if os.geteuid() == 0:
