@@ -14,7 +14,7 @@ import os
 import socket
 import sys
 
-#: the OpenGL version the viewport and the gl solver need (3.3 core, shared with macOS' 4.1)
+#: the OpenGL version the viewport and the gl solver need (3.3 core; macOS offers up to 4.1)
 REQUIRED_GL = 330
 #: environment variable that raises the requirement (for example 990): provokes the CPU
 #: fallback on any machine, to see or test it
