@@ -10,6 +10,7 @@ import os
 import time
 
 from feelflow.haptics.errors import DeviceDisconnected, DeviceError
+from feelflow.haptics.permissions import hid_fix, is_permission_error, serial_fix
 
 
 class SerialTransport:
@@ -29,6 +30,8 @@ class SerialTransport:
             try:
                 self._port = serial.serial_for_url(port, baudrate=baudrate, timeout=0, write_timeout=0.5)
             except (serial.SerialException, OSError, ValueError) as exc:
+                if is_permission_error(exc):
+                    raise DeviceError(serial_fix(port)) from None
                 raise DeviceError(f"cannot open serial port {port}: {exc}") from None
         # On POSIX ports, write to the (non-blocking) descriptor ourselves: pyserial's write
         # with a timeout raises 'Write timeout' AFTER writing when the calling thread was merely
@@ -114,6 +117,10 @@ class HidTransport:
                 else:
                     device.open(vid, pid)
             except (OSError, IOError, ValueError) as exc:
+                nodes = [path] if path is not None else [d.get("path") for d in hid.enumerate(vid, pid)]
+                fix = hid_fix([p.decode(errors="replace") if isinstance(p, bytes) else p for p in nodes if p])
+                if fix is not None:
+                    raise DeviceError(f"cannot open HID device {self.name}: {fix}") from None
                 raise DeviceError(f"cannot open HID device {self.name}: {exc} "
                                   "(is it plugged in, and may this user read /dev/hidraw*?)") from None
         self._dev = device

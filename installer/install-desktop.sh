@@ -2,32 +2,92 @@
 # Puts FeelFlow into the desktop: an application-menu entry with its icon, `feelflow` on the
 # PATH, and `.ffsession` files (docs/sessions.md) that open in FeelFlow's replay when
 # double-clicked. Usage:
-#   installer/install-desktop.sh [--prefix DIR] [--no-setup]   install (again: safe)
+#   installer/install-desktop.sh [--prefix DIR] [--bundle DIR] [--no-setup]   install (again: safe)
 #   installer/install-desktop.sh [--prefix DIR] --uninstall    remove what install wrote
+#   installer/install-desktop.sh --udev [--uninstall]          (as root) the device permission rule
 # Per user by default (XDG): ${XDG_DATA_HOME:-~/.local/share}/{applications,icons,mime} and
 # ~/.local/bin/feelflow. With --prefix DIR (for example /usr/local, as root): DIR/share and
-# DIR/bin, for every user of the machine. The launcher execs this checkout's .venv/bin/feelflow,
-# made first by installer/setup.sh (skipped with --no-setup). Every file written is listed in a
-# manifest (DATA/feelflow/installed-files.txt) with its checksum; --uninstall removes exactly
-# those that still hold what was written, and the folders install created if they are empty.
+# DIR/bin, for every user of the machine. From a checkout the launcher execs its .venv/bin/feelflow,
+# made first by installer/setup.sh (skipped with --no-setup); from a bundle (this script inside
+# the bundle folder, or --bundle DIR naming one) it execs the bundle's feelflow where it lies.
+# Every file written is listed in a manifest (DATA/feelflow/installed-files.txt) with its checksum;
+# --uninstall removes exactly those that still hold what was written, and the folders install
+# created if they are empty (a bundle folder stays: delete it yourself).
+# --udev writes /etc/udev/rules.d/70-feelflow.rules (python -m feelflow.haptics.permissions):
+# HID and serial haptic devices for the logged-in user; --udev --uninstall removes it.
 # update-desktop-database, update-mime-database and gtk-update-icon-cache run when present.
 set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"   # the checkout, or the bundle folder
+assets="$here/installer"
 me="install-desktop"
 
 die() { echo "$me: $1" >&2; exit "${2:-1}"; }
 
-prefix="" uninstall=0 setup=1
+prefix="" uninstall=0 setup=1 bundle="" udev=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --prefix) [ $# -ge 2 ] && [ -n "$2" ] || die "--prefix needs a folder (try --help)" 2; prefix="$2"; shift 2 ;;
     --prefix=*) prefix="${1#--prefix=}"; [ -n "$prefix" ] || die "--prefix needs a folder (try --help)" 2; shift ;;
     --uninstall) uninstall=1; shift ;;
     --no-setup) setup=0; shift ;;
-    -h|--help) sed -n '2,13p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
-    *) die "unknown option '$1' (usage: install-desktop.sh [--prefix DIR] [--uninstall] [--no-setup])" 2 ;;
+    --bundle) [ $# -ge 2 ] && [ -n "$2" ] || die "--bundle needs the bundle folder (try --help)" 2; bundle="$2"; shift 2 ;;
+    --bundle=*) bundle="${1#--bundle=}"; [ -n "$bundle" ] || die "--bundle needs the bundle folder (try --help)" 2; shift ;;
+    --udev) udev=1; shift ;;
+    -h|--help) sed -n '2,21p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) die "unknown option '$1' (usage: install-desktop.sh [--prefix DIR] [--bundle DIR] [--uninstall] [--no-setup] [--udev])" 2 ;;
   esac
 done
+
+# what the launcher runs: a bundle's program (--bundle DIR, or this script inside a bundle folder,
+# which has `feelflow` beside installer/), else the checkout's venv
+if [ -n "$bundle" ]; then
+  [ -d "$bundle" ] || die "--bundle $bundle: no such folder" 2
+  here_bundle="$(cd "$bundle" && pwd)"
+elif [ -f "$here/feelflow" ] && [ -x "$here/feelflow" ] && [ ! -f "$here/pyproject.toml" ]; then
+  here_bundle="$here"
+else
+  here_bundle=""
+fi
+if [ -n "$here_bundle" ]; then
+  target="$here_bundle/feelflow"
+  [ -f "$target" ] && [ -x "$target" ] || die "$target is missing: --bundle needs the folder installer/build-bundle.sh made (dist/feelflow)" 2
+  python_m=("$target")
+  setup=0
+else
+  target="$here/.venv/bin/feelflow"
+  python_m=("$here/.venv/bin/python")
+fi
+
+# --- the udev rule (root) -----------------------------------------------------------------------
+if [ "$udev" = 1 ]; then
+  rules_dir="${FEELFLOW_UDEV_DIR:-/etc/udev/rules.d}"
+  rules="$rules_dir/70-feelflow.rules"
+  reload_udev() {
+    if [ "$rules_dir" = /etc/udev/rules.d ] && command -v udevadm >/dev/null 2>&1; then
+      udevadm control --reload-rules && udevadm trigger --subsystem-match=hidraw --subsystem-match=tty \
+        || echo "$me: warning: udevadm could not reload the rules (unplug and replug the device)" >&2
+    fi
+  }
+  [ -x "${python_m[0]}" ] || die "${python_m[0]} is missing: run installer/setup.sh first (or use a bundle)"
+  text="$("${python_m[@]}" -m feelflow.haptics.permissions)" || die "could not write the udev rule (see above)"
+  if [ "$uninstall" = 1 ]; then
+    if [ ! -e "$rules" ]; then echo "$me: no udev rule to remove ($rules)"; exit 0; fi
+    if [ "$(cat "$rules")" = "$text" ]; then
+      rm -f "$rules" || die "cannot remove $rules (run it with sudo)"
+      reload_udev
+      echo "$me: removed $rules"
+    else
+      echo "$me: kept $rules (changed since it was installed)" >&2
+    fi
+    exit 0
+  fi
+  [ -d "$rules_dir" ] && [ -w "$rules_dir" ] || die "cannot write into $rules_dir: the udev rule is for the whole machine (run it with sudo)"
+  tmp="$(mktemp "$rules_dir/.feelflow-install.XXXXXX")" || die "cannot write into $rules_dir"
+  printf '%s\n' "$text" > "$tmp" && chmod 644 "$tmp" && mv -f "$tmp" "$rules" || { rm -f "$tmp"; die "cannot write $rules"; }
+  reload_udev
+  echo "$me: udev rule installed: $rules (unplug and replug the device; serial ports also need the dialout group: sudo usermod -aG dialout \$USER)"
+  exit 0
+fi
 
 if [ -n "$prefix" ]; then
   case "$prefix" in /*) ;; *) prefix="$(pwd)/$prefix" ;; esac
@@ -40,7 +100,7 @@ else
 fi
 apps="$data/applications" icons="$data/icons/hicolor" mime="$data/mime"
 manifest_dir="$data/feelflow" manifest="$data/feelflow/installed-files.txt"
-for p in "$data" "$bin" "$here"; do
+for p in "$data" "$bin" "$here" "$target"; do
   case "$p" in *[\\\"\`\$%\']*|*$'\n'*|*$'\t'*)
     die "cannot install from or into a path with \\ \" \` \$ % ' or a tab/newline in it: $p" ;; esac
 done
@@ -92,7 +152,6 @@ fi
 if [ "$setup" = 1 ]; then
   bash "$here/installer/setup.sh" || die "installer/setup.sh failed (see above)"
 fi
-target="$here/.venv/bin/feelflow"
 [ -x "$target" ] || die "$target is missing: run installer/setup.sh first (or drop --no-setup)"
 
 # the folders install creates (kept across re-installs, so that uninstall removes them)
@@ -137,24 +196,24 @@ trap 'rm -rf "$work"' EXIT
 
 launcher="$bin/feelflow"
 q="'"
-printf '#!/bin/sh\n# FeelFlow, installed by %s/installer/install-desktop.sh (--uninstall removes it)\nexec %s "$@"\n' \
-  "$here" "$q$target$q" > "$work/launcher"
+printf '#!/bin/sh\n# FeelFlow, installed by %s/install-desktop.sh (--uninstall removes it)\nexec %s "$@"\n' \
+  "$assets" "$q$target$q" > "$work/launcher"
 case "$launcher" in   # the Desktop Entry spec's reserved characters (those not refused above) need quotes
   *[\ \>\<\~\|\&\;\*\?\#\(\)]*) launcher_exec="\"$launcher\"" ;;
   *) launcher_exec="$launcher" ;;
 esac
-entry="$(cat "$here/installer/feelflow.desktop.in")"
+entry="$(cat "$assets/feelflow.desktop.in")"
 entry="${entry//@LAUNCHER_EXEC@/$launcher_exec}"
 printf '%s\n' "${entry//@LAUNCHER@/$launcher}" > "$work/feelflow.desktop"
 
 # refuse before writing anything, so that a conflict leaves no file behind
-for pair in "$work/launcher|$launcher" "$here/installer/feelflow.svg|$icons/scalable/apps/feelflow.svg" \
-            "$here/installer/feelflow-mime.xml|$mime/packages/feelflow.xml" "$work/feelflow.desktop|$apps/feelflow.desktop"; do
+for pair in "$work/launcher|$launcher" "$assets/feelflow.svg|$icons/scalable/apps/feelflow.svg" \
+            "$assets/feelflow-mime.xml|$mime/packages/feelflow.xml" "$work/feelflow.desktop|$apps/feelflow.desktop"; do
   check_free "${pair%%|*}" "${pair#*|}"
 done
 put "$work/launcher" "$launcher" 755
-put "$here/installer/feelflow.svg" "$icons/scalable/apps/feelflow.svg" 644
-put "$here/installer/feelflow-mime.xml" "$mime/packages/feelflow.xml" 644
+put "$assets/feelflow.svg" "$icons/scalable/apps/feelflow.svg" 644
+put "$assets/feelflow-mime.xml" "$mime/packages/feelflow.xml" 644
 put "$work/feelflow.desktop" "$apps/feelflow.desktop" 644
 
 make_dir "$manifest_dir"

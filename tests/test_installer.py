@@ -198,3 +198,91 @@ def test_a_bad_option_is_one_line_and_exit_2(tmp_path, args):
     assert r.returncode == 2
     assert len(r.stderr.strip().splitlines()) == 1 and r.stderr.startswith("install-desktop: ")
     assert r.stdout == "" and not (tmp_path / ".local").exists()
+
+
+# --- a bundle (installer/build-bundle.sh) instead of a checkout ---------------------------------
+def stand_in_bundle(folder: Path) -> Path:
+    """A bundle folder as installer/feelflow.spec lays it out (`feelflow` beside installer/ with
+    the desktop files), its program being installer/bundle_main.py on this checkout's Python:
+    the frozen entry point, unfrozen (tests/test_bundle.py installs the real one)."""
+    (folder / "installer").mkdir(parents=True)
+    for name in ("install-desktop.sh", "feelflow.desktop.in", "feelflow.svg", "feelflow-mime.xml"):
+        shutil.copy2(ROOT / "installer" / name, folder / "installer" / name)
+    program = folder / "feelflow"
+    program.write_text(f"#!/bin/sh\nexec '{ROOT / '.venv' / 'bin' / 'python'}' '{ROOT / 'installer' / 'bundle_main.py'}' \"$@\"\n")
+    program.chmod(0o755)
+    return program
+
+
+def run_script(script: Path, home: Path, *args, **env_extra):
+    env = {k: v for k, v in os.environ.items() if not k.startswith("XDG_")}
+    env.update(HOME=str(home), **env_extra)
+    return subprocess.run(["bash", str(script), *map(str, args)], env=env, capture_output=True, text=True, timeout=60)
+
+
+@needs_venv
+@pytest.mark.parametrize("how", ["script inside the bundle", "--bundle DIR from the checkout"])
+def test_install_from_a_bundle_and_uninstall_leaves_nothing(tmp_path, how):
+    home, bundle = tmp_path / "home", tmp_path / "FeelFlow"
+    home.mkdir()
+    program = stand_in_bundle(bundle)
+    before = snapshot(bundle)
+    if how == "script inside the bundle":
+        r = run_script(bundle / "installer" / "install-desktop.sh", home)
+    else:
+        r = run(home, "--bundle", bundle)
+    assert r.returncode == 0, r.stderr
+    files = installed(home)
+    assert all(p.is_file() for p in files.values())
+    assert f"exec '{program}' \"$@\"" in files["launcher"].read_text()
+    assert desktop_entry(files["desktop"])["Exec"].split() == [str(files["launcher"]), "gui", "%f"]
+    h = subprocess.run([str(files["launcher"]), "--help"], capture_output=True, text=True, timeout=60)
+    assert h.returncode == 0 and h.stdout.startswith("usage: feelflow"), h.stderr
+    assert not (bundle / ".venv").exists()       # no setup.sh ran for a bundle
+    r = run(home, "--uninstall")
+    assert r.returncode == 0, r.stderr
+    assert list(home.iterdir()) == []            # nothing left in the home folder
+    assert snapshot(bundle) == before            # and the bundle folder as it was
+
+
+def test_bundle_folder_without_a_program_is_one_line_and_exit_2(tmp_path):
+    (tmp_path / "empty").mkdir()
+    for args in (["--bundle", tmp_path / "empty"], ["--bundle", tmp_path / "missing"]):
+        r = run(tmp_path, *args)
+        assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+        assert not (tmp_path / ".local").exists()
+
+
+@needs_venv
+def test_udev_rule_install_and_uninstall(tmp_path):
+    from feelflow.haptics.permissions import RULES_FILE, udev_rules
+
+    rules_dir = tmp_path / "rules.d"
+    rules_dir.mkdir()
+    (rules_dir / "50-other.rules").write_text("# not FeelFlow's\n")
+    before = snapshot(rules_dir)
+    r = run_script(SCRIPT, tmp_path, "--udev", FEELFLOW_UDEV_DIR=str(rules_dir))
+    assert r.returncode == 0, r.stderr
+    assert (rules_dir / RULES_FILE).read_text() == udev_rules()
+    assert not (tmp_path / ".local").exists()    # the rule only: no desktop entry for root
+    r = run_script(SCRIPT, tmp_path, "--udev", "--uninstall", FEELFLOW_UDEV_DIR=str(rules_dir))
+    assert r.returncode == 0, r.stderr
+    assert snapshot(rules_dir) == before
+    # a rule changed by hand is kept
+    (rules_dir / RULES_FILE).write_text(udev_rules() + "# local change\n")
+    r = run_script(SCRIPT, tmp_path, "--udev", "--uninstall", FEELFLOW_UDEV_DIR=str(rules_dir))
+    assert r.returncode == 0 and "kept" in r.stderr and (rules_dir / RULES_FILE).exists()
+    # from a bundle, the same rule (the program runs `feelflow -m feelflow.haptics.permissions`)
+    (rules_dir / RULES_FILE).unlink()
+    stand_in_bundle(tmp_path / "bundle")
+    r = run_script(tmp_path / "bundle" / "installer" / "install-desktop.sh", tmp_path, "--udev",
+                   FEELFLOW_UDEV_DIR=str(rules_dir))
+    assert r.returncode == 0, r.stderr
+    assert (rules_dir / RULES_FILE).read_text() == udev_rules()
+
+
+@needs_venv
+def test_udev_rule_where_it_cannot_be_written_says_sudo(tmp_path):
+    r = run_script(SCRIPT, tmp_path, "--udev", FEELFLOW_UDEV_DIR=str(tmp_path / "no-such-dir"))
+    assert r.returncode == 1 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert "(run it with sudo)" in r.stderr

@@ -32,6 +32,7 @@ from feelflow.app.gui.qt_runtime import make_none_immortal
 
 make_none_immortal()  # before any Qt object: see app/gui/qt_runtime.py
 
+from feelflow.app.gui import first_start  # noqa: E402
 from feelflow.app.gui.force_plot import ForcePlot  # noqa: E402
 from feelflow.app.gui.side_panel import SidePanel  # noqa: E402
 from feelflow.app.gui.display_modes import DISPLAY_MODES  # noqa: E402
@@ -121,7 +122,7 @@ class MainWindow(QMainWindow):
         p.arrowsToggled.connect(lambda on: setattr(self.viewport, "show_arrows", on))
         p.inputChanged.connect(self.inputs.set_input)
         vp.contextReady.connect(self._on_context)
-        vp.contextFailed.connect(self._cannot_start)
+        first_start.watch_gl(self)   # no OpenGL 3.3: a dialog, then the numpy solver on the CPU
         vp.bodyPulled.connect(self.inputs.mouse_pulled)
         vp.polygonEdited.connect(self.bodies.edit_polygon)
         vp.inputRefused.connect(lambda: self.replays.refuse("the mouse does not move the body"))

@@ -21,6 +21,7 @@ from PySide6.QtWidgets import QToolTip
 
 from feelflow import SHADER_DIR
 from feelflow.app.gui import turn_handle
+from feelflow.app.gui.first_start import required_gl
 from feelflow.app.gui.display_modes import COLOUR_BAR_MARGIN, DISPLAY_MODES
 from feelflow.app.gui.overlay import Overlay
 from feelflow.app.model.tunnel import TunnelModel
@@ -84,9 +85,9 @@ class Viewport(QOpenGLWidget):
 
     def initializeGL(self):
         try:
-            self.ctx = moderngl.create_context(require=330)
+            self.ctx = moderngl.create_context(require=required_gl())
         except Exception as exc:   # moderngl.Error and friends: say so, never a traceback
-            self.ctx = None
+            self.ctx = None        # the window then draws on the CPU (app/gui/cpu_field.py)
             self.contextFailed.emit(f"OpenGL 3.3 is not available here ({str(exc).splitlines()[0]})")
             return
         self._init_programs()
@@ -116,6 +117,10 @@ class Viewport(QOpenGLWidget):
 
     def upload_field(self, rgba: np.ndarray):
         """numpy path: copy (ny, nx, 4) float32 (rho, ux, uy, vorticity) into the field texture."""
+        if self.ctx is None:       # no OpenGL 3.3: cpu_field.CpuCanvas colours it on the CPU
+            self.cpu_rgba = rgba
+            self.cpu_canvas.update()   # set by first_start.run_on_cpu
+            return
         ny, nx = rgba.shape[:2]
         tex = self.field_texture
         if tex is None or tex.size != (nx, ny) or getattr(self, "_own_texture", False) is False:
@@ -149,7 +154,7 @@ class Viewport(QOpenGLWidget):
         return QPointF(r.left() + (x + 0.5) / nx * r.width(), r.bottom() - (y + 0.5) / ny * r.height())
 
     def paintGL(self):
-        if self.ctx is None:
+        if self.ctx is None:       # no OpenGL 3.3: a cpu_field.CpuCanvas paints over the viewport
             return
         painter = QPainter(self)
         painter.beginNativePainting()   # Qt's GL state is saved; moderngl draws the field

@@ -6,8 +6,9 @@ double-clicking a session file in the file manager replays it; `feelflow --selft
 measures that replay (frames and session steps per second).
 
 The OpenGL surface format (3.3 core, no depth buffer, no vsync) is set before the QApplication
-exists (shared/notes/gl-qt-on-this-machine.md). Without a display there is no window: one line
-says so and the command exits 2 (try `feelflow run` for a headless run).
+exists. Without a display there is no window: one line says so and the command exits 2 (try
+`feelflow run` for a headless run); app/gui/first_start.py has that check, the CPU fallback
+where OpenGL 3.3 is missing, and the lesson chooser a first start opens.
 """
 from __future__ import annotations
 
@@ -25,16 +26,6 @@ def add_arguments(parser):
     parser.add_argument("--backend", choices=("gl", "numpy"), default=None,
                         help=f"solver backend (default {DEFAULT_BACKEND}; numpy uploads the field every frame)")
     parser.add_argument("--fresh", action="store_true", help="ignore remembered settings")
-
-
-def has_display() -> bool:
-    """Is there a screen Qt can open a window with OpenGL on?"""
-    platform = os.environ.get("QT_QPA_PLATFORM", "")
-    if platform.startswith("offscreen") or platform.startswith("minimal"):
-        return False
-    if sys.platform.startswith("linux"):
-        return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
-    return True
 
 
 def set_surface_format():
@@ -62,9 +53,11 @@ def main(args) -> int:
     session = getattr(args, "session", None)
     if session is not None and not os.path.isfile(session):
         raise UserError(f"{session}: no such session file")
-    if not has_display():
-        raise UserError("no display to open the window on (DISPLAY is not set); "
-                        "use 'feelflow run' for a headless run, or run under xvfb-run")
+    from feelflow.app.gui.first_start import display_problem
+
+    problem = display_problem()
+    if problem is not None:
+        raise UserError(problem)
     backend = getattr(args, "backend", None) or DEFAULT_BACKEND
     from feelflow.app.gui.qt_runtime import make_none_immortal
 
@@ -90,6 +83,10 @@ def main(args) -> int:
     window = MainWindow(backend=backend, settings=settings)
     if session is not None:
         replay_when_ready(window, session)
+    if not selftest:
+        from feelflow.app.gui.first_start import offer_lessons
+
+        offer_lessons(window, settings, first_start=session is None)   # the lesson chooser
     if selftest:
         from feelflow.app.gui.selftest import SelfTest
 
