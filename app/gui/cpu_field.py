@@ -50,7 +50,7 @@ def field_colours(rgba: np.ndarray, mode: int, scale: float, value_range, rho_re
 def paint(viewport, rgba: np.ndarray | None, device) -> None:
     """Paint the field `rgba` of `viewport` (app.gui.viewport.Viewport) and its overlays on
     `device`, a widget of the viewport's size."""
-    from feelflow.app.gui.viewport import DISPLAY_MODES
+    from feelflow.app.gui.display_modes import DISPLAY_MODES
 
     p = QPainter(device)
     p.fillRect(device.rect(), BACKGROUND)
@@ -63,7 +63,7 @@ def paint(viewport, rgba: np.ndarray | None, device) -> None:
         image = QImage(rgb.data, nx, ny, 3 * nx, QImage.Format_RGB888)
         p.setRenderHint(QPainter.SmoothPixmapTransform)
         p.drawImage(QRectF(viewport.lattice_rect()), image)
-        viewport._paint_overlay(p)
+        viewport.overlay.paint(p)
     p.end()
     viewport.frames += 1
 
