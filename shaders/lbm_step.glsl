@@ -1,13 +1,14 @@
 #version 330 core
-// One lattice Boltzmann step t -> t+1, collide and stream fused (pull form), exactly as
-// docs/algorithm.md states it. Populations are stored shifted, g_i = f*_i - w_i RHO0, two nodes
+// One lattice Boltzmann step t -> t+1, collide and stream fused (pull form), the same rules in
+// the same order as the numpy reference (solver/numpy_backend.py). Populations are stored shifted, g_i = f*_i - w_i RHO0, two nodes
 // per texel in five RGBA32F textures (shaders/paired_layout.glsl, solver/gl_layout.py); each
 // fragment updates the two nodes a = (2k, y) and b = (2k + 1, y) of its texel k.
 // References: Bouzidi, Firdaouss & Lallemand (2001); Lallemand & Luo (2003); Ginzburg (2008);
 // Guo, Zheng & Shi (2002).
 //
 // Compile-time variants (defines injected by solver/gl_programs.py). llvmpipe executes both
-// sides of a divergent branch, so each region of the grid is drawn by the variant it needs:
+// sides of a divergent branch, so each region of the grid is drawn by the variant it needs
+// (solver/gl_regions.py):
 //   BODY  1: rule 1a (Bouzidi links with the moving-wall term) and solid nodes (body window);
 //   EDGES 1: rules 1b-1e (walls, inlet, pressure outlet, periodic wrap) (edge strips); streams
 //     like the fast path where the REPEAT samplers wrap right (a tunnel: what crosses the inlet
@@ -24,8 +25,6 @@
 //     block's first step restarts it); the backend reads them once per block.
 //   TRT, GUO_FORCE, SPONGE: collision operator, Guo body force, outlet sponge (per-column rates).
 //   X_PERIODIC 0/1; Y_MODE 0 no_slip, 1 free_slip, 2 periodic; NX_ODD: nx is odd.
-//   DIVERGENCE_DISCARD 1: a node with a non-finite density discards its fragment (an
-//     occlusion-query divergence check; measured slower than the tile check, not the default).
 // @LATTICE
 // @INCLUDE paired_layout.glsl
 
@@ -93,7 +92,7 @@ void stream_node(ivec2 x, out float g[9]) {
 }
 #endif
 
-// f^eq_i - w_i RHO0 for density RHO0 + drho and velocity u (seed eq. 9), shifted.
+// f^eq_i - w_i RHO0 for density RHO0 + drho and velocity u (Qian, d'Humieres & Lallemand 1992), shifted.
 float feq_shifted(int i, float drho, float rho, vec2 u) {
     float cu = 3.0 * dot(vec2(C[i]), u);
     float usq = 1.5 * dot(u, u);
@@ -115,11 +114,6 @@ void store_pair(float a[9], float b[9]) {
 void collide(inout float f[9], ivec2 x) {
     float drho = f[0];
     for (int i = 1; i < Q; ++i) drho += f[i];
-#if DIVERGENCE_DISCARD
-    // a non-finite density writes nothing; the backend counts the fragments that passed with an
-    // occlusion query (measured alternative to shaders/finite_check.glsl; the state is lost anyway)
-    if (!(abs(drho) < 3.0e38)) discard;
-#endif
 #if INCOMPRESSIBLE
     float rho = RHO0;  // He & Luo (1997): the velocity terms and u = j / rho take RHO0
 #else

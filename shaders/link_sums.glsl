@@ -1,8 +1,8 @@
 #version 330 core
 // The momentum exchange's link sums of one step on the GPU (docs/algorithm.md 'Forces'; Wen,
-// Zhang, Tu, Wang & Fang 2014; Ladd 1994), drawn by the step's own pass into a slot of the band
-// area: one RGBA32F texel per state texel with a cut link, so that a block reads back those few
-// texels instead of the window's five attachments. The state texels with links are listed in
+// Zhang, Tu, Wang & Fang 2014; Ladd 1994), drawn right after the step into the same framebuffer,
+// in a slot of the band area (solver/gl_band.py): one RGBA32F texel per state texel with a cut
+// link, so that a block reads back those few texels instead of the window's five attachments. The state texels with links are listed in
 // LINK_TEXELS, packed row by row; one rectangle covers the list (llvmpipe pays per primitive:
 // a point per texel cost the step about 10 %, the rectangle next to nothing).
 //

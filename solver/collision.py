@@ -27,7 +27,7 @@ class Collider:
     """In-place collision of a (9, ny, nx) array of shifted populations.
 
     omega_p, omega_m: scalars, or (nx,) rows (outlet sponge). force: (Fx, Fy) body-force density.
-    keep: None, or an (nx,) row (the sponge's absorbing layer, solver.numpy_backend.absorb_keep):
+    keep: None, or an (nx,) row (the sponge's absorbing layer, solver.sponge.absorb_keep):
     the equilibria use the density fluctuation drho * keep and the velocity
     keep u + (1 - keep) u_target, so each collision relaxes the node towards (RHO0, u_target) at
     omega+ (1 - keep); u_target = (target(iy), 0), `target` passed per call.

@@ -12,14 +12,22 @@ dropped): GLSL code two programs share, e.g. the texture layout of the populatio
 (`paired_layout.glsl`). The k-th included file's lines are numbered from k * INCLUDE_LINES
 by `#line` (Mesa attributes some errors to the wrong source-string number, never to the wrong
 line), which `ShaderError` turns back into the included file's name and line.
+
+Also the few things every pass does: `begin_pass` sets the whole GL state a pass needs (a host
+such as Qt may have left blending, a scissor box or its own framebuffer), `set_uniforms` skips
+uniforms the compiler dropped, `triangles` turns rectangles into vertices.
 """
 from __future__ import annotations
 
 import re
 from pathlib import Path
 
+import moderngl
+import numpy as np
+
 from feelflow import SHADER_DIR
 from feelflow.solver.lattice import glsl_constants
+
 MARKER = "// @LATTICE"
 INCLUDE = "// @INCLUDE "
 #: line-number offset of each included file (file k starts at k * INCLUDE_LINES + 1)
@@ -99,3 +107,28 @@ def create_program(ctx, vertex: str, fragment: str, defines: dict | None = None,
             files = vs_files
         body = log.split("===============", 1)[-1]
         raise ShaderError(_explain(files, body)) from None
+
+
+def set_uniforms(prog, **values) -> None:
+    """Set the uniforms of `prog` that it has (the compiler drops unused ones)."""
+    for name, value in values.items():
+        if name in prog:
+            prog[name].value = value
+
+
+def begin_pass(ctx, fbo, size) -> None:
+    """The state every pass needs, whatever the host left: no blending, depth test or other
+    capability (Qt enters paintGL with blending on), no scissor box, `fbo` bound with a
+    viewport of `size`."""
+    ctx.enable_only(moderngl.NOTHING)
+    ctx.scissor = None
+    fbo.use()
+    ctx.viewport = (0, 0, *size)
+
+
+def triangles(rects) -> np.ndarray:
+    """Two triangles per rectangle (x0, y0, x1, y1), texel-edge coordinates, float32 (k*6, 2)."""
+    out = []
+    for x0, y0, x1, y1 in rects:
+        out += [(x0, y0), (x1, y0), (x1, y1), (x0, y0), (x1, y1), (x0, y1)]
+    return np.asarray(out, dtype="f4").reshape(-1, 2)

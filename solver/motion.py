@@ -1,5 +1,5 @@
 """Motion scripts: a body driven through phases of constant velocity (the seed's experiment:
-stopped, moving with the stream, stopped, moving against it; SEED-NOTES 'Experiments').
+stopped, moving with the stream, stopped, moving against it).
 
 `MotionRunner` is the one place that turns a script into `feelflow.solver.set_body` calls: `feelflow run`,
 the validation cases, the report and the GUI's scripted mode all use it. Positions advance exactly by the velocity

@@ -18,6 +18,8 @@ from feelflow.solver.config import FlowConfig
 from feelflow.solver.forces.base import BodyWindow
 from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS, inlet_wall_profile, outlet_incoming, profile, ramp
 from feelflow.solver.lattice import C, OPP, Q, RHO0, W, equilibrium
+from feelflow.solver.relaxation import relaxation_rates
+from feelflow.solver.sponge import absorb_keep
 
 #: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall
 MIRROR_Y = np.array([0, 1, 4, 3, 2, 8, 7, 6, 5])
@@ -30,51 +32,6 @@ def _roll_segments(s: int, n: int):
     if s == 1:
         return [(slice(1, n), slice(0, n - 1)), (slice(0, 1), slice(n - 1, n))]
     return [(slice(0, n - 1), slice(1, n)), (slice(n - 1, n), slice(0, 1))]
-
-
-def sponge_position(config: FlowConfig):
-    """None (no sponge), or the (nx,) row s = (ix - (nx - L) + 1) / L clipped at 0: 0 before the
-    outlet sponge's L = sponge_cells columns, rising to 1 at the last column."""
-    L = config.sponge_cells if config.x_boundary == "tunnel" else 0
-    if L == 0:
-        return None
-    ix = np.arange(config.nx, dtype=np.float64)
-    return np.clip((ix - (config.nx - L) + 1) / L, 0.0, None)
-
-
-def relaxation_rates(config: FlowConfig):
-    """(omega+, omega-) as scalars, or (nx,) rows where the outlet sponge raises nu.
-
-    tau = 3 nu + 1/2; TRT: (1/omega+ - 1/2)(1/omega- - 1/2) = Lambda (Ginzburg et al. 2008).
-    Sponge: nu(ix) = nu (1 + (A - 1) s^2), s = (ix - (nx - L) + 1) / L in the last L columns.
-    """
-    nu = config.nu
-    s = sponge_position(config)
-    if s is not None:
-        nu = nu * (1.0 + (config.sponge_strength - 1.0) * s * s)
-    tau = 3.0 * np.asarray(nu, dtype=np.float64) + 0.5
-    omega_p = 1.0 / tau
-    if config.collision == "trt":
-        omega_m = 1.0 / (0.5 + config.trt_magic / (tau - 0.5))
-    else:
-        omega_m = omega_p
-    if s is None:
-        return float(omega_p), float(omega_m)
-    return omega_p, omega_m
-
-
-def absorb_keep(config: FlowConfig):
-    """None, or the (nx,) row keep(ix) = 1 - a s^2 (a = sponge_absorb, s as in the sponge) of
-    the outlet sponge's absorbing layer: there the equilibria use the density fluctuation
-    keep drho and the velocity keep u + (1 - keep) u_in(iy, t), so each collision relaxes the
-    node towards the far-field state (RHO0, the inflow profile: the outflow of a straight tunnel)
-    at omega+ a s^2. Sound leaves the tunnel instead of ringing between the velocity inlet and
-    the pressure outlet (Kam, Leung & Chew, Phys. Rev. E 74 (2006) 036704; Xu & Sagaut,
-    J. Comput. Phys. 245 (2013) 14). docs/algorithm.md, step 3."""
-    s = sponge_position(config)
-    if s is None or config.sponge_absorb == 0.0:
-        return None
-    return 1.0 - config.sponge_absorb * s * s
 
 
 class NumpySolver(Solver):

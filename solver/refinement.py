@@ -37,7 +37,8 @@ from feelflow.solver.backend import Solver
 from feelflow.solver.body import shifted, unshifted
 from feelflow.solver.config import ConfigError, FlowConfig
 from feelflow.solver.lattice import C, OPP, equilibrium
-from feelflow.solver.numpy_backend import NumpySolver, relaxation_rates
+from feelflow.solver.numpy_backend import NumpySolver
+from feelflow.solver.relaxation import relaxation_rates
 
 #: coarse cells between the patch's border and the body, and between the border and the domain edge
 BODY_MARGIN = 3

@@ -10,8 +10,8 @@ nu the viscosity, d the body size in cells):
 * TRT (Lambda = 3/16, the window's operator): the most restrictive case is the shaken cylinder.
   Its highest cell Reynolds number Re_cell = U / nu below which every point was stable is
   8.75 / 8.75 / 4.375 at d = 10 / 20 / 40: neither Re_cell nor Re_D = U d / nu is constant;
-  Re_cell sqrt(d) is 27.7 / 39.1 / 27.7 (27.7 / 27.95 / 27.7 without the absorbing layer, the
-  fourth session's run), and K is the smallest. The fixed-body cases (plate, wedge, impulsive
+  Re_cell sqrt(d) is 27.7 / 39.1 / 27.7 (27.7 / 27.95 / 27.7 without the absorbing layer),
+  and K is the smallest. The fixed-body cases (plate, wedge, impulsive
   start) stay stable up to Re_cell = 10 at d = 20 (sqrt(d) Re_cell = 44.7) and fail from 11.25.
 * BGK: within 6 d / U only the shaken cylinder failed, at the panel's extreme corner (Re_cell
   45 at d = 20; K_bgk = 156.5); runs of 30 d / U at that corner (`python -m

@@ -1,48 +1,11 @@
-"""`feelflow bench`: its alternating rounds, and `--variants`: the ratios it takes within each
-interleaved round (app/commands/bench_solver.py `against_numpy`)."""
+"""`feelflow bench`: its alternating rounds, the ratios it takes within each round, and the
+tunnel's warm-up (app/bench/solver_speed.py)."""
 import json
 
 import numpy as np
 import pytest
 
 from feelflow.app.cli.main import main as cli_main
-from feelflow.app.bench.solver_speed import BOX, DEFAULT_TUNNEL, NO_BODY_ONE_CALL, NUMPY_TUNNEL, STAIRCASE, against_numpy
-
-
-def test_ratios_are_taken_within_each_round_not_between_the_best_figures():
-    # a slow spell in round 2 slows every run of that round alike
-    wall = {NUMPY_TUNNEL: [50.0, 25.0, 40.0], DEFAULT_TUNNEL: [40.0, 30.0, 32.0], BOX: [90.0, 60.0, 100.0]}
-    out = against_numpy(wall)
-    tunnel, ceiling = out["gl tunnel / numpy tunnel"], out["ceiling: gl box / numpy tunnel"]
-    assert tunnel["samples"] == [0.8, 1.2, 0.8] and tunnel["best"] == 1.2 and tunnel["median"] == 0.8
-    assert ceiling["samples"] == [1.8, 2.4, 2.5] and ceiling["median"] == 2.4
-    # the ratio of the best figures (40 / 50 = 0.8) would hide round 2's 1.2
-    assert tunnel["best"] != max(wall[DEFAULT_TUNNEL]) / max(wall[NUMPY_TUNNEL])
-
-
-def test_the_staircase_prices_each_part_within_each_round():
-    # the tunnel without its body, in the same rounds: its ratio per round, between tunnel and box
-    wall = {NUMPY_TUNNEL: [50.0, 25.0], DEFAULT_TUNNEL: [40.0, 30.0], NO_BODY_ONE_CALL: [70.0, 45.0],
-            BOX: [90.0, 60.0]}
-    out = against_numpy(wall)
-    label = next(lab for lab, name in STAIRCASE if name == NO_BODY_ONE_CALL)
-    assert out[label]["samples"] == [1.4, 1.8]
-    assert list(out) == ["gl tunnel / numpy tunnel", label, "ceiling: gl box / numpy tunnel"]  # runs not there are left out
-
-
-def test_cpu_work_cost_is_the_added_time_per_call_within_each_round():
-    from feelflow.app.bench.solver_speed import (MOVE_EVERY, WORK_AFTER_READ, WORK_BEFORE_READ,
-                                           cpu_work_cost)
-
-    nodes = 100_000  # a call of MOVE_EVERY steps at 50 MLUPS takes 20 ms, at 40 MLUPS 25 ms
-    wall = {DEFAULT_TUNNEL: [50.0, 25.0], WORK_AFTER_READ: [40.0, 20.0], WORK_BEFORE_READ: [50.0, 25.0]}
-    out = cpu_work_cost(wall, nodes)
-    per_call = nodes * MOVE_EVERY / 1e6 * 1e3  # ms per call at 1 MLUPS
-    assert out["after the read"]["samples"] == [round(per_call / 40 - per_call / 50, 3),
-                                                round(per_call / 20 - per_call / 25, 3)]
-    assert out["after the read"]["samples"][0] == 5.0
-    assert out["before the read (GPU busy)"]["samples"] == [0.0, 0.0]  # fully overlapped
-    assert cpu_work_cost({DEFAULT_TUNNEL: [50.0]}, nodes) == {}  # runs not there are left out
 
 
 def test_bench_alternates_the_backends_in_rounds_and_takes_the_median_ratio(tmp_path, capsys):

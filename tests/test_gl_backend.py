@@ -79,31 +79,18 @@ def _diverged_step(s, index, value, steps) -> int:
     return err.value.step
 
 
-@pytest.mark.parametrize("check", ["tiles", "discard"])
-def test_divergence_raises_with_the_step(gl_context, check):
+def test_divergence_raises_with_the_step(gl_context):
     cfg = FlowConfig(nx=40, ny=32, x_boundary="periodic", y_boundary="periodic")
-    s = create_solver("gl", cfg, ctx=gl_context, tuning={"divergence": check})
+    s = create_solver("gl", cfg, ctx=gl_context)
     s.step(5)
     assert _diverged_step(s, (3, 10, 37), np.inf, 10) == 6
-
-
-def test_discard_check_counts_the_body_window_drawn_over_the_interior(gl_context):
-    """The body window's variant is drawn over the fast path beneath it, so a step writes those
-    fragments twice: the occlusion-query check must expect that count, and still catch a NaN."""
-    cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)
-    s = create_solver("gl", cfg, ctx=gl_context, tuning={"divergence": "discard"})
-    s.set_body(Cylinder(6.0, x=20.0, y=16.0), velocity=(0.0, 0.02))
-    s.step(12)  # healthy: no false alarm
-    s.set_body(Cylinder(6.0, x=20.0, y=16.3), velocity=(0.0, 0.02))
-    s.step(12)
-    assert _diverged_step(s, (2, 16, 40), np.nan, 5) == 25
 
 
 def test_body_upload_touches_only_the_window(request):
     """Moving the body rewrites the mask (and q) only around the old and new windows; removing
     the body clears them there."""
     from feelflow.solver.body import expand_box, union_box
-    from feelflow.solver.gl_backend import node_mask
+    from feelflow.solver.gl_body import node_mask
 
     cfg = FlowConfig(nx=64, ny=32)
     s = make_solver("gl", cfg, request)
@@ -125,34 +112,55 @@ def test_body_upload_touches_only_the_window(request):
     assert not mask[y0:y1, x0:x1].any()
 
 
-@pytest.mark.parametrize("window", ["state", "atlas"])
-def test_blocks_of_steps_give_the_forces_and_state_of_single_steps(gl_context, window):
+#: a force model that is not a link sum: with it enabled, every model runs its own code on each
+#: step's body window (copied to the band area or the check atlas), the reference for the sums
+WINDOW_MODEL = "pressure"
+
+
+def _single_steps(s, n, names):
+    """n calls of step(1), each a block of one step read back at once: the mean force."""
+    total = np.zeros((len(names), 2))
+    for _ in range(n):
+        s.step(1)
+        total += [s.forces()[m] for m in names]
+    return total / n
+
+
+@pytest.mark.parametrize("x_boundary", ["tunnel", "periodic"])  # band area; check atlas (no band area)
+def test_blocks_of_steps_give_the_forces_and_state_of_single_steps(gl_context, x_boundary):
     """step(n) reads back once per block of steps (force windows batched on the GPU, one check
     per block): 40 steps in blocks give the same state and the same mean force, impulses of the
-    moves included, as single steps whose window is read directly. window="state" (default):
-    each step's pass copies the window into a slot of its destination's band area (10 slots a
-    side here, blocks of 20); "atlas": a separate pass per step (blocks of 32 + 8). The models
-    run on the windows here (forces="window"); the link sums on the GPU are the next tests."""
-    cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)
+    moves included, as single steps. A tunnel's step pass copies each window into a slot of its
+    destination's band area (10 slots a side here, blocks of 20); an x-periodic channel has no
+    band area, and a second pass per step copies the window into the check atlas (blocks of 32
+    + 8). The models run on the windows here; the link sums on the GPU are the next tests."""
+    cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10, x_boundary=x_boundary,
+                     body_force=(2e-6, 0.0) if x_boundary == "periodic" else (0.0, 0.0))
+    names = ["momentum_exchange", WINDOW_MODEL]
     runs = []
-    for tuning in ({"window": window, "forces": "window"}, {"check_every": 1, "window": "read", "forces": "window"}):
-        s = create_solver("gl", cfg, ctx=gl_context, tuning=tuning)
-        s.enable_force_models(["momentum_exchange"])
+    for blocks in (True, False):
+        s = create_solver("gl", cfg, ctx=gl_context)
+        s.enable_force_models(names)
         s.set_body(Cylinder(6.0, x=20.0, y=16.0))
         s.step(5)
         s.set_body(Cylinder(6.0, x=20.0, y=16.5), velocity=(0.0, 0.1))
-        s.step(40)
-        runs.append((s.forces()["momentum_exchange"], s.distributions()))
+        if blocks:
+            s.step(40)
+            forces = np.array([s.forces()[m] for m in names])
+        else:
+            forces = _single_steps(s, 40, names)
+        assert (s._band.layout is not None) == (x_boundary == "tunnel")
+        runs.append((forces, s.distributions()))
     (f_block, g_block), (f_single, g_single) = runs
     assert np.array_equal(g_block, g_single)
     assert np.allclose(f_block, f_single, rtol=1e-12, atol=0)
-    assert abs(f_block[0]) > 0  # the cylinder feels the flow
+    assert abs(f_block[0, 0]) > 0  # the cylinder feels the flow
 
 
 def test_link_sums_on_the_gpu_give_the_momentum_exchanges_of_the_window(gl_context):
-    """forces="gpu" (the default where only momentum exchanges are enabled) with both exchanges:
-    the link-sum pass sums the links (shaders/link_sums.glsl) into the band area instead of
-    copying the window for the models' code. Both forms, on a body moved, turned and spun between
+    """With both exchanges as the only models, the link-sum pass sums the links
+    (shaders/link_sums.glsl) into the band area instead of copying the window for the models'
+    code (the reference: the same models with a window model enabled too). Both forms, on a body moved, turned and spun between
     blocks (Bouzidi links of both kinds, moving wall, cover/uncover impulses), agree with the
     models on the window to float32 round-off of the sums (1e-5 of the largest force; measured
     2.8e-7), and the state is the same bit for bit."""
@@ -162,8 +170,8 @@ def test_link_sums_on_the_gpu_give_the_momentum_exchanges_of_the_window(gl_conte
     names = ["momentum_exchange", "momentum_exchange_classic"]
     runs = []
     for forces in ("gpu", "window"):
-        s = create_solver("gl", cfg, ctx=gl_context, tuning={"forces": forces})
-        s.enable_force_models(names)
+        s = create_solver("gl", cfg, ctx=gl_context)
+        s.enable_force_models(names + ([WINDOW_MODEL] if forces == "window" else []))
         out = []
         for k in range(12):
             shape = (Cylinder(10.0, x=30.3 + 0.13 * k, y=24.2 - 0.07 * k) if k < 6 else
@@ -196,8 +204,8 @@ def test_the_step_pass_sums_the_links_of_a_single_momentum_exchange(gl_context, 
     cfg = FlowConfig(nx=96, ny=48, inflow_speed=0.05, inflow_ramp_steps=10)
     runs = []
     for forces in ("gpu", "window"):
-        s = create_solver("gl", cfg, ctx=gl_context, tuning={"forces": forces})
-        s.enable_force_models([model])
+        s = create_solver("gl", cfg, ctx=gl_context)
+        s.enable_force_models([model] + ([WINDOW_MODEL] if forces == "window" else []))
         out = []
         for k in range(8):
             shape = (Cylinder(10.0, x=30.3 + 0.13 * k, y=24.2 - 0.07 * k) if k < 4 else
@@ -220,14 +228,16 @@ def test_the_step_pass_sums_the_links_of_a_single_momentum_exchange(gl_context, 
     assert s_gpu._link_sums == 0 and s_gpu._block_sums
 
 
-@pytest.mark.parametrize("forces", ["gpu", "pass", "window"])
-def test_a_non_finite_body_window_raises_with_its_step_on_either_force_path(gl_context, forces):
+@pytest.mark.parametrize("forces", ["pass", "sum pass", "window"])
+def test_a_non_finite_body_window_raises_with_its_step_on_every_force_path(gl_context, forces):
     """A NaN next to the body is reported from the step whose window holds it, the same step
-    and message whether the step's pass summed the links (forces="gpu", one model: found by
-    replaying the block), the link-sum pass did (forces="pass") or the window was copied."""
+    and message whether the step's pass summed the links (one momentum exchange: found by
+    replaying the block), the link-sum pass did (both exchanges) or the window was copied."""
+    names = {"pass": ["momentum_exchange"], "sum pass": ["momentum_exchange", "momentum_exchange_classic"],
+             "window": ["momentum_exchange", WINDOW_MODEL]}[forces]
     cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04)
-    s = create_solver("gl", cfg, ctx=gl_context, tuning={"forces": forces})
-    s.enable_force_models(["momentum_exchange"])
+    s = create_solver("gl", cfg, ctx=gl_context)
+    s.enable_force_models(names)
     s.set_body(Cylinder(8.0, x=20.0, y=16.0))
     s.step(5)
     f = s.distributions()
@@ -236,46 +246,32 @@ def test_a_non_finite_body_window_raises_with_its_step_on_either_force_path(gl_c
     with pytest.raises(SolverDiverged) as err:
         s.step(10)
     assert err.value.step == 5 and "around the body" in str(err.value)
-    assert s._block_sums == (forces == "pass")
-    assert s._link_sums == (1 if forces == "gpu" else 0)
-
-
-def test_before_read_runs_once_per_block_while_its_steps_are_still_unread(gl_context):
-    """GLSolver.before_read (the bench's overlap probe, docs/performance.md 'Ninth session') is
-    called once per block of steps, after the block's draws and before its read-back, and
-    changes nothing: the same state and forces as without it."""
-    cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)
-    runs = []
-    for hook in (False, True):
-        s = create_solver("gl", cfg, ctx=gl_context, tuning={"check_every": 8})
-        s.enable_force_models(["momentum_exchange"])
-        s.set_body(Cylinder(6.0, x=20.0, y=16.0))
-        times = []
-        if hook:
-            s.before_read = lambda s=s: times.append(s.time)
-        s.step(20)
-        runs.append((s.forces()["momentum_exchange"], s.distributions()))
-        if hook:
-            assert times == [8, 16, 20]  # the draws of each block queued, none of it read yet
-    (f0, g0), (f1, g1) = runs
-    assert np.array_equal(g0, g1) and f0 == f1
+    assert s._block_sums == (forces == "sum pass")
+    assert s._link_sums == (1 if forces == "pass" else 0)
 
 
 def test_window_wider_than_the_band_area_falls_back_to_the_atlas(gl_context):
-    """A body window wider than the band area (BAND_WIDTH) takes the atlas path, same numbers."""
+    """A body window wider than the band area (BAND_WIDTH) takes the atlas path: blocks give
+    the numbers of single steps."""
     from feelflow.shapes import FlatPlate
     from feelflow.solver.gl_backend import BAND_WIDTH
 
     cfg = FlowConfig(nx=BAND_WIDTH + 64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)
     plate = FlatPlate(length=BAND_WIDTH + 10.0, thickness=2.0, x=cfg.nx / 2, y=16.0, angle=np.pi / 2)
+    names = ["momentum_exchange", WINDOW_MODEL]
     runs = []
-    for tuning in ({"forces": "window"}, {"check_every": 1, "window": "read", "forces": "window"}):
-        s = create_solver("gl", cfg, ctx=gl_context, tuning=tuning)
-        s.enable_force_models(["momentum_exchange"])
+    for blocks in (True, False):
+        s = create_solver("gl", cfg, ctx=gl_context)
+        s.enable_force_models(names)
         s.set_body(plate)
         assert s.body.window[2] - s.body.window[0] > BAND_WIDTH
-        s.step(12)
-        runs.append((s.forces()["momentum_exchange"], s.distributions()))
+        if blocks:
+            s.step(12)
+            forces = np.array([s.forces()[m] for m in names])
+        else:
+            forces = _single_steps(s, 12, names)
+        assert s._band.layout is None  # no slot fits: the check atlas took the windows
+        runs.append((forces, s.distributions()))
     (f_block, g_block), (f_single, g_single) = runs
     assert np.array_equal(g_block, g_single)
     assert np.allclose(f_block, f_single, rtol=1e-12, atol=0)

@@ -14,7 +14,7 @@ from solver_backends import BACKENDS
 from feelflow.solver.config import FlowConfig
 from feelflow.solver.inflow import INLET_DIRECTIONS, inflow_velocity, inlet_wall_profile, profile, ramp
 from feelflow.solver.lattice import equilibrium
-from feelflow.solver.numpy_backend import relaxation_rates
+from feelflow.solver.relaxation import relaxation_rates
 
 
 def test_ramp_is_smooth_from_zero_to_one():

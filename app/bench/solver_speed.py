@@ -1,4 +1,4 @@
-"""`feelflow bench [solver] [--json PATH] [--quick] [--variants]`: solver speed, both backends.
+"""`feelflow bench [solver] [--json PATH] [--quick] [--profile]`: solver speed, both backends.
 
 In one process, the same scenes on the numpy and the gl backend (EGL standalone context):
 an empty periodic box and a tunnel with a moving cylinder (moved every 10 steps as the window
@@ -12,19 +12,14 @@ its start-up transient). It also measures this machine's memory-copy bandwidth (
 written per second) and reports each MLUPS as a fraction of the D2Q9 bound, 72 bytes per node
 and step (9 float32 read + 9 written). GPU work is timed up to `glFinish`.
 
-`--variants` instead compares the gl backend's tuning choices on the moving-cylinder tunnel,
-interleaved in the same run with the periodic box and the numpy tunnel (so that the ratios, and
-the box's ceiling on any gl tunnel, are taken within each round), and llvmpipe's thread count
-and SIMD width in subprocesses
-(docs/performance.md). Figures from a shared machine are indicative.
+`--profile` instead splits the wall time of the gl moving tunnel into its parts (draw calls,
+read-backs, moves) under cProfile, and its CPU time by thread. Figures from a shared machine
+are indicative; compare ratios measured in the same run.
 """
 from __future__ import annotations
 
-import json
 import os
 import platform
-import subprocess
-import sys
 import time
 
 import numpy as np
@@ -73,10 +68,9 @@ def warmup_steps(scene: str, config, quick: bool) -> int:
     for a tunnel, unless `quick`, also its start-up transient: the inflow ramp, then 2 nx steps,
     more than the sqrt(3) nx the inlet's sound front needs to cross the channel (c_s = 1/sqrt(3)).
     Until the front has passed, the still fluid ahead of it holds populations so small that
-    float32 stores them subnormal; x86 computes with those many times slower, so numpy's first
-    round ran about 10 % slow (llvmpipe flushes them to zero) and the first round's ratio came
-    out high (docs/bench/s22/subnormals.txt, subnormals-1024.txt: none were left after 600 steps
-    at 512x256, 1 200 at 1024x512)."""
+    float32 stores them subnormal; x86 computes with those many times slower (llvmpipe flushes
+    them to zero), so numpy's first round would run slow and the first round's ratio come out
+    high (tests/test_bench_solver.py checks that none are left after the warm-up)."""
     if scene != "tunnel" or quick:
         return 20
     return 20 + config.inflow_ramp_steps + 2 * config.nx
@@ -85,16 +79,15 @@ def warmup_steps(scene: str, config, quick: bool) -> int:
 class SceneRun:
     """One scene on one solver: `advance(n)` runs n steps the way the window drives them.
 
-    For the tunnel's cost breakdown (`--variants`), `moves=False` keeps the cylinder where it
-    was placed, and `call_steps` sets how many steps each `step()` call runs (None: all n at
-    once) instead of MOVE_EVERY."""
+    For the profile's comparison (`--profile`), `moves=False` keeps the cylinder where it was
+    placed, and `call_steps` sets how many steps each `step()` call runs (None: all n at once)
+    instead of MOVE_EVERY."""
 
-    def __init__(self, scene, solver, moves: bool = True, call_steps: int | None = MOVE_EVERY,
-                 after_call=None):
+    def __init__(self, scene, solver, moves: bool = True, call_steps: int | None = MOVE_EVERY):
         from feelflow.shapes import Cylinder
 
         self.scene, self.solver = scene, solver
-        self.moves, self.call_steps, self.after_call = moves, call_steps, after_call
+        self.moves, self.call_steps = moves, call_steps
         cfg = solver.config
         self.k = 0
         if scene == "tunnel":
@@ -117,8 +110,6 @@ class SceneRun:
         while done < n:
             chunk = n - done if self.call_steps is None else min(self.call_steps, n - done)
             self.solver.step(chunk)
-            if self.after_call is not None:
-                self.after_call()
             self.k += chunk
             done += chunk
             if self.scene == "tunnel" and self.moves:
@@ -232,175 +223,6 @@ def _format_row(r) -> str:
             f"({r['mlups_per_cpu_s']:.1f} MLUPS per CPU-second){each}")
 
 
-# --- tuning variants (docs/performance.md) ---------------------------------------------------
-#: the runs of `--variants` that `against_numpy` divides
-DEFAULT_TUNNEL = "default: the step's own pass sums the links as it streams (G4 zw)"
-LINK_SUM_PASS_TUNNEL = "a link-sum pass per step sums them into a band area (forces=pass)"
-WINDOW_COPY_TUNNEL = "the step's own pass copies the window to a band area (forces=window)"
-BOX = "empty periodic box (default)"
-#: the tunnel with parts taken away, each run in one step(n) call a round (no call ends):
-#: against numpy they say what the tunnel would reach if those parts cost nothing
-FIXED_ONE_CALL = "default, cylinder not moved, one step(n) call a round"
-FIXED_NO_FORCE_ONE_CALL = "default, cylinder not moved, no force model, one step(n) call a round"
-NO_BODY_ONE_CALL = "tunnel without a body (edges and sponge only), one step(n) call a round"
-FIXED_STEP_CALLS = "default, cylinder not moved, step(10) calls"
-STAIRCASE = (("free moves (not moved, step(10) calls) / numpy", FIXED_STEP_CALLS),
-             ("free moves and call ends (not moved, one call) / numpy", FIXED_ONE_CALL),
-             ("... and no force model / numpy", FIXED_NO_FORCE_ONE_CALL),
-             ("... and no body (edges, sponge) / numpy", NO_BODY_ONE_CALL))
-NUMPY_TUNNEL = "numpy backend, the same moving tunnel (the reference)"
-#: the premise of a design whose moves and read-backs never drain llvmpipe's queue: CPU work done
-#: while llvmpipe still has steps queued is free. Two runs of the default tunnel add the same
-#: Python busy work to every step(10) call: once after the call's read (llvmpipe idle), once
-#: before it (GLSolver.before_read: llvmpipe busy with the call's last queued steps).
-CPU_WORK_MS = 3.0
-WORK_AFTER_READ = f"default + {CPU_WORK_MS:g} ms of Python per step(10) call, after its read"
-WORK_BEFORE_READ = f"default + {CPU_WORK_MS:g} ms of Python per step(10) call, before its read (GPU busy)"
-VARIANTS = {
-    "one program for every node (no regions)": {"split": False},
-    "regions, read back every step": {"check_every": 1, "window": "read"},
-    "default, force window read right after each step": {"window": "read"},
-    "blocks of 32, a pass per step copies the window to an atlas": {"window": "atlas"},
-    WINDOW_COPY_TUNNEL: {"forces": "window"},
-    LINK_SUM_PASS_TUNNEL: {"forces": "pass"},
-    DEFAULT_TUNNEL: {},
-    "default, regions as two triangles each, not scissored": {"draw": "triangles"},
-    "default, divergence by discard + occlusion query": {"divergence": "discard"},
-}
-#: step variants (body, edges, sponge) whose cost per node the variants run measures
-REGION_VARIANTS = {"interior (fast path)": (0, 0, 0), "interior + sponge rates": (0, 0, 1),
-                   "edges: walls, inlet, outlet": (0, 1, 1), "body window": (1, 0, 1),
-                   "everything (body + edges)": (1, 1, 1)}
-
-
-def against_numpy(wall: dict) -> dict:
-    """Per round, the gl default tunnel and the gl box against the numpy tunnel measured in the
-    same round, seconds apart (`--variants` interleaves its runs, so a slow spell of a shared
-    machine hits them alike): best and median over the rounds.
-
-    The box is the ceiling: it runs the tunnel interior's collide-and-stream pass on every node
-    with no walls, inlet, outlet, sponge, body, moves, force model or read-back, so no tunnel
-    built on that pass does less work per node. Where box / numpy stays below a target (issue 4:
-    2x), no change to the tunnel's boundaries, moves or read-backs reaches it on this machine
-    today; only a faster pass or renderer could.
-
-    Between the two, where those runs are there (STAIRCASE), the tunnel with parts taken away:
-    the cylinder not moved, in the same step(10) calls (what a body path whose moves cost
-    nothing could reach), then with all steps in one call (what a design with moves and
-    read-backs that never drain llvmpipe's queue could reach at best), then also without a force model,
-    then without the body: each ratio bounds what the tunnel reaches if what is taken away
-    cost nothing, so the steps between them price each part against the target."""
-    ref = wall[NUMPY_TUNNEL]
-    out = {}
-    pairs = (("gl tunnel / numpy tunnel", DEFAULT_TUNNEL),) + STAIRCASE + (("ceiling: gl box / numpy tunnel", BOX),)
-    for label, name in pairs:
-        if name not in wall:
-            continue
-        ratios = [round(g / n, 3) for g, n in zip(wall[name], ref)]
-        out[label] = _stats(ratios)
-    return out
-
-
-def cpu_work_cost(wall: dict, nodes: int) -> dict:
-    """Per round, the wall milliseconds per step(MOVE_EVERY) call that CPU_WORK_MS of CPU work
-    added to the default tunnel, placed after the call's read and before it (from MLUPS
-    measured in the same round). Overlap gains where 'before' costs less than 'after'."""
-    def per_call_ms(mlups):
-        return nodes * MOVE_EVERY / (mlups * 1e6) * 1e3
-
-    out = {}
-    for label, name in (("after the read", WORK_AFTER_READ), ("before the read (GPU busy)", WORK_BEFORE_READ)):
-        if name in wall and DEFAULT_TUNNEL in wall:
-            added = [round(per_call_ms(w) - per_call_ms(d), 3) for w, d in zip(wall[name], wall[DEFAULT_TUNNEL])]
-            out[label] = {"best": min(added), "median": float(np.median(added)), "samples": added}
-    return out
-
-
-def busy_python(ms: float) -> None:
-    """Keep this thread busy for `ms` of its own CPU time (the CPU work of cpu_work_cost)."""
-    end = time.thread_time() + ms / 1e3
-    while time.thread_time() < end:
-        pass
-
-
-def _stats(values):
-    return {"best": max(values), "median": float(np.median(values)), "samples": values}
-
-
-def run_variants(quick: bool, seconds: float | None):
-    """Interleaved rounds of every tuning variant on the moving-cylinder tunnel (MLUPS per wall
-    and per CPU second), with the gl box and the numpy tunnel in the same rounds (`against_numpy`:
-    the ratios and the ceiling), the cost per node of each step variant, and llvmpipe's thread
-    count and vector width (subprocesses)."""
-    from feelflow.shapes import Cylinder
-    from feelflow.solver.backend import create_solver
-    from feelflow.solver.gl_backend import GLSolver
-
-    seconds = seconds if seconds is not None else (0.3 if quick else 1.0)
-    rounds = 2 if quick else 5
-    nx, ny = 512, 256
-    ctx, err = _gl_context()
-    if ctx is None:
-        raise SystemExit(f"feelflow: {err}")
-    runs = {}
-    for name, tuning in VARIANTS.items():
-        runs[name] = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx, tuning=tuning))
-    no_force = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx))
-    no_force.solver.enable_force_models([])
-    runs["default, no force model (no window readback)"] = no_force
-    runs[FIXED_STEP_CALLS] = SceneRun(
-        "tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False)
-    for name, forces, body in ((FIXED_ONE_CALL, True, True), (FIXED_NO_FORCE_ONE_CALL, False, True),
-                               (NO_BODY_ONE_CALL, False, False)):
-        run = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx), moves=False, call_steps=None)
-        if not forces:
-            run.solver.enable_force_models([])
-        if not body:
-            run.solver.set_body(None)
-        runs[name] = run
-    runs[WORK_AFTER_READ] = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx),
-                                     after_call=lambda: busy_python(CPU_WORK_MS))
-    runs[WORK_BEFORE_READ] = SceneRun("tunnel", GLSolver(scene_config("tunnel", nx, ny), ctx=ctx))
-    runs[WORK_BEFORE_READ].solver.before_read = lambda: busy_python(CPU_WORK_MS)
-    runs[BOX] = SceneRun("box", GLSolver(scene_config("box", nx, ny), ctx=ctx))
-    runs[NUMPY_TUNNEL] = SceneRun("tunnel", create_solver("numpy", scene_config("tunnel", nx, ny)))
-    wall = {name: [] for name in runs}
-    per_cpu = {name: [] for name in runs}
-    for run in runs.values():
-        run.advance(warmup_steps(run.scene, run.solver.config, quick))
-    for _ in range(rounds):
-        for name, run in runs.items():
-            m = measure(run, seconds, warmup=0)
-            wall[name].append(m["mlups"])
-            per_cpu[name].append(m["mlups_per_cpu_s"])
-    probe = GLSolver(scene_config("tunnel", nx, ny), ctx=ctx)
-    probe.set_body(Cylinder(ny / 8, x=nx / 4, y=ny / 2))
-    draws = 20 if quick else 60
-    cost = {name: [] for name in REGION_VARIANTS}
-    for key in REGION_VARIANTS.values():
-        probe.time_variant(key, 3)  # compile
-    for _ in range(rounds):
-        for name, key in REGION_VARIANTS.items():
-            c0 = time.process_time()
-            probe.time_variant(key, draws)
-            cost[name].append(round(nx * ny * draws / (time.process_time() - c0) / 1e6, 2))
-    result = {"grid": f"{nx}x{ny}", "renderer": ctx.info.get("GL_RENDERER"), "machine": machine(),
-              "variants": {n: {"wall": _stats(wall[n]), "per_cpu_s": _stats(per_cpu[n])} for n in runs},
-              "against_numpy": against_numpy(wall),
-              "cpu_work_ms_per_call": {"work_ms": CPU_WORK_MS, **cpu_work_cost(wall, nx * ny)},
-              "step_variants_full_grid_mlups_per_cpu_s": {n: _stats(v) for n, v in cost.items()}}
-    result["llvmpipe_knobs"] = {
-        f"{var}={value}": _subprocess_tunnel(nx, ny, seconds * rounds, {var: value})
-        for var, values in LLVMPIPE_KNOBS.items() for value in values}
-    return result
-
-
-#: llvmpipe environment variables measured by `--variants` in subprocesses (llvmpipe reads them
-#: once, when it loads): rasteriser threads, and the SIMD width of its generated code
-#: ("256 bits" in the renderer string; AVX-512 machines accept 512)
-LLVMPIPE_KNOBS = {"LP_NUM_THREADS": ("1", "2", "4"), "LP_NATIVE_VECTOR_WIDTH": ("128", "256", "512")}
-
-
 PROFILE_PARTS = {  # (label, function name, file suffix or None for a built-in method)
     "draw calls (queue the step; wait while llvmpipe's queue is full)": ("<method 'render' of 'mgl.VertexArray' objects>", None),
     "end of each step() call: read back, force models, divergence check": ("_resolve_checks", "gl_backend.py"),
@@ -493,21 +315,6 @@ def run_profile(seconds: float | None):
             "threads_without_profiler": threads}
 
 
-def _subprocess_tunnel(nx: int, ny: int, seconds: float, env_extra: dict):
-    """The default moving-cylinder tunnel in a fresh process with `env_extra` set: wall MLUPS,
-    MLUPS per CPU-s and the renderer string, or None where the process failed."""
-    code = ("import json; from feelflow.app.bench.solver_speed import _gl_context, SceneRun, scene_config, measure; "
-            "from solver.gl_backend import GLSolver; ctx, _ = _gl_context(); "
-            f"r = SceneRun('tunnel', GLSolver(scene_config('tunnel', {nx}, {ny}), ctx=ctx)); "
-            f"m = measure(r, {seconds}); m['renderer'] = ctx.info.get('GL_RENDERER'); print(json.dumps(m))")
-    out = subprocess.run([sys.executable, "-c", code], env={**os.environ, **env_extra},
-                         capture_output=True, text=True)
-    if out.returncode != 0:
-        return None
-    m = json.loads(out.stdout.strip().splitlines()[-1])
-    return {"mlups": m["mlups"], "mlups_per_cpu_s": m["mlups_per_cpu_s"], "renderer": m["renderer"]}
-
-
 def main(args) -> int:
     quick = bool(getattr(args, "quick", False))
     seconds = getattr(args, "seconds", None)
@@ -525,27 +332,6 @@ def main(args) -> int:
             print(f"    {label:32s} wall {th['wall_ms_per_step']:.3f} ms, llvmpipe threads "
                   f"{th['llvmpipe_cpu_ms_per_step']:.3f} CPU-ms, main thread {th['other_cpu_ms_per_step']:.3f} "
                   f"CPU-ms, cores idle {100 * th['cores_idle_fraction']:.1f} %")
-    elif getattr(args, "variants", False):
-        result = run_variants(quick, seconds)
-        print(f"gl tuning variants, moving-cylinder tunnel {result['grid']}, {result['renderer']}")
-        print(f"  {'variant':72s} {'MLUPS (wall) best/median':>26s} {'per CPU-s best/median':>24s}")
-        for name, v in result["variants"].items():
-            w, c = v["wall"], v["per_cpu_s"]
-            print(f"  {name:72s} {w['best']:12.1f} {w['median']:9.1f} {c['best']:14.1f} {c['median']:9.1f}")
-        for label, v in result["against_numpy"].items():
-            print(f"  {label:72s} {v['best']:11.2f}x {v['median']:8.2f}x   (ratios within each round)")
-        work = result["cpu_work_ms_per_call"]
-        for label in ("after the read", "before the read (GPU busy)"):
-            if label in work:
-                print(f"  {work['work_ms']:g} ms of Python per step(10) call {label:40s} adds "
-                      f"{work[label]['median']:6.2f} ms a call (median; best {work[label]['best']:.2f})")
-        print("  step variant drawn over the whole grid (MLUPS per CPU-s, best/median):")
-        for name, v in result["step_variants_full_grid_mlups_per_cpu_s"].items():
-            print(f"    {name:70s} {v['best']:12.1f} {v['median']:9.1f}")
-        print("  llvmpipe settings, default moving tunnel in a fresh process (MLUPS wall, per CPU-s, renderer):")
-        for knob, m in result["llvmpipe_knobs"].items():
-            print(f"    {knob:28s} " + (f"{m['mlups']:8.1f} {m['mlups_per_cpu_s']:8.1f}  {m['renderer']}"
-                                         if m is not None else "failed"))
     else:
         bench_rounds(quick, getattr(args, "rounds", None))  # refused before anything is printed or run
         m = machine()

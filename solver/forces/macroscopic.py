@@ -9,9 +9,9 @@ the flow sampled on a contour around the body.
   each weighted by its element length. rho: the mean density on the same contour.
 - V: the body's translational velocity (rotation is ignored).
 - A: `shape.frontal_area` for the direction of U.
-- C_D, C_L: a table per shape kind (below), textbook values at Re 1e4-1e5, collected in
-  (C_L is referred to the chord c of the half airfoil, C_D to the frontal width A)
-  ../shared/reference/benchmarks.md from White, *Fluid Mechanics* (table 7.2) and Hoerner,
+- C_D, C_L: a table per shape kind (below), textbook values at Re 1e4-1e5
+  (C_L is referred to the chord c of the half airfoil, C_D to the frontal width A), from
+  White, *Fluid Mechanics* (table 7.2) and Hoerner,
   *Fluid-Dynamic Drag* (1965). e_L is the unit vector normal to U on the side of the body's own
   "up" (its +y axis rotated by its angle).
 
@@ -34,12 +34,11 @@ from feelflow.solver.lattice import RHO0
 
 #: kind -> (C_D, source). Wedges depend on which way they face (see `drag_coefficient`).
 DRAG_COEFFICIENTS: dict[str, tuple[float, str]] = {
-    "cylinder": (1.2, "circular cylinder, Re 1e4-1e5: White, Fluid Mechanics, table 7.2; benchmarks.md"),
-    "plate": (2.0, "flat plate normal to the flow: White table 7.2; Hoerner (1965) ch. 3; benchmarks.md"),
-    "wedge_apex_upstream": (1.55, "equilateral triangle, apex upstream, 1.5-1.6: White table 7.2; benchmarks.md"),
-    "wedge_face_upstream": (2.0, "equilateral triangle, flat face upstream: White table 7.2; benchmarks.md"),
-    "half_airfoil": (0.6, "closest tabulated body: 2:1 ellipse, long axis along the flow: White table 7.2; "
-                          "benchmarks.md"),
+    "cylinder": (1.2, "circular cylinder, Re 1e4-1e5: White, Fluid Mechanics, table 7.2"),
+    "plate": (2.0, "flat plate normal to the flow: White table 7.2; Hoerner (1965) ch. 3"),
+    "wedge_apex_upstream": (1.55, "equilateral triangle, apex upstream, 1.5-1.6: White table 7.2"),
+    "wedge_face_upstream": (2.0, "equilateral triangle, flat face upstream: White table 7.2"),
+    "half_airfoil": (0.6, "closest tabulated body: 2:1 ellipse, long axis along the flow: White table 7.2"),
     "polygon": (2.0, "no tabulated value for an arbitrary polygon: the bluff-body value of the flat plate "
                      "(White table 7.2), an upper estimate"),
 }

@@ -1,5 +1,5 @@
-"""Galilean invariance of the force on a moving body (the seed's failure, SEED-NOTES 'Three
-force models'; Wen et al. 2014).
+"""Galilean invariance of the force on a moving body (where the seed thesis's force
+models failed; Wen et al. 2014).
 
 On a doubly periodic lattice (no walls, no inlet: the three runs are exact Galilean transforms
 of one another, up to the lattice):
@@ -7,7 +7,7 @@ of one another, up to the lattice):
   towed  - fluid at rest, cylinder moving at -U;
   co-moving - fluid and cylinder both moving at +U (no relative motion).
 The drag averaged over the second half of the run must agree between fixed and towed within
-3 %, and the co-moving body must feel a mean force below 2 % of the fixed drag (issue 2).
+3 %, and the co-moving body must feel a mean force below 2 % of the fixed drag.
 
 Limits of this test: in a uniform stream the co-moving body leaves the equilibrium untouched,
 so its force is zero to rounding for any momentum exchange, and at this Mach number the classic
@@ -75,7 +75,7 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
         "cd_fixed": units.force_coefficient(fixed[0], SPEED, d),
         "towed_vs_fixed": towed[0] / fixed[0] - 1.0,
         "comoving_vs_fixed": math.hypot(*comoving) / abs(fixed[0])})
-    result.checks += [Check("towed_vs_fixed", -0.03, 0.03, "issue 2: towed = fixed drag within 3 %"),
-                      Check("comoving_vs_fixed", 0.0, 0.02, "issue 2: co-moving force < 2 % of fixed drag")]
+    result.checks += [Check("towed_vs_fixed", -0.03, 0.03, "target: towed = fixed drag within 3 %"),
+                      Check("comoving_vs_fixed", 0.0, 0.02, "target: co-moving force < 2 % of fixed drag")]
     result.notes = f"periodic {nx} x {8 * d}, U = {SPEED}, Re = {RE:g}, {steps} steps each, mean over the second half"
     return watch.fill(result)

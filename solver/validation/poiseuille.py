@@ -6,13 +6,13 @@ walls that are two rectangles (`feelflow.shapes.Polygon`) seen by the solver as 
 (q = Q_BOTTOM, Q_TOP: not 1/2), so the interpolated bounce-back (Bouzidi et al. 2001) is what
 places them. Steady solution u(y) = g / (2 nu) (y - y_b)(y_t - y). Diffusive scaling: tau and
 the peak speed stay fixed as the width H grows, so the relative L2 error must fall like H^-2
-(issue 2: order 2 +- 0.2 over at least three resolutions).
+(target: order 2 +- 0.2 over at least three resolutions).
 
 Q_BOTTOM < 1/2 and Q_TOP > 1/2, so both branches of the linear rule are checked. With q < 1/2
 the rule needs the node x + c_i, which for the diagonal links of the first and last column lies
 across the periodic seam: the walls' window spans the periodic width, and the backends take
-that node from the other edge (docs/algorithm.md rule 1a; before the seventh session they fell
-back to the half-way rule there, and q = 0.3 gave order 1.1 and a flow that varied along x).
+that node from the other edge (docs/algorithm.md rule 1a; falling back to the half-way rule there
+instead gives order 1.1 at q = 0.3 and a flow that varies along x).
 Each run starts from the analytic profile and runs until the field changes by less than
 `STEADY_TOL` (relative) over a block: the discrete steady state, whatever the start.
 """
@@ -189,7 +189,7 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
     quantities["order"] = float(order)
     quantities["steady"] = float(all(steady))
     result = CaseResult(NAME, backend, resolutions[-1], quantities=quantities)
-    result.checks += [Check("order", 1.8, 2.2, "issue 2: L2 error order 2 +- 0.2"),
+    result.checks += [Check("order", 1.8, 2.2, "target: L2 error order 2 +- 0.2"),
                       Check("steady", 1.0, 1.0, f"steady within {STEADY_TOL:g} U per block")]
     result.notes = (f"widths {', '.join(f'{h:g}' for h in heights)} cells, q = {Q_BOTTOM} / {Q_TOP}, "
                     f"nu = {NU}, U_peak = {U_PEAK}, TRT, Guo forcing, periodic x ({NX} columns)")

@@ -1,8 +1,8 @@
 """Schaefer-Turek 2D-1: steady flow past a cylinder at Re = 20; C_D, C_L and dp.
 
-Targets (issue 2): at 20 cells per diameter C_D within 1 % of 5.5795 and dp within 2 %; at 40
-cells C_D within 0.3 %, C_L within 10 %, dp within 1 % (of the refined reference values,
-benchmarks.md). Runs from the developed channel flow until C_D, C_L and dp, averaged over a
+Targets: at 20 cells per diameter C_D within 1 % of 5.5795 and dp within 2 %; at 40
+cells C_D within 0.3 %, C_L within 10 %, dp within 1 % (of the refined reference values of
+John 2004). Runs from the developed channel flow until C_D, C_L and dp, averaged over a
 block of steps, change by less than `TOL` from one block to the next: a convergence criterion,
 not a fixed step count. A block is one acoustic round trip along the channel (2 nx / c_s steps),
 so that the sound waves of the start, reflected between inlet and outlet, average out.

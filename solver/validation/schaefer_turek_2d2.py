@@ -5,8 +5,7 @@ tunnel's slowest sound mode (`Geometry.acoustic_period`), then runs until the li
 is periodic (successive periods and lift amplitudes agree within `PERIODIC_TOL`) and measures
 over the last `MEASURE_PERIODS` periods: the Strouhal number St = D f / U_mean from upward zero
 crossings of C_L (linearly interpolated), the largest C_D and C_L, and the mean C_D. Targets:
-the published intervals (Schaefer & Turek 1996, benchmarks.md), checked at 40 cells per
-diameter as the issue asks.
+the published intervals (Schaefer & Turek 1996), checked at 40 cells per diameter.
 
 Why the smooth start (measured, docs/validation.md): the benchmark quantities are maxima of
 the periodic signal. Started impulsively (the cylinder put into the developed channel flow),
@@ -19,7 +18,7 @@ C_D and the shedding were unchanged. Ramped in over two acoustic periods, the rm
 its period-averaged signal falls from 0.013 to 0.0004 (20 cells) and successive periods agree to
 0.02 %, hence the tighter `PERIODIC_TOL`. Diagnostics: `python -m feelflow.app.bench.st2d2_diagnose`.
 
-Why the absorbing sponge (fourth session, measured, docs/validation.md): even after a smooth
+Why the absorbing sponge (measured, docs/validation.md): even after a smooth
 start, the drag's oscillation at twice the shedding frequency drives the tunnel's sound, and
 the closed-open pipe (velocity inlet, pressure outlet) answers it: at 30 cells with U_m 0.05,
 where 2f sits on the third acoustic mode, C_D's 2f line was 0.051 against 0.031 off resonance,

@@ -2,7 +2,7 @@
 against wind speed U, per hard scene and collision operator, on the window's grid.
 
 Scenes (grid 192 x 96, the window's tunnel: velocity inlet, pressure outlet with its 32-cell
-sponge and the sponge's absorbing layer (since the fifth session, as the window), no-slip walls,
+sponge and the sponge's absorbing layer (as the window has), no-slip walls,
 float32; the body of size `d` at the window's start point (0.3 nx, ny/2)):
   plate45            - a flat plate d long and 0.5 cells thick (thinner than a cell) at 45 deg,
                        fixed, the wind blowing everywhere from the first step (the window's start);

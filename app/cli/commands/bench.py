@@ -1,9 +1,9 @@
 """`feelflow bench [solver|accuracy|haptics]`: speed of the solver backends, their speed against
 their error, or the haptic loop.
 
-The solver bench lives in `app/commands/bench_solver.py`, speed against error in
-`app/commands/bench_accuracy.py`, the haptic one in `app/commands/bench_haptics.py`; this
-module only dispatches.
+The solver bench lives in `app/bench/solver_speed.py`, speed against error in
+`app/bench/accuracy.py`, the haptic one in `app/bench/haptic_loop.py`; this module only
+dispatches.
 """
 from __future__ import annotations
 
@@ -29,8 +29,6 @@ def add_arguments(parser):
                         help="accuracy: only this backend (repeatable; default: numpy float64, numpy float32, gl)")
     parser.add_argument("--axis", action="append", choices=AXES,
                         help="accuracy: only this axis (repeatable; default: all three)")
-    parser.add_argument("--variants", action="store_true",
-                        help="solver: compare the gl backend's tuning variants (docs/performance.md)")
     parser.add_argument("--profile", action="store_true",
                         help="solver: where the gl moving tunnel's wall time goes (docs/performance.md)")
 
