@@ -1,6 +1,6 @@
 #version 330 core
 // One lattice Boltzmann step t -> t+1, collide and stream fused (pull form), exactly as
-// docs/algorithm.md states it. Populations are stored shifted, g_i = f*_i - w_i RHO0, two nodes
+// docs/science/algorithm.md states it. Populations are stored shifted, g_i = f*_i - w_i RHO0, two nodes
 // per texel in five RGBA32F textures (shaders/paired_layout.glsl, solver/gl_layout.py); each
 // fragment updates the two nodes a = (2k, y) and b = (2k + 1, y) of its texel k.
 // References: Bouzidi, Firdaouss & Lallemand (2001); Lallemand & Luo (2003); Ginzburg (2008);

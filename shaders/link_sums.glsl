@@ -1,5 +1,5 @@
 #version 330 core
-// The momentum exchange's link sums of one step on the GPU (docs/algorithm.md 'Forces'; Wen,
+// The momentum exchange's link sums of one step on the GPU (docs/science/algorithm.md 'Forces'; Wen,
 // Zhang, Tu, Wang & Fang 2014; Ladd 1994), drawn by the step's own pass into a slot of the band
 // area: one RGBA32F texel per state texel with a cut link, so that a block reads back those few
 // texels instead of the window's five attachments. The state texels with links are listed in

@@ -1,4 +1,4 @@
-"""The fragment-shader backend: docs/algorithm.md in GLSL 330 core, run through moderngl.
+"""The fragment-shader backend: docs/science/algorithm.md in GLSL 330 core, run through moderngl.
 
 `GLSolver(config, ctx=moderngl_context)` implements `feelflow.solver.backend.Solver` with the same extra
 methods as the numpy reference (`add_force_model`, `body_window`). It never
@@ -37,7 +37,7 @@ API for the app (a QOpenGLWidget sharing this context):
   textures are nx + BAND_WIDTH wide for tunnels. One pass a step keeps llvmpipe at one scene a
   step (a separate copy pass into an atlas, which x-periodic grids, whose texture must be nx
   wide for the REPEAT wrap, and windows wider than the band area still use, cost the moving
-  tunnel 25-30 %: docs/performance.md). At the end of the block a pass sums texture G0 (g0 of
+  tunnel 25-30 %: docs/science/performance.md). At the end of the block a pass sums texture G0 (g0 of
   both nodes of a texel) of the final state over tiles (`shaders/finite_check.glsl`; NaN reaches
   every population of the neighbours within a step, so a NaN never vanishes from the fluid) and the windows and sums are read once. A non-finite sum
   replays the block from its start state, which a third state side keeps, with a check after
@@ -57,7 +57,7 @@ API for the app (a QOpenGLWidget sharing this context):
   the same stored populations and the same Bouzidi rule as the step (forces="window": the
   window and the models' own code, as for every other model). (An occlusion query counting
   fragments that a non-finite node discards, tuning divergence="discard", halved the step's
-  speed on llvmpipe: docs/performance.md.)
+  speed on llvmpipe: docs/science/performance.md.)
 """
 from __future__ import annotations
 
@@ -102,7 +102,7 @@ class LinkSums:
     texels: (n, 2) the state texels (k, y) that hold a cut link; `table` lists them packed row
     by row, (k, y, 1, 0) each, in a texture as wide as a slot; `vao` draws, per slot, one
     rectangle over the rows the list takes (llvmpipe pays per primitive, so not a point per
-    texel: docs/performance.md). List entry j lands on texel (j % ww, j // ww) of its slot.
+    texel: docs/science/performance.md). List entry j lands on texel (j % ww, j // ww) of its slot.
     """
 
     vao: object
@@ -159,10 +159,10 @@ def node_mask(solid: np.ndarray, q: np.ndarray, box, links=None, window=None) ->
 
 
 class GLSolver(Solver):
-    """docs/algorithm.md on the GPU (fragment shaders), float32; see the module docstring."""
+    """docs/science/algorithm.md on the GPU (fragment shaders), float32; see the module docstring."""
 
     name = "gl"
-    #: default tuning (docs/performance.md measures each choice). forces: "gpu", the momentum
+    #: default tuning (docs/science/performance.md measures each choice). forces: "gpu", the momentum
     #: exchanges' link sums on the GPU (one model: summed by the step's own pass into G4's spare
     #: channels; both: by the link-sum pass into the band area), "pass" (always that pass) or
     #: "window" (the body window copied and every model's own code)
@@ -290,7 +290,7 @@ class GLSolver(Solver):
         The body window is drawn last, over the fast path or edge strip beneath it (its variant
         writes every texel it covers; _set_rects draws the keys in order, body keys last): one
         rectangle per variant instead of the interior cut into four around the window, and the
-        other regions stay the same as the body moves (docs/performance.md, tenth session).
+        other regions stay the same as the body moves (docs/science/performance.md, tenth session).
         """
         nx, ny, a = self._kx, self.ny, ALIGN  # texel columns
         if window is not None:
@@ -339,7 +339,7 @@ class GLSolver(Solver):
         inside is fully covered, and a move changes only the body window's scissor box; drawn
         as two triangles (draw="triangles"), the 4x4 blocks along the diagonal are shaded twice,
         once per triangle, which doubles the cost of the 4-texel edge strips
-        (docs/performance.md)."""
+        (docs/science/performance.md)."""
         regions = sorted(self._regions(window).items())
         if regions == self._draw_regions:
             return
@@ -725,7 +725,7 @@ class GLSolver(Solver):
 
     def time_variant(self, key, draws: int) -> float:
         """Seconds to draw step variant `key` = (body, edges, sponge) over the whole grid
-        `draws` times (the state is advanced: for docs/performance.md's cost table only)."""
+        `draws` times (the state is advanced: for docs/science/performance.md's cost table only)."""
         import time
 
         vbo = self.ctx.buffer(_triangles([(0, 0, self._kx, self.ny)]).tobytes())

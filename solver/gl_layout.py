@@ -8,7 +8,7 @@ of texture t, each as (direction, node) with node 0 for a and 1 for b:
 
 The streaming step pulls g_i(x - c_i). A fragment updates both nodes of its texel k, and the
 nine texels it needs, (k - 1 .. k + 1, y - 1 .. y + 1), are each fetched once
-(shaders/lbm_step.glsl, stream_pair; docs/performance.md, thirteenth session):
+(shaders/lbm_step.glsl, stream_pair; docs/science/performance.md, thirteenth session):
 - G0, G1, G2 at the texel k of rows y, y - 1, y + 1 hold everything that stays in the texel's
   column pair: the rest populations and, per row offset, what moves straight, what node a
   sends to node b (east-going, c_x = +1) and what node b sends to node a (west-going);

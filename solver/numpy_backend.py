@@ -1,4 +1,4 @@
-"""The numpy reference backend: docs/algorithm.md, vectorised over the whole grid.
+"""The numpy reference backend: docs/science/algorithm.md, vectorised over the whole grid.
 
 Storage: post-collision populations shifted by their rest value, g_i = f*_i - w_i RHO0, so
 float32 keeps density fluctuations of 1e-5 (Skordos 1993). Streaming is a periodic shift of
@@ -70,7 +70,7 @@ def absorb_keep(config: FlowConfig):
     node towards the far-field state (RHO0, the inflow profile: the outflow of a straight tunnel)
     at omega+ a s^2. Sound leaves the tunnel instead of ringing between the velocity inlet and
     the pressure outlet (Kam, Leung & Chew, Phys. Rev. E 74 (2006) 036704; Xu & Sagaut,
-    J. Comput. Phys. 245 (2013) 14). docs/algorithm.md, step 3."""
+    J. Comput. Phys. 245 (2013) 14). docs/science/algorithm.md, step 3."""
     s = sponge_position(config)
     if s is None or config.sponge_absorb == 0.0:
         return None
@@ -78,7 +78,7 @@ def absorb_keep(config: FlowConfig):
 
 
 class NumpySolver(Solver):
-    """Reference D2Q9 solver (docs/algorithm.md), numpy, float64 or float32 storage."""
+    """Reference D2Q9 solver (docs/science/algorithm.md), numpy, float64 or float32 storage."""
 
     name = "numpy"
 

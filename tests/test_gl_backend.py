@@ -241,7 +241,7 @@ def test_a_non_finite_body_window_raises_with_its_step_on_either_force_path(gl_c
 
 
 def test_before_read_runs_once_per_block_while_its_steps_are_still_unread(gl_context):
-    """GLSolver.before_read (the bench's overlap probe, docs/performance.md 'Ninth session') is
+    """GLSolver.before_read (the bench's overlap probe, docs/science/performance.md 'Ninth session') is
     called once per block of steps, after the block's draws and before its read-back, and
     changes nothing: the same state and forces as without it."""
     cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04, inflow_ramp_steps=10)

@@ -16,7 +16,7 @@ and step (9 float32 read + 9 written). GPU work is timed up to `glFinish`.
 interleaved in the same run with the periodic box and the numpy tunnel (so that the ratios, and
 the box's ceiling on any gl tunnel, are taken within each round), and llvmpipe's thread count
 and SIMD width in subprocesses
-(docs/performance.md). Figures from a shared machine are indicative.
+(docs/science/performance.md). Figures from a shared machine are indicative.
 """
 from __future__ import annotations
 
@@ -75,7 +75,7 @@ def warmup_steps(scene: str, config, quick: bool) -> int:
     Until the front has passed, the still fluid ahead of it holds populations so small that
     float32 stores them subnormal; x86 computes with those many times slower, so numpy's first
     round ran about 10 % slow (llvmpipe flushes them to zero) and the first round's ratio came
-    out high (docs/bench/s22/subnormals.txt, subnormals-1024.txt: none were left after 600 steps
+    out high (docs/science/performance.md, 'Warm-up': none were left after 600 steps
     at 512x256, 1 200 at 1024x512)."""
     if scene != "tunnel" or quick:
         return 20
@@ -232,7 +232,7 @@ def _format_row(r) -> str:
             f"({r['mlups_per_cpu_s']:.1f} MLUPS per CPU-second){each}")
 
 
-# --- tuning variants (docs/performance.md) ---------------------------------------------------
+# --- tuning variants (docs/science/performance.md) ---------------------------------------------------
 #: the runs of `--variants` that `against_numpy` divides
 DEFAULT_TUNNEL = "default: the step's own pass sums the links as it streams (G4 zw)"
 LINK_SUM_PASS_TUNNEL = "a link-sum pass per step sums them into a band area (forces=pass)"
@@ -452,7 +452,7 @@ def thread_split(run: SceneRun, steps: int) -> dict | None:
 def run_profile(seconds: float | None):
     """The default moving tunnel (512x256, gl) under cProfile: where its wall time goes.
 
-    Each part is the cumulative wall time of one function (docs/performance.md); the parts do
+    Each part is the cumulative wall time of one function (docs/science/performance.md); the parts do
     not overlap, and the rest is the Python around them. While the main thread waits in a draw
     call, llvmpipe's threads are busy; during the other parts they have nothing queued."""
     import cProfile

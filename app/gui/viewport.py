@@ -47,7 +47,7 @@ BODY_EDGE = QColor(20, 20, 20)
 DRAG_COLOUR = QColor(230, 40, 40)
 LIFT_COLOUR = QColor(40, 120, 255)
 COLOUR_BAR_MARGIN = 132  # pixels on the right kept for the colour bar
-#: the dashed line where the outlet zone (the sponge, docs/algorithm.md step 3) begins
+#: the dashed line where the outlet zone (the sponge, docs/science/algorithm.md step 3) begins
 OUTLET_LINE = QColor(255, 255, 255, 150)
 WHEEL_DEG_PER_NOTCH = 2.0  # one notch of the mouse wheel (120 eighths of a degree) turns the body this far
 MOUSE_HINT = ("Drag the body to move it; drag its round handle or turn the mouse wheel to rotate it "

@@ -201,7 +201,7 @@ def _forces(run: dict, model: str) -> np.ndarray:
 
 
 def acoustic_period(run: dict) -> float:
-    """Period of the tunnel's quarter-wave acoustic mode, 4 nx / c_s steps (README, 'Solver'):
+    """Period of the tunnel's quarter-wave acoustic mode, 4 nx / c_s steps (docs/science/algorithm.md, 'Inflow'):
     the inlet and the outlet both reflect sound, and every start, stop and ramp rings it."""
     return 4.0 * run["nx"] / math.sqrt(CS2)
 
@@ -460,7 +460,7 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
     add("# The seed's experiments on FeelFlow: four force models side by side\n")
     add("Written by `feelflow report seed` (app/seed_report.py) from the scenes in `scenes/`; "
         "`feelflow report seed --replot` rebuilds this page from the stored series in `report-seed/`.\n")
-    add("Models (docs/force-models.md): `momentum_exchange` (the reference: Galilean-invariant momentum exchange), "
+    add("Models (docs/science/force-models.md): `momentum_exchange` (the reference: Galilean-invariant momentum exchange), "
         "`momentum_exchange_classic` (the seed's), `macroscopic` (drag equation with tabulated C_D, velocity sampled "
         "4 cells off the wall), `pressure` (seed eq. 24 with beta = rho_0/6, i.e. the lattice pressure; no shear). "
         "Forces in lattice units per step; means at the end of each phase or run, over the longest whole number "
@@ -486,7 +486,7 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
             "impulsive start and stop of the body: the column *swing* is the standard deviation of F_x (100-step "
             "means) over the last half of the second stopped phase. Differences smaller than it are noise. "
             "The clean Galilean check is `pytest tests/test_force_models_flow.py -s` (the same protocol in two "
-            "frames in a periodic box, no tunnel acoustics; docs/force-models.md has its numbers). The classic form "
+            "frames in a periodic box, no tunnel acoustics; docs/science/force-models.md has its numbers). The classic form "
             "differs from the reference only by -u_w sum (f_out - f_in) over the body links and by the cover/uncover "
             "impulse; both stay small while the density stays at rho_0 (the tunnel's pressure outlet holds it there), "
             "and that test shows the classic form failing at an ambient density 5 % above rho_0.\n")
@@ -530,7 +530,7 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
             s = res["shapes"][m]
             order = " > ".join(sorted(keys, key=lambda k: -s[k]["drag"]))
             add(f"| {m} | " + " | ".join(_g(s[k]["cd"]) for k in keys) + f" | {order} |")
-        add("\nThe macroscopic model's ordering is its C_D table's (docs/force-models.md), an input, not a result.")
+        add("\nThe macroscopic model's ordering is its C_D table's (docs/science/force-models.md), an input, not a result.")
         add(f"\n![drag per shape]({plots_dir}/drag_per_shape.png)")
 
     if "lift" in res:

@@ -1,5 +1,5 @@
 """`feelflow report seed`: reproduce the seed's experiments with all four force models and write
-docs/report-seed.md with PNG plots (the work is in app/seed_report.py).
+docs/science/report-seed.md with PNG plots (the work is in app/seed_report.py).
 `feelflow report lessons [--only KEY,...] [--compare] [--json PATH]`: run the Presets menu's
 lessons headless as the window does and print how steady their forces are (app/lesson_report.py).
 `feelflow report scenes [--only NAME,...] [--compare] [--json PATH]`: run the example scenes with an
@@ -38,8 +38,8 @@ def add_arguments(parser):
                              "first step, sudden wind changes); scenes: also without the absorbing layer")
     parser.add_argument("--json", default=None, metavar="PATH", help="lessons, scenes: also write the runs as JSON")
     parser.add_argument("--scenes", default="scenes", metavar="DIR", help="folder holding the scenes (default: scenes)")
-    parser.add_argument("--out", default="docs", metavar="DIR",
-                        help="folder for report-seed.md and report-seed/ (default: docs)")
+    parser.add_argument("--out", default="docs/science", metavar="DIR",
+                        help="folder for report-seed.md and report-seed/ (default: docs/science)")
     parser.add_argument("--replot", action="store_true",
                         help="rebuild text and plots from the stored series without running the flow")
 
