@@ -56,7 +56,7 @@ def inlet_wall_profile(ny: int, speed: float, kind: str) -> np.ndarray:
     s = iy + 1/2 - c_iy / 2: the row's own height for i = 1, half a cell below for i = 5, half a
     cell above for i = 8. The row's own velocity for the diagonals is off by half a cell's change
     of the profile, a first-order error that shears the flow at the inlet (docs/science/validation.md,
-    2D-2 item 10).
+    Schaefer-Turek 2D-1).
     """
     s = np.arange(ny) + 0.5
     return np.stack([profile_at(s - 0.5 * C[i, 1], ny, speed, kind) for i in INLET_DIRECTIONS])

@@ -12,7 +12,7 @@ one row more or less changes the blockage D / H, and with it C_D by about half a
 C_L by tens of percent at 16 - 24 cells, more than the resolution itself changes them; a
 cylinder of a non-whole D that kept H exact would sit off-centre on the lattice, and the lift of
 2D-1 (2 per mille of the drag) then comes out wrong by several times its size (probes,
-docs/science/validation.md, 'Whole channel heights'). Reference values:
+docs/science/validation.md, Schaefer-Turek 2D-1). Reference values:
 /work/shared/reference/benchmarks.md (Schaefer & Turek 1996, refined reference values of
 John 2004 for 2D-1).
 """
