@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 #: the example scenes a class opens with File > Open or `feelflow run` (the seed report's scenes
-#: keep their own set-up: their figures in docs/science/report-seed.md were measured with it)
+#: keep their own set-up: their figures in docs/science/seed-report.md were measured with it)
 SCENES = ("default", "plate", "half_airfoil", "wedge_upstream", "wedge_downstream", "seed_experiment")
 #: the column whose mean velocity is watched (cells from the inlet)
 PROBE_COLUMN = 5

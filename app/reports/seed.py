@@ -8,7 +8,7 @@ lift on the half airfoil (`lift_airfoil_half.toml`); drag on a plate at five spe
 (`drag_vs_speed.toml`, swept here over `SWEEP_SPEEDS`). Means are taken over the last half of
 each phase (or of the run), so the start-up transient is left out.
 
-The measured numbers are stored in `report-seed/data.json` next to the report, so the text and
+The measured numbers are stored in `seed-report/data.json` next to the report, so the text and
 plots can be rebuilt (`--replot`) without running the flow again.
 """
 from __future__ import annotations
@@ -112,7 +112,7 @@ def run_scene(scene, backend: str, log=print) -> dict:
     return rows
 
 
-#: the report's parts, each run and stored on its own (report-seed/data-<part>.json)
+#: the report's parts, each run and stored on its own (seed-report/data-<part>.json)
 PARTS = ("protocol", "shapes", "sweep", "lift")
 
 
@@ -458,8 +458,8 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
     L: list[str] = []
     add = L.append
     add("# The seed's experiments on FeelFlow: four force models side by side\n")
-    add("Written by `feelflow report seed` (app/seed_report.py) from the scenes in `scenes/`; "
-        "`feelflow report seed --replot` rebuilds this page from the stored series in `report-seed/`.\n")
+    add("Written by `feelflow report seed` (app/reports/seed.py) from the scenes in `scenes/`; "
+        "`feelflow report seed --replot` rebuilds this page from the stored series in `seed-report/`.\n")
     add("Models (docs/science/force-models.md): `momentum_exchange` (the reference: Galilean-invariant momentum exchange), "
         "`momentum_exchange_classic` (the seed's), `macroscopic` (drag equation with tabulated C_D, velocity sampled "
         "4 cells off the wall), `pressure` (seed eq. 24 with beta = rho_0/6, i.e. the lattice pressure; no shear). "
@@ -593,13 +593,13 @@ def verdict(m: str, res: dict) -> str:
 
 
 def write_report(out_dir: Path) -> Path:
-    """Analyse the stored parts, plot, write report-seed.md; returns its path."""
-    folder = out_dir / "report-seed"
+    """Analyse the stored parts, plot, write seed-report.md; returns its path."""
+    folder = out_dir / "seed-report"
     parts = load_parts(folder)
     if not parts:
         raise UserError(f"{folder}: no stored experiment data; run `feelflow report seed` first")
     res = analyse(parts)
     make_plots(parts, res, folder)
-    path = out_dir / "report-seed.md"
-    write_text_atomic(path, markdown(parts, res, "report-seed"))
+    path = out_dir / "seed-report.md"
+    write_text_atomic(path, markdown(parts, res, "seed-report"))
     return path
