@@ -22,7 +22,7 @@ of `feelflow.haptics.types`. The API for the app:
     loop.stop(); dev.close()
 
 In the app, prefer the same loop in a child process, which no GUI or solver thread of the app
-can stall through the interpreter lock (docs/haptics.md, 'Timing'):
+can stall through the interpreter lock (docs/guide/haptic-devices.md, 'The force loop'):
 
     loop = ProcessForceLoop("sim://haply2diy", LoopConfig(...), on_disconnect=callback)
     loop.capabilities; loop.start(); ...same calls as above...; loop.close()

@@ -3,7 +3,7 @@
 Why: CPython threads share one interpreter lock (GIL). A GUI or solver thread that holds it and
 is descheduled by a busy OS, or sits in a long C call that keeps it (GL calls do), stalls the
 1 kHz loop thread for milliseconds (measured on the loaded 2-core dev machine: a pure-Python busy
-thread next to the loop took the p99 period jitter from 0.02 ms to 4.3 ms; docs/haptics.md).
+thread next to the loop took the p99 period jitter from 0.02 ms to 4.3 ms; docs/guide/haptic-devices.md).
 A child process has its own interpreter, where the loop competes with nothing of the app.
 
 `ProcessForceLoop(url, config)` offers the ForceLoop API (start, stop, pause, resume,

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Puts FeelFlow into the desktop: an application-menu entry with its icon, `feelflow` on the
-# PATH, and `.ffsession` files (docs/sessions.md) that open in FeelFlow's replay when
+# PATH, and `.ffsession` files (docs/reference/session-format.md) that open in FeelFlow's replay when
 # double-clicked. Usage:
 #   installer/install-desktop.sh [--prefix DIR] [--bundle DIR] [--no-setup]   install (again: safe)
 #   installer/install-desktop.sh [--prefix DIR] --uninstall    remove what install wrote

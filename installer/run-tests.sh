@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sets everything up (installer/setup.sh), then runs the test suite under a virtual X screen
-# (GUI tests need a real window with OpenGL; see docs/testing.md). Two pytest processes: the
+# (GUI tests need a real window with OpenGL; see docs/developer/testing.md). Two pytest processes: the
 # unit and gl tiers first, then the gui tier, which cannot share a process with an EGL
 # standalone context (tests/conftest.py says why). Extra arguments replace the default
 # selection and run in one process, for example: installer/run-tests.sh -m slow

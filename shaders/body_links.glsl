@@ -1,6 +1,6 @@
 #version 330 core
 // Included (// @INCLUDE body_links.glsl, after // @LATTICE) by the programs that apply rule 1a
-// of docs/algorithm.md to the body's links: lbm_step.glsl (its BODY variant streams with it)
+// of docs/science/algorithm.md to the body's links: lbm_step.glsl (its BODY variant streams with it)
 // and link_sums.glsl (the momentum exchange sums what it gives), so both use one rule.
 // References: Bouzidi, Firdaouss & Lallemand (2001), linear scheme; the moving-wall term of
 // Lallemand & Luo (2003); solver/bouzidi.py is the numpy reference's form of the same rule.

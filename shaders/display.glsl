@@ -1,6 +1,6 @@
 #version 330 core
 // Colours the flow field for the window: one quantity through a colormap look-up texture.
-// field texel (ix, iy) = (rho, ux, uy, vorticity) in lattice units (docs/algorithm.md).
+// field texel (ix, iy) = (rho, ux, uy, vorticity) in lattice units (docs/science/algorithm.md).
 // @LATTICE
 
 uniform sampler2D field;

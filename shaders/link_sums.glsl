@@ -1,5 +1,5 @@
 #version 330 core
-// The momentum exchange's link sums of one step on the GPU (docs/algorithm.md 'Forces'; Wen,
+// The momentum exchange's link sums of one step on the GPU (docs/science/algorithm.md 'Forces'; Wen,
 // Zhang, Tu, Wang & Fang 2014; Ladd 1994), drawn right after the step into the same framebuffer,
 // in a slot of the band area (solver/gl_band.py): one RGBA32F texel per state texel with a cut
 // link, so that a block reads back those few texels instead of the window's five attachments. The state texels with links are listed in

@@ -64,7 +64,7 @@ class Shape(ABC):
 
 
 class BodyRaster:
-    """A shape on the lattice (docs/algorithm.md, 'Links cut by the body').
+    """A shape on the lattice (docs/science/algorithm.md, 'Links cut by the body').
 
     Held on `box` (x0, y0, x1, y1), the shape's bounding box grown by a cell and clipped to the
     grid: every solid node and every cut link lies in it, so a move costs the body's size, not

@@ -1,6 +1,6 @@
 """Shapes as plain dictionaries and JSON files (the shape editor's and scene files' format).
 
-Format: docs/shapes.md. A dictionary is `{"kind": ..., <parameters>, "x", "y", "angle"}` as
+Format: docs/reference/shapes.md. A dictionary is `{"kind": ..., <parameters>, "x", "y", "angle"}` as
 written by `Shape.to_dict()`; a shape file wraps one as `{"format": "feelflow-shape",
 "version": 1, "shape": {...}}`. Writes are atomic (temp file in the same folder + os.replace).
 """

@@ -1,6 +1,6 @@
 """Put a shape on the lattice: solid mask, exact cut fractions q, and the window around them.
 
-docs/algorithm.md, 'Links cut by the body': q[i, y, x] in (0, 1] is the fraction of the link
+docs/science/algorithm.md, 'Links cut by the body': q[i, y, x] in (0, 1] is the fraction of the link
 x -> x + c_i up to its first crossing of the true boundary (Bouzidi et al. 2001), for every fluid
 node x whose link meets the boundary, including links whose both ends are fluid (thin plates).
 Only nodes within sqrt(2) of the boundary can own a cut link, so only those are tested, and only

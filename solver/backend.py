@@ -1,6 +1,6 @@
 """One solver interface, two backends (`numpy`, `gl`), chosen by an explicit registry.
 
-A backend implements docs/algorithm.md. Physics tests are parametrised over `BACKENDS`.
+A backend implements docs/science/algorithm.md. Physics tests are parametrised over `BACKENDS`.
 """
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ class SolverDiverged(RuntimeError):
 
 
 class Solver(ABC):
-    """A D2Q9 lattice with at most one rigid body (docs/algorithm.md)."""
+    """A D2Q9 lattice with at most one rigid body (docs/science/algorithm.md)."""
 
     name: str = "abstract"
     #: True when the last set_body motion (or the inflow) was reduced to config.max_speed
@@ -116,7 +116,7 @@ class Solver(ABC):
     @abstractmethod
     def shifted_distributions(self) -> np.ndarray:
         """The stored state g = f* - w_i RHO0 (9, ny, nx), in the backend's storage precision
-        (docs/algorithm.md, 'Lattice, storage'); a view or a fresh read-back, never modified."""
+        (docs/science/algorithm.md, 'Lattice, storage'); a view or a fresh read-back, never modified."""
 
     def distributions(self) -> np.ndarray:
         """Full (unshifted) post-collision populations f*, float64 array (9, ny, nx)."""

@@ -1,6 +1,6 @@
 """The rigid body on the lattice: pose, motion, cover/uncover refill and the force window.
 
-docs/algorithm.md, 'Moving the body'. Refill after Lallemand & Luo, J. Comput. Phys. 184 (2003)
+docs/science/algorithm.md, 'Moving the body'. Refill after Lallemand & Luo, J. Comput. Phys. 184 (2003)
 406: an uncovered node gets f^eq(rho_new, u_body) with rho_new the mean density of its fluid
 neighbours. Shared by both backends: the gl backend reads back the body window, calls `refill`
 on it and writes the changed nodes back (not for a move that covers and uncovers no node: its

@@ -1,4 +1,4 @@
-"""Interpolated bounce-back on the body links (docs/algorithm.md, rule 1a).
+"""Interpolated bounce-back on the body links (docs/science/algorithm.md, rule 1a).
 
 Bouzidi, Firdaouss & Lallemand, Phys. Fluids 13 (2001) 3452, linear scheme, with the
 moving-wall term of Lallemand & Luo, J. Comput. Phys. 184 (2003) 406 (seed eqs. 13-17).

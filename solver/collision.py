@@ -1,4 +1,4 @@
-"""D2Q9 collision on shifted populations, in place, for the numpy backend (docs/algorithm.md, step 2-3).
+"""D2Q9 collision on shifted populations, in place, for the numpy backend (docs/science/algorithm.md, step 2-3).
 
 BGK (Bhatnagar, Gross & Krook 1954) and TRT (Ginzburg, Verhaeghe & d'Humieres 2008) with the
 Guo, Zheng & Shi (2002) forcing. Populations are g_i = f_i - w_i RHO0; with drho = sum g the

@@ -1,6 +1,6 @@
 """Tunnel ends: inlet velocity (smooth ramp-up times a profile) and the pressure outlet.
 
-docs/algorithm.md, rules c and d and 'Inflow'. One definition for both backends: `ramp`,
+docs/science/algorithm.md, rules c and d and 'Inflow'. One definition for both backends: `ramp`,
 `profile` (per row) and `inlet_wall_profile` (per inlet link: rule c) (the numpy backend
 multiplies them each step with the profiles cached, the gl backend uploads the profiles as a
 texture and the ramp as a uniform); `inflow_velocity` is the row's product, the definition the
@@ -55,8 +55,8 @@ def inlet_wall_profile(ny: int, speed: float, kind: str) -> np.ndarray:
     inflow there (Ladd 1994: the wall velocity at the point where the link meets the wall), at
     s = iy + 1/2 - c_iy / 2: the row's own height for i = 1, half a cell below for i = 5, half a
     cell above for i = 8. The row's own velocity for the diagonals is off by half a cell's change
-    of the profile, a first-order error that shears the flow at the inlet (docs/validation.md,
-    2D-2 item 10).
+    of the profile, a first-order error that shears the flow at the inlet (docs/science/validation.md,
+    Schaefer-Turek 2D-1).
     """
     s = np.arange(ny) + 0.5
     return np.stack([profile_at(s - 0.5 * C[i, 1], ny, speed, kind) for i in INLET_DIRECTIONS])

@@ -28,7 +28,7 @@ def equilibrium(rho, ux, uy, incompressible: bool = False):
     """Second-order equilibrium f_i^eq (seed eq. 9), shape (9, *rho.shape).
 
     f_i^eq = w_i rho (1 + 3 c.u + 9/2 (c.u)^2 - 3/2 u.u); with `incompressible` He & Luo's
-    (1997) f_i^eq = w_i (rho + RHO0 (3 c.u + 9/2 (c.u)^2 - 3/2 u.u)) (docs/algorithm.md, step 3).
+    (1997) f_i^eq = w_i (rho + RHO0 (3 c.u + 9/2 (c.u)^2 - 3/2 u.u)) (docs/science/algorithm.md, step 3).
     """
     rho = np.asarray(rho)
     ux = np.asarray(ux)

@@ -1,4 +1,4 @@
-"""The numpy reference backend: docs/algorithm.md, vectorised over the whole grid.
+"""The numpy reference backend: docs/science/algorithm.md, vectorised over the whole grid.
 
 Storage: post-collision populations shifted by their rest value, g_i = f*_i - w_i RHO0, so
 float32 keeps density fluctuations of 1e-5 (Skordos 1993). Streaming is a periodic shift of
@@ -35,7 +35,7 @@ def _roll_segments(s: int, n: int):
 
 
 class NumpySolver(Solver):
-    """Reference D2Q9 solver (docs/algorithm.md), numpy, float64 or float32 storage."""
+    """Reference D2Q9 solver (docs/science/algorithm.md), numpy, float64 or float32 storage."""
 
     name = "numpy"
 

@@ -1,5 +1,5 @@
 """Local grid refinement around the body: a patch of half-size cells inside the coarse lattice
-(numpy reference; docs/algorithm.md, 'Local refinement').
+(numpy reference; docs/science/algorithm.md, 'Local refinement').
 
 Two-level, refinement ratio 2, acoustic scaling (dx and dt halve, so velocities and the 2D
 force per unit span keep their lattice values up to a factor below), in the overlapping form

@@ -1,10 +1,10 @@
 """The measured stability limit of the scheme on the window's hard cases, in one place.
 
-Measured by `feelflow validate --case stability --json docs/bench/stability.json`
+Measured by `feelflow validate --case stability --json docs/science/data/stability-numpy.json`
 (solver/validation/stability.py: a plate thinner than a cell at 45 deg, an impulsively started
 cylinder, a cylinder shaken and spun at the Mach cap, the wedge pointing upstream; 192 x 96,
 float32, 6 d / U steps a point, the window's absorbing sponge, AMD EPYC 2 vCPUs, 2026-11-22;
-the map is in the README's Validation section). What the data say (lattice units, U the wind,
+the map is in docs/science/validation.md, 'Stability'). What the data say (lattice units, U the wind,
 nu the viscosity, d the body size in cells):
 
 * TRT (Lambda = 3/16, the window's operator): the most restrictive case is the shaken cylinder.

@@ -26,7 +26,7 @@ def test_no_glsl_in_python_and_no_pickle():
 
 
 def test_installed_pyside6_does_not_drop_references_to_none():
-    """The pinned PySide6 must not have the 6.12.0 defect (app/qt_runtime.py): a void call
+    """The pinned PySide6 must not have the 6.12.0 defect (app/gui/qt_runtime.py): a void call
     leaves None's reference count where it was."""
     from feelflow.app.gui.qt_runtime import none_refcount_leak_per_call
 

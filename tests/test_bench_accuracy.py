@@ -1,4 +1,4 @@
-"""`feelflow bench accuracy`: speed against error on Schaefer-Turek 2D-1 (app/commands/bench_accuracy.py)."""
+"""`feelflow bench accuracy`: speed against error on Schaefer-Turek 2D-1 (app/bench/accuracy.py)."""
 import json
 import math
 

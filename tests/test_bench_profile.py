@@ -1,4 +1,4 @@
-"""`feelflow bench --profile`: where the gl moving tunnel's wall time goes (docs/performance.md)."""
+"""`feelflow bench --profile`: where the gl moving tunnel's wall time goes (docs/science/performance.md)."""
 import json
 
 import pytest

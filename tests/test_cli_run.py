@@ -159,7 +159,7 @@ def test_validate_prints_a_table_and_writes_json(tmp_path):
 @pytest.mark.gl
 def test_run_on_gl_matches_numpy(tmp_path):
     """`--backend gl` (own EGL context) writes the same forces as the numpy reference, to the
-    float32 tolerance of docs/algorithm.md."""
+    float32 tolerance of docs/science/algorithm.md."""
     pytest.importorskip("feelflow.solver.gl_backend", reason="the gl backend is not built yet")
     scene = write(tmp_path, SMALL)
     tables = {}
@@ -186,7 +186,7 @@ def test_run_record_replays_to_the_same_forces(tmp_path):
     """`run --record` writes a session whose numpy replay reproduces the run's forces exactly.
     Its export has one row per solver call (finer than the run's interval means): where both
     have a row the velocity agrees (the export's pose is the pose during the call, the run's the
-    pose after it: docs/sessions.md), and over the first interval (one call) the forces too."""
+    pose after it: docs/reference/session-format.md), and over the first interval (one call) the forces too."""
     scene = write(tmp_path, SMALL)
     out, session = tmp_path / "forces.csv", tmp_path / "run.ffsession"
     result = feelflow("run", scene, "--out", out, "--record", session)

@@ -43,7 +43,7 @@ def haply_port():
     sim.stop()
 
 
-# hAPI M3 firmware v1.5, device id 5, the 2DIY port set-up (docs/haptics.md)
+# hAPI M3 firmware v1.5, device id 5, the 2DIY port set-up (docs/guide/haptic-devices.md)
 HAPLY_TABLE = [
     # host sends                                   device answers
     ("00 05",                                       ""),  # reset

@@ -75,7 +75,7 @@ def test_install_writes_a_consistent_desktop_entry_and_a_working_launcher(tmp_pa
     # Icon: the installed icon's name, in the hicolor theme's scalable apps folder
     assert e["Icon"] == files["icon"].stem and files["icon"].parent.parts[-3:] == ("hicolor", "scalable", "apps")
     assert files["icon"].read_bytes() == (ROOT / "installer" / "feelflow.svg").read_bytes()
-    # MimeType: the type the installed MIME package defines, for the suffix app/session.py writes
+    # MimeType: the type the installed MIME package defines, for the suffix app/sessions/ writes
     from feelflow.app.sessions import SUFFIX
 
     assert e["MimeType"] == f"{SUFFIX_TYPE};"

@@ -1,4 +1,4 @@
-"""The Presets menu's lessons as a class sees them (app/lesson_report.py, README 'Lessons'):
+"""The Presets menu's lessons as a class sees them (app/lesson_report.py, docs/science/validation.md 'Calm tunnels'):
 the forces settle, the drag-against-speed fit uses steady drag only, and the sweep's wind changes
 are spread out. numpy backend, the lessons' own scenes, run as the window runs them."""
 from __future__ import annotations
@@ -63,7 +63,7 @@ def test_the_sweep_starts_after_the_ramp_and_spreads_each_change_of_wind():
 def test_lift_lesson_settles_to_a_steady_lift():
     """The half airfoil's lift over the lesson's last 1000 steps. As the preset ran before the
     fifth session (no absorbing layer, put into a moving stream) its scatter was 0.13 of the
-    drag (`feelflow report lessons --compare`, README 'Lessons'); with the smooth start and the
+    drag (`feelflow report lessons --compare`, docs/science/validation.md 'Calm tunnels'); with the smooth start and the
     absorbing layer 0.0014."""
     from feelflow.app.reports.lessons import run_lesson
 
@@ -76,7 +76,7 @@ def test_drag_speed_lesson_fits_the_steady_drag_law():
     """The log-log view's fit (settled samples) agrees with the law of the drag at the end of
     each hold, and the drag holds still there; plain (sudden start and wind steps, no absorbing
     layer) the scatter was 0.6 - 2.6 of the drag and the view's fit 1.02; now 0.03 - 0.06 and 1.57
-    (`feelflow report lessons --compare`, README 'Lessons')."""
+    (`feelflow report lessons --compare`, docs/science/validation.md 'Calm tunnels')."""
     from feelflow.app.reports.lessons import run_lesson
 
     r = run_lesson("drag_speed")

@@ -120,7 +120,7 @@ def test_a_developed_channel_flow_crosses_the_patch():
 
 def test_a_refined_patch_takes_2d1_towards_the_finer_lattice():
     """2D-1 at 10 cells per diameter: C_D is 0.53 % above the reference on the plain lattice
-    (docs/bench/s17/accuracy.txt), 0.13 % above at 20 cells and -0.04 % at 40. With the
+    (docs/science/data/accuracy-numpy.json), 0.13 % above at 20 cells and -0.04 % at 40. With the
     cylinder and its near wake (1 D ahead, 3 D behind, 1 D each side) at 20 cells the error
     must be at most half the plain lattice's."""
     from feelflow.solver.validation import schaefer_turek_2d1 as case

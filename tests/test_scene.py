@@ -1,4 +1,4 @@
-"""Scene files: the examples load, keys mean what docs/scenes.md says, bad values name their key."""
+"""Scene files: the examples load, keys mean what docs/reference/scenes.md says, bad values name their key."""
 import math
 import pathlib
 

@@ -1,4 +1,4 @@
-"""The example scenes' tunnels are calm (app/scene_report.py, README 'Scenes'): their outlet
+"""The example scenes' tunnels are calm (app/scene_report.py, docs/science/validation.md 'Calm tunnels'): their outlet
 sponge has the window's absorbing layer, which lets the tunnel's sound out after the inflow ramp.
 numpy backend, the scenes as `feelflow run` runs them."""
 from __future__ import annotations

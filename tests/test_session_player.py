@@ -1,4 +1,4 @@
-"""The incremental session player (app/session_player.py) behind the window's replay: replayed
+"""The incremental session player (app/sessions/replay.py) behind the window's replay: replayed
 a few steps at a time it gives the recorded force series bit for bit (numpy), the same as
 `replay()`, with the body at the recorded poses; an impossible event is one SessionError line."""
 from __future__ import annotations

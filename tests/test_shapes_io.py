@@ -93,10 +93,10 @@ def test_save_replaces_existing_file(tmp_path):
 
 
 def test_examples_in_docs_parse():
-    """Every JSON example in docs/shapes.md is a valid shape or shape file."""
+    """Every JSON example in docs/reference/shapes.md is a valid shape or shape file."""
     from pathlib import Path
 
-    text = (Path(__file__).resolve().parents[1] / "docs" / "shapes.md").read_text()
+    text = (Path(__file__).resolve().parents[1] / "docs" / "reference" / "shapes.md").read_text()
     blocks = [b.split("```", 1)[0] for b in text.split("```json\n")[1:]]
     one_line = [ln for ln in blocks[0].splitlines() if ln.strip()]
     assert len(one_line) == 5

@@ -1,5 +1,5 @@
 """Rasterisation: exact cut fractions against hand computations, and the lattice invariants of
-docs/algorithm.md ('Links cut by the body')."""
+docs/science/algorithm.md ('Links cut by the body')."""
 from __future__ import annotations
 
 import math

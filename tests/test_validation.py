@@ -84,7 +84,7 @@ def test_schaefer_turek_2d1_coarse_converges_near_the_benchmark(request):
     assert abs(r.quantities["cd_rel_error"]) < 0.03, r.quantities
     assert abs(r.quantities["dp_rel_error"]) < 0.05, r.quantities
     # the lift, 2 per mille of the drag, is the sensitive one: -19 % here while the inlet's
-    # diagonal links took the row's velocity (docs/validation.md, 2D-2 item 10)
+    # diagonal links took the row's velocity (docs/science/validation.md, Schaefer-Turek 2D-1)
     assert abs(r.quantities["cl_rel_error"]) < 0.05, r.quantities
 
 
@@ -92,8 +92,8 @@ def test_schaefer_turek_2d1_coarse_converges_near_the_benchmark(request):
 def test_schaefer_turek_2d1_drag_converges_at_second_order_with_tau_held(request):
     """D = 20 -> 30 with U_m D held (tau 0.65, `feelflow bench accuracy --axis tau`): every error
     of a second-order scheme falls like D^-2. C_D's observed order was 1.23 while the inlet's
-    diagonal links took the row's velocity, a first-order error (docs/validation.md, 2D-2
-    item 10)."""
+    diagonal links took the row's velocity, a first-order error (docs/science/validation.md, Schaefer-Turek
+    2D-1 section)."""
     import math
 
     from feelflow.app.bench.accuracy import TAU_FIXED

@@ -16,7 +16,7 @@ float32, gl float32) along three axes of what a run costs and what it tells:
   and the boundary rules' only parameter, stays that of D = 20 at the validation's U_m, and the
   Mach number falls like 1 / D. Every error term of a second-order scheme then falls like D^-2,
   which the resolution axis cannot show: there tau grows with D, and the curved-wall rule's
-  error depends on tau (docs/validation.md, 2D-2 item 9).
+  error depends on tau (docs/science/validation.md, Schaefer-Turek 2D-1).
 
 Per run it reports the grid, steps, wall and CPU seconds, MLUPS, and the relative errors of
 C_D, C_L and dp against the refined reference values (John 2004,
@@ -151,7 +151,7 @@ def format_row(label: str, r: dict) -> str:
 
 
 def markdown_tables(result) -> str:
-    """The two axes as Markdown tables (what README quotes), rows in the order run."""
+    """The two axes as Markdown tables (what docs/science/performance.md quotes), rows in the order run."""
     cols = "| variant | D | U_m | tau | grid | steps | wall s | CPU s | MLUPS | C_D error | C_L error | dp error |"
     rule = "|" + " --- |" * (cols.count("|") - 1)
     out = []

@@ -274,7 +274,7 @@ def thread_split(run: SceneRun, steps: int) -> dict | None:
 def run_profile(seconds: float | None):
     """The default moving tunnel (512x256, gl) under cProfile: where its wall time goes.
 
-    Each part is the cumulative wall time of one function (docs/performance.md); the parts do
+    Each part is the cumulative wall time of one function (docs/science/performance.md); the parts do
     not overlap, and the rest is the Python around them. While the main thread waits in a draw
     call, llvmpipe's threads are busy; during the other parts they have nothing queued."""
     import cProfile

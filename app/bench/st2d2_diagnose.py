@@ -1,4 +1,4 @@
-"""Diagnose Schaefer-Turek 2D-2 (docs/validation.md): record C_D(t), C_L(t) and analyse them.
+"""Diagnose Schaefer-Turek 2D-2 (docs/science/validation.md): record C_D(t), C_L(t) and analyse them.
 
     python -m feelflow.app.bench.st2d2_diagnose record --d 20 [--u 0.075] [--ramp-periods 2 | --impulsive]
         [--sponge CELLS [--absorb A]] [--length-d 22] [--conv-times 60] [--sample 2]

@@ -1,6 +1,6 @@
 """The `feelflow` command line (also `python -m feelflow.app`).
 
-Each sub-command lives in `app/commands/<name>.py` with `add_arguments(parser)` and
+Each sub-command lives in `app/cli/commands/<name>.py` with `add_arguments(parser)` and
 `main(args) -> int`. Errors a user can cause are reported as one line on stderr with exit 2;
 no tracebacks reach the user.
 """

@@ -3,7 +3,7 @@ loop, hands the body target to the simulation and the selected model's force to 
 
 The loop runs as `feelflow.haptics.ProcessForceLoop`, in a process of its own: in this window the GUI,
 the solver and GL calls hold Python's interpreter lock, which stalled an in-process loop
-thread for 3-11 ms at the 99th percentile (docs/haptics.md); in its own process it kept p99
+thread for 3-11 ms at the 99th percentile (docs/guide/haptic-devices.md); in its own process it kept p99
 jitter under 1 ms. A disconnect (reported from the loop's watcher thread) comes back to the
 GUI thread as a Qt signal."""
 from __future__ import annotations

@@ -23,7 +23,7 @@ BODY_FILL = QColor(225, 225, 225)
 BODY_EDGE = QColor(20, 20, 20)
 DRAG_COLOUR = QColor(230, 40, 40)
 LIFT_COLOUR = QColor(40, 120, 255)
-#: the dashed line where the outlet zone (the sponge, docs/algorithm.md step 3) begins
+#: the dashed line where the outlet zone (the sponge, docs/science/algorithm.md step 3) begins
 OUTLET_LINE = QColor(255, 255, 255, 150)
 
 

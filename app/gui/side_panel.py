@@ -56,7 +56,7 @@ TOOLTIPS = {
                  "Reynolds number, with eddies and a swinging wake",
     "grid": "How many cells the tunnel has: a finer grid shows more detail but runs slower",
     "wall": "What the top and bottom of the tunnel are",
-    "model": "How the force on the body is computed from the flow (docs/force-models.md)",
+    "model": "How the force on the body is computed from the flow (docs/science/force-models.md)",
     "compare_all": "Compute every force model at once and plot them together (dashed lines are lift)",
     "display": "What the colours show: speed, vorticity (spin), pressure, or moving tracer particles",
     "arrows": "Draw the drag (red) and lift (blue) forces on the body",

@@ -1,5 +1,5 @@
 """Lessons from the Presets menu. The physics of each is a scene file in scenes/presets/
-(app/scene.py format: grid, flow, body, motion script, force models); this table adds only how
+(app/model/scene.py format: grid, flow, body, motion script, force models); this table adds only how
 the window presents it: title, display mode, plot view, a note, and a wind-speed sweep where the
 lesson needs one (scene files have no time-varying wind)."""
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Scene files: a TOML description of a wind-tunnel run, loaded into a validated `Scene`.
 
-Every key is documented in docs/scenes.md. Every bad value, missing required key or unknown key
+Every key is documented in docs/reference/scenes.md. Every bad value, missing required key or unknown key
 raises `feelflow.app.cli.main.UserError` with one line: `FILE: KEY: what is wrong`.
 """
 from __future__ import annotations
@@ -140,7 +140,7 @@ class _Table:
     def done(self):
         unknown = [k for k in self.data if k not in self.used]
         if unknown:
-            self.reader.fail(self.key(unknown[0]), "unknown key (see docs/scenes.md)")
+            self.reader.fail(self.key(unknown[0]), "unknown key (see docs/reference/scenes.md)")
 
 
 class _Reader:
@@ -211,7 +211,7 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
     body_table = top.table("body", required=True)
     body = _body(reader, body_table, nx, ny)
 
-    # reference length and speed (stated in docs/scenes.md): frontal size across the stream,
+    # reference length and speed (stated in docs/reference/scenes.md): frontal size across the stream,
     # inflow speed; without inflow, the fastest phase of the motion script
     motion_list = top.raw("motion", [])
     phases = _phases(reader, motion_list, inflow_speed)

@@ -1,6 +1,6 @@
 """The running wind tunnel behind the window (Qt-free, so it is testable on its own):
 the solver, the body and its pose, the mouse coupling, the force models in use, and the
-force history the plot and readouts show. Lattice units (docs/algorithm.md).
+force history the plot and readouts show. Lattice units (docs/science/algorithm.md).
 """
 from __future__ import annotations
 
@@ -45,7 +45,7 @@ def default_base_config(grid) -> FlowConfig:
     Ramping the inlet up from fluid at rest excites a slow slosh of the whole tunnel, its
     quarter-wave sound mode (mean u swings +-60 % of U with a 1000-step ramp, +-6 % with 2000,
     measured at 256 x 128); starting in uniform flow keeps the mean within +-4 % from the start.
-    The absorbing layer (sponge_absorb, docs/algorithm.md step 3) lets that sound out: after a
+    The absorbing layer (sponge_absorb, docs/science/algorithm.md step 3) lets that sound out: after a
     1000-step ramp at 256 x 128 the mean u swings by 0.3 % of U instead of 46 % (a test,
     tests/test_solver_boundaries.py), so a change of wind settles at once."""
     nx, ny = grid
@@ -81,7 +81,7 @@ class History:
     steps after a wind change had finished, the drag's 250-step means stayed within 5 % of the
     hold's end value at every wind of the sweep, while the first few hundred steps carry the
     acceleration's added-mass force and the flow's rearrangement (up to +60 %). What the choice
-    gives is measured by `feelflow report lessons` (README 'Lessons': the fitted exponent)."""
+    gives is measured by `feelflow report lessons` (docs/science/validation.md 'Calm tunnels': the fitted exponent)."""
 
     time: list = field(default_factory=list)
     body_velocity: list = field(default_factory=list)
@@ -187,8 +187,8 @@ class Simulation:
     over `SWEEP_SLEW_STEPS`: a sudden change sends a pressure pulse (rho c_s dU) through the
     tunnel that rings between the walls, across the stream, where the outlet's absorbing layer
     cannot take it out; 500 steps is a little more than that ringing's period at the lessons'
-    128 rows (2 ny / c_s = 443 steps). Measured (`feelflow report lessons --compare`, README
-    'Lessons'): the drag's scatter over the second half of each hold falls severalfold."""
+    128 rows (2 ny / c_s = 443 steps). Measured (`feelflow report lessons --compare`, docs/science/validation.md
+    'Calm tunnels'): the drag's scatter over the second half of each hold falls severalfold."""
 
     SWEEP_SLEW_STEPS = 500
 
@@ -229,7 +229,7 @@ class Simulation:
     def _build(self, keep_flow: bool):
         config = self.flow_config()
         same_grid = self.solver is not None and (self.solver.config.nx, self.solver.config.ny) == (config.nx, config.ny)
-        if self.solver is None:   # one SessionSolver for the life of the window (app/session.py)
+        if self.solver is None:   # one SessionSolver for the life of the window (app/sessions/)
             backend = create_solver(self.backend, config, **({"ctx": self.ctx} if self.backend == "gl" else {}))
             self.solver = SessionSolver(backend)
         else:                     # recorded as a rebuild when a session is being recorded

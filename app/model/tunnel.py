@@ -6,7 +6,7 @@ knowing which it holds; tests/test_tunnel_model.py checks both against it, membe
 
 Changing the live tunnel (body, flow, grid, lessons, recording) is not part of it: those calls
 go to the live `Simulation` only, which a replay never replaces. Lattice units throughout
-(docs/algorithm.md).
+(docs/science/algorithm.md).
 """
 from __future__ import annotations
 

@@ -5,8 +5,8 @@ speed and the exponent the plot's log-log view fits (app/force_plot.py, settled 
 
 `compare=True` also runs each lesson *plain*: without the sponge's absorbing layer, with the
 wind blowing everywhere from the first step and the sweep's wind changed at once, which is how
-the presets ran before the fifth session; the difference is what those choices buy (README
-'Lessons'). Qt-free (the fit is app.force_plot's function, imported lazily with pyqtgraph).
+the presets ran before the fifth session; the difference is what those choices buy (docs/science/validation.md
+'Calm tunnels'). Qt-free (the fit is app.force_plot's function, imported lazily with pyqtgraph).
 """
 from __future__ import annotations
 

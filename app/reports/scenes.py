@@ -2,11 +2,11 @@
 headless as `feelflow run` runs them, and how calm their tunnel is: the mean velocity through a
 column near the inlet against the inflow speed once the inflow ramp is over (the tunnel's
 quarter-wave sound mode swings it; Kam, Leung & Chew 2006 and Xu & Sagaut 2013 for the
-absorbing layer that lets the sound out, docs/algorithm.md step 3), and the drag's scatter
+absorbing layer that lets the sound out, docs/science/algorithm.md step 3), and the drag's scatter
 over the second half of the run.
 
 `compare=True` also runs each scene without the sponge's absorbing layer (`sponge_absorb = 0`),
-which is how the example scenes ran before the sixth session (README 'Scenes'). Qt-free.
+which is how the example scenes ran before the sixth session (docs/science/validation.md 'Calm tunnels'). Qt-free.
 """
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 #: the example scenes a class opens with File > Open or `feelflow run` (the seed report's scenes
-#: keep their own set-up: their figures in docs/report-seed.md were measured with it)
+#: keep their own set-up: their figures in docs/science/seed-report.md were measured with it)
 SCENES = ("default", "plate", "half_airfoil", "wedge_upstream", "wedge_downstream", "seed_experiment")
 #: the column whose mean velocity is watched (cells from the inlet)
 PROBE_COLUMN = 5

@@ -8,7 +8,7 @@ lift on the half airfoil (`lift_airfoil_half.toml`); drag on a plate at five spe
 (`drag_vs_speed.toml`, swept here over `SWEEP_SPEEDS`). Means are taken over the last half of
 each phase (or of the run), so the start-up transient is left out.
 
-The measured numbers are stored in `report-seed/data.json` next to the report, so the text and
+The measured numbers are stored in `seed-report/data.json` next to the report, so the text and
 plots can be rebuilt (`--replot`) without running the flow again.
 """
 from __future__ import annotations
@@ -51,9 +51,9 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
     L: list[str] = []
     add = L.append
     add("# The seed's experiments on FeelFlow: four force models side by side\n")
-    add("Written by `feelflow report seed` (app/seed_report.py) from the scenes in `scenes/`; "
-        "`feelflow report seed --replot` rebuilds this page from the stored series in `report-seed/`.\n")
-    add("Models (docs/force-models.md): `momentum_exchange` (the reference: Galilean-invariant momentum exchange), "
+    add("Written by `feelflow report seed` (app/reports/seed.py) from the scenes in `scenes/`; "
+        "`feelflow report seed --replot` rebuilds this page from the stored series in `seed-report/`.\n")
+    add("Models (docs/science/force-models.md): `momentum_exchange` (the reference: Galilean-invariant momentum exchange), "
         "`momentum_exchange_classic` (the seed's), `macroscopic` (drag equation with tabulated C_D, velocity sampled "
         "4 cells off the wall), `pressure` (seed eq. 24 with beta = rho_0/6, i.e. the lattice pressure; no shear). "
         "Forces in lattice units per step; means at the end of each phase or run, over the longest whole number "
@@ -79,7 +79,7 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
             "impulsive start and stop of the body: the column *swing* is the standard deviation of F_x (100-step "
             "means) over the last half of the second stopped phase. Differences smaller than it are noise. "
             "The clean Galilean check is `pytest tests/test_force_models_flow.py -s` (the same protocol in two "
-            "frames in a periodic box, no tunnel acoustics; docs/force-models.md has its numbers). The classic form "
+            "frames in a periodic box, no tunnel acoustics; docs/science/force-models.md has its numbers). The classic form "
             "differs from the reference only by -u_w sum (f_out - f_in) over the body links and by the cover/uncover "
             "impulse; both stay small while the density stays at rho_0 (the tunnel's pressure outlet holds it there), "
             "and that test shows the classic form failing at an ambient density 5 % above rho_0.\n")
@@ -123,7 +123,7 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
             s = res["shapes"][m]
             order = " > ".join(sorted(keys, key=lambda k: -s[k]["drag"]))
             add(f"| {m} | " + " | ".join(fmt(s[k]["cd"]) for k in keys) + f" | {order} |")
-        add("\nThe macroscopic model's ordering is its C_D table's (docs/force-models.md), an input, not a result.")
+        add("\nThe macroscopic model's ordering is its C_D table's (docs/science/force-models.md), an input, not a result.")
         add(f"\n![drag per shape]({plots_dir}/drag_per_shape.png)")
 
     if "lift" in res:
@@ -182,13 +182,13 @@ def verdict(m: str, res: dict) -> str:
 
 
 def write_report(out_dir: Path) -> Path:
-    """Analyse the stored parts, plot, write report-seed.md; returns its path."""
-    folder = out_dir / "report-seed"
+    """Analyse the stored parts, plot, write seed-report.md; returns its path."""
+    folder = out_dir / "seed-report"
     parts = load_parts(folder)
     if not parts:
         raise UserError(f"{folder}: no stored experiment data; run `feelflow report seed` first")
     res = analyse(parts)
     make_plots(parts, res, folder)
-    path = out_dir / "report-seed.md"
-    write_text_atomic(path, markdown(parts, res, "report-seed"))
+    path = out_dir / "seed-report.md"
+    write_text_atomic(path, markdown(parts, res, "seed-report"))
     return path

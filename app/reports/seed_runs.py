@@ -1,7 +1,7 @@
 """The seed report's runs: its scenes run on a backend with all four force models, stored as JSON.
 
 Each part (PARTS) is a set of scene runs; `run_part` runs one, `save_part` stores it in
-`report-seed/<part>.json` and `load_parts` reads them back, so the analysis, plots and text
+`seed-report/<part>.json` and `load_parts` reads them back, so the analysis, plots and text
 (app/reports/seed.py) can be rebuilt without running the flow again.
 """
 from __future__ import annotations
@@ -35,7 +35,7 @@ QUICK = {"phase_steps": 40, "steps": 80, "ramp": 20}
 
 
 def load_scene_with(path: Path, *, phase_steps=None, steps=None, inflow_speed=None, ramp=None, interval=None):
-    """A scene file with some keys replaced, validated like any scene (app/scene.py)."""
+    """A scene file with some keys replaced, validated like any scene (app/model/scene.py)."""
     from feelflow.app.model.scene import scene_from_dict
 
     try:
@@ -99,7 +99,7 @@ def run_scene(scene, backend: str, log=print) -> dict:
     return rows
 
 
-#: the report's parts, each run and stored on its own (report-seed/data-<part>.json)
+#: the report's parts, each run and stored on its own (seed-report/data-<part>.json)
 PARTS = ("protocol", "shapes", "sweep", "lift")
 
 

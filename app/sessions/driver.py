@@ -1,6 +1,6 @@
 """The solver as the app drives it (`SessionSolver`): one code path for the window, the headless
 runner and the replay, which is why a replay reproduces a run bit for bit on the same backend
-and machine (docs/sessions.md, "Replay and playback"). Qt-free."""
+and machine (docs/reference/session-format.md, "Replay and playback"). Qt-free."""
 from __future__ import annotations
 
 import dataclasses

@@ -1,6 +1,6 @@
 """The session file: a versioned zip, read and written here and nowhere else.
 
-Format (docs/sessions.md): a zip with `manifest.json` (format, version, FeelFlow version,
+Format (docs/reference/session-format.md): a zip with `manifest.json` (format, version, FeelFlow version,
 backend, renderer, created time, the scene, counts), `parameters.json` (parameter changes) and
 `inputs.npz` / `forces.npz` (arrays, read with `allow_pickle=False`; never pickle), plus
 `state.npz` when the recording began on a running flow. Every event carries its *session step*
@@ -26,7 +26,7 @@ import numpy as np
 from feelflow.solver.config import ConfigError, FlowConfig
 
 FORMAT = "feelflow-session"
-#: bumped whenever a version-1 reader would misread a file (docs/sessions.md, "Versioning")
+#: bumped whenever a version-1 reader would misread a file (docs/reference/session-format.md, "Versioning")
 VERSION = 1
 SUFFIX = ".ffsession"
 
@@ -39,7 +39,7 @@ MEMBERS = (MANIFEST, PARAMETERS, INPUTS, FORCES)
 #: largest uncompressed member we read (a zip bomb is refused before it is inflated)
 MAX_MEMBER_BYTES = 1 << 30
 
-#: parameter name -> what its value is (docs/sessions.md, "Parameter changes")
+#: parameter name -> what its value is (docs/reference/session-format.md, "Parameter changes")
 PARAMETER_NAMES = ("body", "inflow_speed", "nu", "force_models", "pause", "resume", "reset", "rebuild")
 #: array name -> (dtype, trailing shape) in each .npz member
 INPUT_ARRAYS = {"seq": ("int64", ()), "step": ("int64", ()), "pose": ("float64", (3,)),

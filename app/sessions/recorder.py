@@ -1,5 +1,5 @@
 """Recording a session: the scene, every input, every parameter change and the force series,
-stamped with the session step (docs/sessions.md). `SessionSolver` (driver.py) feeds a
+stamped with the session step (docs/reference/session-format.md). `SessionSolver` (driver.py) feeds a
 recorder as a side effect of being driven. Qt-free."""
 from __future__ import annotations
 
@@ -72,7 +72,7 @@ class SessionRecorder:
         self._inputs.append((seq, t) + values)
 
     def record_parameter(self, name: str, value=None, *, step=None) -> None:
-        """A parameter change (PARAMETER_NAMES; docs/sessions.md says what each value is)."""
+        """A parameter change (PARAMETER_NAMES; docs/reference/session-format.md says what each value is)."""
         if name not in PARAMETER_NAMES:
             raise ValueError(f"unknown parameter {name!r}; one of {', '.join(PARAMETER_NAMES)}")
         if name == "body" and value is not None and not isinstance(value, dict):

@@ -3,7 +3,7 @@ between two calls (`feelflow session replay` runs the same player to the end in 
 
 `SessionPlayer` feeds the events of a `Session` in recorded order (`seq`) through the same
 `SessionSolver` that recorded them (driver.py), so on the recording backend and machine
-the force series comes out bit for bit (docs/sessions.md, "Replay and playback"). A force row
+the force series comes out bit for bit (docs/reference/session-format.md, "Replay and playback"). A force row
 is one `step(n)` call: by default the player never splits it, so one `advance` may run past its
 budget by at most the steps of one row; with `split_rows=True` (the window's replay) it runs a
 row longer than the whole budget in parts that fit it (`SessionSolver.step_part`: the same

@@ -1,4 +1,4 @@
-"""FeelFlow's serial protocol for a Hapkit-style 1-DOF paddle (version 1; docs/haptics.md).
+"""FeelFlow's serial protocol for a Hapkit-style 1-DOF paddle (version 1; docs/guide/haptic-devices.md).
 
 Frame: 0xA5 0x5A | version u8 | type u8 | length u8 | payload | crc u16 (little-endian)
 where crc is CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF; Python's binascii.crc_hqx) over

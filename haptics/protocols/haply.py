@@ -2,7 +2,7 @@
 
 Read from HaplyHaptics/Haply-Arduino-Firmware-Versions (Haply_M3_Firmware_V1_5: command_instructions,
 setup_device, write_states, read_states) and HaplyHaptics/UnityHAPI (hAPI/Device.cs:
-Device_set_parameters, Device_write_torques); see docs/haptics.md for the byte tables.
+Device_set_parameters, Device_write_torques); see docs/guide/haptic-devices.md for the byte tables.
 
 Host -> board (no framing, no checksum; floats are IEEE-754 single, little-endian):
   reset  : 0x00, id

@@ -4,7 +4,7 @@ Report 1: translation x, y, z as int16 little-endian (7 bytes with the id); newe
 (SpaceMouse Wireless/Pro/Compact family) send report 1 with translation AND rotation (13 bytes).
 Report 2: rotation rx, ry, rz int16 (7 bytes). Report 3: buttons, a bit mask (bit 0 = button 1).
 Deflections reach about +-350 counts at full push. Axes as the device reports them: x right,
-y towards the user, z down (docs/haptics.md cites where this layout was read).
+y towards the user, z down (docs/guide/haptic-devices.md cites where this layout was read).
 """
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """The interface every force model shares: a model sees only the body's neighbourhood.
 
 Both backends hand the same `BodyWindow` (numpy arrays) to the same model code, so forces agree
-between backends by construction (docs/algorithm.md, 'Forces'). The one exception: where the
+between backends by construction (docs/science/algorithm.md, 'Forces'). The one exception: where the
 momentum exchanges are the only models, the gl backend sums their links on the GPU
 (shaders/link_sums.glsl) to the same formulas; a test holds it to the window's numbers.
 """

@@ -1,4 +1,4 @@
-"""Momentum exchange on the body links (docs/algorithm.md, 'Forces').
+"""Momentum exchange on the body links (docs/science/algorithm.md, 'Forces').
 
 Galilean-invariant form: Wen, Zhang, Tu, Wang & Fang, J. Comput. Phys. 266 (2014) 161, per link
 (c_ib - u_w) f*_ib(x) - (c_i - u_w) f_i^in(x), plus the cover/uncover impulse J.

@@ -23,7 +23,7 @@ from feelflow.solver.lattice import C
 def moments(window):
     """(rho, ux, uy) of the window's populations f*(t), each (h, w) float64.
 
-    Collision conserves rho and rho u (docs/algorithm.md), so these are the moments at t
+    Collision conserves rho and rho u (docs/science/algorithm.md), so these are the moments at t
     (up to the half body-force term, zero unless the scene sets a body force).
     """
     f = np.asarray(window.f, dtype=np.float64)

@@ -2,7 +2,7 @@
 channel closed by no-slip walls and periodic in x (no inlet or outlet: nothing enters or leaves).
 
 Reported: the relative drift of the total mass (fluid nodes plus solid nodes, which hold
-f^eq(rho_0, u_body): docs/algorithm.md) between the start and the end, and the largest
+f^eq(rho_0, u_body): docs/science/algorithm.md) between the start and the end, and the largest
 excursion on the way. Covering and refilling nodes (Lallemand & Luo 2003) and interpolated
 bounce-back (Bouzidi et al. 2001) do not conserve mass exactly; this measures by how much.
 Target (ours, set before the first measurement): |drift| below 1e-3.

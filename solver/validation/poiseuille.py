@@ -11,7 +11,7 @@ the peak speed stay fixed as the width H grows, so the relative L2 error must fa
 Q_BOTTOM < 1/2 and Q_TOP > 1/2, so both branches of the linear rule are checked. With q < 1/2
 the rule needs the node x + c_i, which for the diagonal links of the first and last column lies
 across the periodic seam: the walls' window spans the periodic width, and the backends take
-that node from the other edge (docs/algorithm.md rule 1a; falling back to the half-way rule there
+that node from the other edge (docs/science/algorithm.md rule 1a; falling back to the half-way rule there
 instead gives order 1.1 at q = 0.3 and a flow that varies along x).
 Each run starts from the analytic profile and runs until the field changes by less than
 `STEADY_TOL` (relative) over a block: the discrete steady state, whatever the start.
@@ -34,7 +34,7 @@ RESOLUTIONS = (8, 16, 32, 64)
 QUICK_RESOLUTIONS = (8, 16, 32)
 #: float32 storage (the gl backend) stops at 32 rows: at 64 the body force per step (9.5e-7)
 #: is a few ulp of the stored populations, and float32 round-off moves the steady error by
-#: about 1e-4, half the scheme's own 2.0e-4 (docs/validation.md: gl 3.3e-4 at 64 rows with
+#: about 1e-4, half the scheme's own 2.0e-4 (docs/science/validation.md: gl 3.3e-4 at 64 rows with
 #: `feelflow validate --backend gl --case poiseuille --resolution 64`, numpy float64 2.0e-4)
 RESOLUTIONS_FLOAT32 = QUICK_RESOLUTIONS
 DEFAULT_RESOLUTION = RESOLUTIONS[-1]
@@ -131,7 +131,7 @@ class Channel:
 
 def velocity_x(solver) -> np.ndarray:
     """u_x from the stored post-collision populations: (sum c_x f* - F_x / 2) / rho, since
-    collision with the Guo source adds F/2 to the momentum of f^in + F/2 (docs/algorithm.md)."""
+    collision with the Guo source adds F/2 to the momentum of f^in + F/2 (docs/science/algorithm.md)."""
     f = solver.distributions()
     rho = f.sum(axis=0)
     return (np.tensordot(C[:, 0].astype(float), f, axes=1) - 0.5 * solver.config.body_force[0]) / rho

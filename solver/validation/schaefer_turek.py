@@ -12,7 +12,7 @@ one row more or less changes the blockage D / H, and with it C_D by about half a
 C_L by tens of percent at 16 - 24 cells, more than the resolution itself changes them; a
 cylinder of a non-whole D that kept H exact would sit off-centre on the lattice, and the lift of
 2D-1 (2 per mille of the drag) then comes out wrong by several times its size (probes,
-docs/validation.md, 'Whole channel heights'). Reference values: Schaefer & Turek 1996, with
+docs/science/validation.md, 'Whole channel heights'). Reference values: Schaefer & Turek 1996, with
 the refined reference values of John 2004 for 2D-1.
 """
 from __future__ import annotations
@@ -70,7 +70,7 @@ class Geometry:
         return Cylinder(diameter=float(self.d), x=self.centre[0], y=self.centre[1])
 
     def profile(self) -> np.ndarray:
-        """The inlet profile (docs/algorithm.md 'Inflow'), one value per row."""
+        """The inlet profile (docs/science/algorithm.md 'Inflow'), one value per row."""
         s = np.arange(self.ny) + 0.5
         return 4 * self.u_max * s * (self.ny - s) / self.ny ** 2
 
@@ -109,7 +109,7 @@ class Geometry:
 
     def start_from_rest(self, make_solver, ramp_steps: int, refine: bool = False, **config_overrides):
         """A solver with the fluid at rest and the cylinder in place; the inflow rises over
-        `ramp_steps` ((1 - cos)/2, docs/algorithm.md 'Inflow'). Slow against
+        `ramp_steps` ((1 - cos)/2, docs/science/algorithm.md 'Inflow'). Slow against
         `acoustic_period()`, this excites the tunnel's sound modes far less than `start`."""
         solver = self.solver_factory(make_solver, refine)(self.config(inflow_ramp_steps=int(ramp_steps),
                                                                       **config_overrides))

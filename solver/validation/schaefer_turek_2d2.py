@@ -7,7 +7,7 @@ over the last `MEASURE_PERIODS` periods: the Strouhal number St = D f / U_mean f
 crossings of C_L (linearly interpolated), the largest C_D and C_L, and the mean C_D. Targets:
 the published intervals (Schaefer & Turek 1996), checked at 40 cells per diameter.
 
-Why the smooth start (measured, docs/validation.md): the benchmark quantities are maxima of
+Why the smooth start (measured, docs/science/validation.md): the benchmark quantities are maxima of
 the periodic signal. Started impulsively (the cylinder put into the developed channel flow),
 the tunnel rings: the velocity inlet and the pressure outlet both reflect sound, long sound
 waves are hardly damped (still rms 0.012 in C_D after 44 000 steps at 40 cells), and the modes (at 2.1, 3.0, 3.8, 9-11 times the
@@ -18,7 +18,7 @@ C_D and the shedding were unchanged. Ramped in over two acoustic periods, the rm
 its period-averaged signal falls from 0.013 to 0.0004 (20 cells) and successive periods agree to
 0.02 %, hence the tighter `PERIODIC_TOL`. Diagnostics: `python -m feelflow.app.bench.st2d2_diagnose`.
 
-Why the absorbing sponge (measured, docs/validation.md): even after a smooth
+Why the absorbing sponge (measured, docs/science/validation.md): even after a smooth
 start, the drag's oscillation at twice the shedding frequency drives the tunnel's sound, and
 the closed-open pipe (velocity inlet, pressure outlet) answers it: at 30 cells with U_m 0.05,
 where 2f sits on the third acoustic mode, C_D's 2f line was 0.051 against 0.031 off resonance,

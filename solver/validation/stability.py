@@ -21,7 +21,7 @@ so each (scene, collision, U) bisects the ordered viscosities for the smallest s
 The limit is reported per (scene, collision, d) as a grid Reynolds number Re_cell = U / nu:
 the lowest Re_cell at which a run failed and the highest below which every run was stable.
 Whether Re_cell or Re_D = U d / nu describes it is measured: the full scan repeats the most
-restrictive TRT scene with d = 10 and 40 (`SIZE_CHECK`). Measured (README, Validation): neither
+restrictive TRT scene with d = 10 and 40 (`SIZE_CHECK`). Measured (docs/science/validation.md, 'Stability'): neither
 is constant; Re_cell sqrt(d) varies less (27.7 / 39.1 / 27.7 at d = 10 / 20 / 40), so
 solver/stability_limit.py states the limit as U sqrt(d) / nu <= K with K the smallest
 (`k_measured_<collision>` in the results).
@@ -164,7 +164,7 @@ def _shake(solver, body, steps, point, watch, u_bound):
     """Back and forth along the stream over one diameter (centred on the start), spinning with
     the direction of travel, at the Mach cap: asks for the cap in translation and in rotation;
     `set_body` scales both so that the fastest surface point moves at exactly max_speed
-    (docs/algorithm.md 'Speed limit'), so each keeps half of it."""
+    (docs/science/algorithm.md 'Speed limit'), so each keeps half of it."""
     cap = solver.config.max_speed
     x0, y0, x1, y1 = body.bounding_box()
     radius = math.hypot(0.5 * (x1 - x0), 0.5 * (y1 - y0))   # the cap's R: centre to a box corner

@@ -1,1 +1,1 @@
-"""Sub-commands of `feelflow`, one module each (see app/cli.py)."""
+"""Sub-commands of `feelflow`, one module each (see app/cli/main.py)."""

@@ -30,7 +30,7 @@ def add_arguments(parser):
     parser.add_argument("--axis", action="append", choices=AXES,
                         help="accuracy: only this axis (repeatable; default: all three)")
     parser.add_argument("--profile", action="store_true",
-                        help="solver: where the gl moving tunnel's wall time goes (docs/performance.md)")
+                        help="solver: where the gl moving tunnel's wall time goes (docs/science/performance.md)")
 
 
 def main(args) -> int:

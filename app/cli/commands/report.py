@@ -1,12 +1,12 @@
 """`feelflow report seed`: reproduce the seed's experiments with all four force models and write
-docs/report-seed.md with PNG plots (the work is in app/seed_report.py).
+docs/science/seed-report.md with PNG plots (the work is in app/reports/seed.py).
 `feelflow report lessons [--only KEY,...] [--compare] [--json PATH]`: run the Presets menu's
 lessons headless as the window does and print how steady their forces are (app/lesson_report.py).
 `feelflow report scenes [--only NAME,...] [--compare] [--json PATH]`: run the example scenes with an
 outlet sponge as `feelflow run` does and print how calm their tunnel is (app/scene_report.py).
 
 Parts (`--only`): protocol (or one diameter, protocol:d32), shapes, sweep, lift; each stores its
-series in OUT/report-seed/data-<part>.json (data-protocol-<d>.json per diameter), and the report
+series in OUT/seed-report/data-<part>.json (data-protocol-<d>.json per diameter), and the report
 is written from every part stored there, so parts can be run separately (or again, or in
 parallel) and `--replot` rebuilds text and plots without running.
 """
@@ -38,8 +38,8 @@ def add_arguments(parser):
                              "first step, sudden wind changes); scenes: also without the absorbing layer")
     parser.add_argument("--json", default=None, metavar="PATH", help="lessons, scenes: also write the runs as JSON")
     parser.add_argument("--scenes", default="scenes", metavar="DIR", help="folder holding the scenes (default: scenes)")
-    parser.add_argument("--out", default="docs", metavar="DIR",
-                        help="folder for report-seed.md and report-seed/ (default: docs)")
+    parser.add_argument("--out", default="docs/science", metavar="DIR",
+                        help="folder for seed-report.md and seed-report/ (default: docs/science)")
     parser.add_argument("--replot", action="store_true",
                         help="rebuild text and plots from the stored series without running the flow")
 
@@ -81,7 +81,7 @@ def main(args) -> int:
             print(f"feelflow report seed: {part} on {args.backend}", file=sys.stderr, flush=True)
             data = run_part(part, scenes, args.backend, args.quick, phase_steps,
                             log=lambda line: print(line, file=sys.stderr, flush=True), keys=keys)
-            save_part(out / "report-seed", data)
+            save_part(out / "seed-report", data)
     path = write_report(out)
     print(f"{path}: written")
     return 0

@@ -19,13 +19,13 @@ from feelflow.app.errors import UserError
 
 
 def add_arguments(parser):
-    parser.add_argument("scene", metavar="SCENE.toml", help="the scene file (keys: docs/scenes.md)")
+    parser.add_argument("scene", metavar="SCENE.toml", help="the scene file (keys: docs/reference/scenes.md)")
     parser.add_argument("--backend", default=None, metavar="numpy|gl",
                         help="solver backend (default: the scene's run.backend, else numpy)")
     parser.add_argument("--steps", default=None, metavar="N", help="number of steps (default: the scene's)")
     parser.add_argument("--out", default="forces.csv", metavar="PATH", help="CSV file to write (default: forces.csv)")
     parser.add_argument("--record", default=None, metavar="FILE.ffsession",
-                        help="also record the run as a session file (docs/sessions.md)")
+                        help="also record the run as a session file (docs/reference/session-format.md)")
 
 
 def positive_int_option(name: str, text):

@@ -1,6 +1,6 @@
 """`feelflow session info|replay|export FILE`: look into, re-simulate or export a session file.
 
-Format: docs/sessions.md. A bad file is one line on stderr and exit 2 (app.cli.UserError).
+Format: docs/reference/session-format.md. A bad file is one line on stderr and exit 2 (app.cli.UserError).
 `replay --check` exits 1 when the replay deviates from the recorded forces by more than
 `--tolerance` (relative to the largest recorded force).
 """

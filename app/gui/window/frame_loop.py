@@ -137,7 +137,7 @@ class FrameLoop:
         t1 = time.perf_counter()
         rgba = self.upload_field()
         # a blow-up in the field raises SolverDiverged from the solver's own check (both
-        # backends, docs/algorithm.md 'Divergence'); the forces are checked here, cheaply
+        # backends, docs/science/algorithm.md 'Divergence'); the forces are checked here, cheaply
         if not all(math.isfinite(v) for f in forces.values() for v in f):
             self._on_nan()
             return

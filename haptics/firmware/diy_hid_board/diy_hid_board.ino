@@ -1,6 +1,6 @@
 // FeelFlow DIY HID force board: pose in, force out, over vendor-defined 64-byte HID reports.
 //
-// Protocol v1 (docs/haptics.md, haptics/protocols/diyhid.py; keep the three in step). Raw
+// Protocol v1 (docs/guide/haptic-devices.md, haptics/protocols/diyhid.py; keep the three in step). Raw
 // 64-byte reports, no report ids, little-endian:
 //   board -> host  STATE 0x01: version, seq u8, x i32 um, y i32 um, angle i16 mrad, buttons u8, status u8
 //                  INFO  0x83: version, dof u8, max_force u16 mN, x_min, x_max, y_min, y_max i32 um

@@ -1,6 +1,6 @@
 // FeelFlow paddle firmware: a Hapkit-style 1-DOF paddle speaking FeelFlow's serial protocol v1.
 //
-// Protocol (docs/haptics.md, haptics/protocols/hapkit.py; keep the three in step):
+// Protocol (docs/guide/haptic-devices.md, haptics/protocols/hapkit.py; keep the three in step):
 //   frame  = 0xA5 0x5A | version | type | length | payload | crc16 (little-endian)
 //   crc16  = CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF) over version, type, length, payload
 //   host -> paddle: 0x01 HELLO (empty), 0x02 FORCE (seq u16, force f32 N), 0x03 STOP (empty)
