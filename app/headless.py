@@ -1,5 +1,5 @@
 """Solvers for the command line: a backend by name; `gl` gets its own EGL context
-(DESIGN rule 2: the CLI hands the shader backend `create_context(standalone=True, backend='egl')`).
+(docs/developer/architecture.md, rule 2: the CLI hands the shader backend `create_context(standalone=True, backend='egl')`).
 """
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """FeelFlow haptics: devices (serial, HID, simulated) and the safe 1 kHz force loop.
 
-Qt-free and solver-free (DESIGN.md rule 1): what crosses the boundary are the small value types
+Qt-free and solver-free (docs/developer/architecture.md, rule 1): what crosses the boundary are the small value types
 of `feelflow.haptics.types`. The API for the app:
 
     from feelflow.haptics import list_devices, open_device, ForceLoop, LoopConfig, ForceSample

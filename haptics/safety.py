@@ -1,4 +1,4 @@
-"""The safety rules of the force loop, in one place (issue 6, 'Safety').
+"""The safety rules of the force loop, in one place (docs/guide/haptic-devices.md).
 
 A gain g in [0, 1] multiplies the force every tick:
   - hard faults set g = 0 at once: the stop key (latched until `clear_stop`), a NaN/inf force

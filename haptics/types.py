@@ -1,4 +1,4 @@
-"""The small value types that cross the haptics boundary (DESIGN.md, 'One frame, as data').
+"""The small value types that cross the haptics boundary (docs/developer/architecture.md, 'One frame, as data').
 
 Nothing here knows about the solver or Qt: the app turns solver output into `ForceSample`s and
 reads `BodyTarget`s back. Times are `time.monotonic()` seconds unless a field says otherwise.

@@ -11,7 +11,7 @@ import numpy as np
 
 from feelflow.shapes.base import Shape, ShapeError
 
-#: smallest allowed extent of a body, in lattice cells (issue 2: "smaller than 2 cells")
+#: smallest allowed extent of a body, in lattice cells (a body smaller than 2 cells is not resolved by the lattice)
 MIN_EXTENT = 2.0
 
 

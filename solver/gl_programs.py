@@ -2,7 +2,7 @@
 
 Every file in `shaders/` is one shader stage whose line 1 is the `#version` directive for GLSL
 330 core (GL 3.3 core, which macOS's 4.1 core also runs). A line `// @LATTICE` is replaced by the D2Q9 constants of
-`feelflow.solver.lattice.glsl_constants()` (the one lattice definition, DESIGN rule 3) and by any
+`feelflow.solver.lattice.glsl_constants()` (the one lattice definition: docs/developer/architecture.md, rule 3) and by any
 compile-time `#define`s a variant asks for; a `#line` directive after the injected block puts
 the driver's line numbers back on the file's own lines, so a compile error reported by the
 driver as "0:57(3)" is line 57 of the file. `ShaderError` names the file and that line.

@@ -8,7 +8,7 @@ import pytest
 
 pytest_plugins = ["gui_fixtures"]   # the GUI tests' window fixture; imports Qt only in a gui run
 
-# Mesa's shader cache and Qt's caches go to a temp dir, never the user's home (shared/notes).
+# Mesa's shader cache and Qt's caches go to a temp dir, never the user's home.
 _cache = tempfile.mkdtemp(prefix="feelflow-test-cache-")
 os.environ.setdefault("MESA_SHADER_CACHE_DIR", _cache)
 os.environ.setdefault("XDG_CACHE_HOME", _cache)

@@ -1,6 +1,6 @@
 """Force models on constructed windows whose answer is known analytically (no solver).
 
-- macroscopic: the drag equation on a uniform field (issue 3), the contour mean of a linear field
+- macroscopic: the drag equation on a uniform field , the contour mean of a linear field
   (the value at the centre, by symmetry), coefficient orientation, lift direction.
 - pressure: a field whose equation-of-state pressure is linear, p = g . (x - x_c), gives
   F = - g * (body area) (Gauss; Archimedes' principle), whatever the solid nodes hold.

@@ -1,4 +1,4 @@
-"""Force models on real flows, on every backend (issue 3).
+"""Force models on real flows, on every backend.
 
 - Galilean invariance: the seed's protocol (stopped, with the stream, stopped, against; shortened)
   run twice, in the lab frame (stream U) and in the frame of the stream (fluid at rest, every

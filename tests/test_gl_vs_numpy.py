@@ -1,7 +1,7 @@
 """The shader backend against the numpy reference, both in float32, same scene, N steps.
 
 docs/science/algorithm.md is implemented operation for operation by both, so fields must agree to
-float32 rounding (1e-5 relative) and every force model to 1e-4 relative (issue 4).
+float32 rounding (1e-5 relative) and every force model to 1e-4 relative.
 Relative = max |gl - numpy| / max |numpy| over the grid: of f, of rho - 1 where the scene makes
 the density vary (else of rho), of each velocity component against the top speed.
 """

@@ -1,4 +1,4 @@
-"""Each safety rule of the force loop, by a test that fails without the rule (issue 6).
+"""Each safety rule of the force loop, by a test that fails without the rule .
 
 The loop runs for real (its own thread, 1 kHz) against simulators speaking the real protocols;
 a feeder thread plays the solver. Timing assertions are generous (a loaded 2-core machine):

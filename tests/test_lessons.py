@@ -61,8 +61,8 @@ def test_the_sweep_starts_after_the_ramp_and_spreads_each_change_of_wind():
 
 
 def test_lift_lesson_settles_to_a_steady_lift():
-    """The half airfoil's lift over the lesson's last 1000 steps. As the preset ran before the
-    fifth session (no absorbing layer, put into a moving stream) its scatter was 0.13 of the
+    """The half airfoil's lift over the lesson's last 1000 steps. Run plain
+    (no absorbing layer, put into a moving stream) its scatter was 0.13 of the
     drag (`feelflow report lessons --compare`, docs/science/validation.md 'Calm tunnels'); with the smooth start and the
     absorbing layer 0.0014."""
     from feelflow.app.reports.lessons import run_lesson

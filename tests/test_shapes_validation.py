@@ -1,4 +1,4 @@
-"""Invalid geometry is refused with a one-line message naming the problem (issue 2, sec. 2)."""
+"""Invalid geometry is refused with a one-line message naming the problem."""
 from __future__ import annotations
 
 import math

@@ -1,7 +1,7 @@
 """Physics validation (solver/validation/): quick versions in the default run, full ones `slow`.
 
 Each case measures against physics (analytic solutions, convergence order, published
-benchmarks, Galilean invariance, conservation); the targets are issue 2's.
+benchmarks, Galilean invariance, conservation); the targets are the published ones (docs/science/validation.md).
 """
 import pytest
 

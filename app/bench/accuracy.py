@@ -19,8 +19,7 @@ float32, gl float32) along three axes of what a run costs and what it tells:
   error depends on tau (docs/science/validation.md, Schaefer-Turek 2D-1).
 
 Per run it reports the grid, steps, wall and CPU seconds, MLUPS, and the relative errors of
-C_D, C_L and dp against the refined reference values (John 2004,
-/work/shared/reference/benchmarks.md); per backend, the observed order of the C_D error between
+C_D, C_L and dp against the refined reference values (John 2004); per backend, the observed order of the C_D error between
 successive resolutions. All rows of one invocation come from one process, so their ratios
 compare; the absolute seconds depend on the machine (printed) and on its load.
 """

@@ -6,7 +6,7 @@ and, on simulators, a scripted hand that steps the handle. Reports the loop rate
 jitter |period - 1 ms| (median, p99, max), the latency from a pose change to the body moving
 and from a solver force change to the device command (first response and 50 % of the step),
 and the largest force commanded (by the loop, and as the simulated device received it).
-Targets (issue 6): rate within 1 % of 1 kHz, p99 jitter < 1 ms, force never above the maximum.
+Targets: rate within 1 % of 1 kHz, p99 jitter < 1 ms, force never above the maximum.
 """
 from __future__ import annotations
 

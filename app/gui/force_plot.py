@@ -1,6 +1,6 @@
 """The live force plot (pyqtgraph): drag and lift against time for the force model in use (or
 all models), C_D / C_L readouts, and "drag against relative speed" on log-log axes with the
-fitted exponent (the U^2 lesson: shared/reference/benchmarks.md, 'Low-Re drag').
+fitted exponent (the U^2 lesson: at low Re, C_D falls as Re grows, so drag grows slower than U^2).
 """
 from __future__ import annotations
 

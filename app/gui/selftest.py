@@ -148,7 +148,7 @@ class SelfTest:
         yield from self._wait(1.0)
         r = w.replays.replay
         self.results["grid"] = f"{r.config.nx}x{r.config.ny}"
-        for split in (False, True):   # rows whole (as before the fifth session), then long rows in parts
+        for split in (False, True):   # rows whole, then long rows in parts
             r.split_rows = split
             yield from self._wait(0.5)
             s0, f0, t0 = r.step, w.viewport.frames, time.perf_counter()

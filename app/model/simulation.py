@@ -76,8 +76,8 @@ class History:
     """One sample per frame: step, body velocity, relative wind, force of each model in use, and
     whether the sample is *settled*: the relative wind has stayed within `WIND_TOLERANCE` of its
     value for at least `SETTLE_STEPS` steps. Only settled samples are steady drag; the
-    drag-against-speed view fits those (app/force_plot.py). SETTLE_STEPS was chosen from a probe
-    of the 'Drag grows with speed' lesson (fifth session, not a command: indicative only): 750
+    drag-against-speed view fits those (app/gui/force_plot.py). SETTLE_STEPS was chosen from a probe
+    of the 'Drag grows with speed' lesson (not a command: indicative only): 750
     steps after a wind change had finished, the drag's 250-step means stayed within 5 % of the
     hold's end value at every wind of the sweep, while the first few hundred steps carry the
     acceleration's added-mass force and the flow's rearrangement (up to +60 %). What the choice
@@ -155,7 +155,7 @@ def wrap_degrees(degrees: float) -> float:
 
 
 def phase_name(velocity, wind: float) -> str:
-    """Plain words for a scripted phase (SEED-NOTES 'Experiments')."""
+    """Plain words for a scripted phase (the 2007 thesis's experiments)."""
     vx, vy = velocity
     if vx == 0.0 and vy == 0.0:
         return "stopped"

@@ -4,9 +4,9 @@ of its forces: how steady drag and lift are at the end, and for the wind sweep t
 speed and the exponent the plot's log-log view fits (app/force_plot.py, settled samples only).
 
 `compare=True` also runs each lesson *plain*: without the sponge's absorbing layer, with the
-wind blowing everywhere from the first step and the sweep's wind changed at once, which is how
-the presets ran before the fifth session; the difference is what those choices buy (docs/science/validation.md
-'Calm tunnels'). Qt-free (the fit is app.force_plot's function, imported lazily with pyqtgraph).
+wind blowing everywhere from the first step and the sweep's wind changed at once, the old way of
+running them; the difference is what those choices buy (docs/science/validation.md
+'Calm tunnels'). Qt-free (the fit is app.model.power_law's).
 """
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ absorbing layer that lets the sound out, docs/science/algorithm.md step 3), and 
 over the second half of the run.
 
 `compare=True` also runs each scene without the sponge's absorbing layer (`sponge_absorb = 0`),
-which is how the example scenes ran before the sixth session (docs/science/validation.md 'Calm tunnels'). Qt-free.
+the old way of running them (docs/science/validation.md 'Calm tunnels'). Qt-free.
 """
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """Force models (one module each) behind one interface (solver/forces/base.py).
 
 `MODELS` is the explicit registry: name -> "module:Class". A model is imported and computed only
-when something selects it (DESIGN rule 6).
+when something selects it (model only what a scene needs).
 """
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """The window's one-line dialogs: bad input or a failed file operation is one plain sentence,
-never a traceback (DESIGN.md, house rules)."""
+never a traceback (docs/developer/architecture.md, rule 7)."""
 from __future__ import annotations
 
 from PySide6.QtWidgets import QMessageBox, QWidget
