@@ -247,13 +247,31 @@ class PolygonalShape(Shape):
     user_vertices = False
 
 
+#: most vertices a polygon may have: the simplicity check is O(n^2) and the rasteriser walks
+#: every edge for every link, so 1000 vertices (finer than any 2D lattice body needs) stay fast
+MAX_VERTICES = 1000
+
+
+def _is_real(c) -> bool:
+    return isinstance(c, (int, float, np.integer, np.floating)) and not isinstance(c, (bool, np.bool_))
+
+
 def _vertex_tuple(vertices) -> tuple[tuple[float, float], ...]:
+    if isinstance(vertices, (list, tuple)):
+        if len(vertices) > MAX_VERTICES:
+            raise ShapeError(f"polygon has {len(vertices)} vertices, at most {MAX_VERTICES}")
+        if not all(isinstance(v, (list, tuple)) and len(v) == 2 and all(map(_is_real, v)) for v in vertices):
+            raise ShapeError("polygon vertices must be a list of (x, y) number pairs (not text or true/false)")
+    elif isinstance(vertices, np.ndarray) and vertices.dtype.kind not in "iuf":
+        raise ShapeError("polygon vertices must be a list of (x, y) number pairs")
     try:
         arr = np.asarray(vertices, dtype=np.float64)
     except (TypeError, ValueError):
         raise ShapeError("polygon vertices must be a list of (x, y) number pairs") from None
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise ShapeError("polygon vertices must be a list of (x, y) number pairs")
+    if arr.shape[0] > MAX_VERTICES:
+        raise ShapeError(f"polygon has {arr.shape[0]} vertices, at most {MAX_VERTICES}")
     if arr.shape[0] < 3:
         raise ShapeError(f"polygon needs at least 3 vertices, got {arr.shape[0]}")
     if not np.all(np.isfinite(arr)):

@@ -17,6 +17,9 @@ COLLISIONS = ("bgk", "trt")
 EQUILIBRIA = ("compressible", "incompressible")
 PROFILES = ("uniform", "parabolic")
 DTYPES = ("float64", "float32")
+#: largest body force per node (lattice units): Guo's forcing adds F to the momentum each step,
+#: so F = 1e-3 alone takes a fluid at rest to Ma 0.17 (u = 0.098) in about 100 steps
+MAX_BODY_FORCE = 1e-3
 
 
 class ConfigError(ValueError):
@@ -100,4 +103,7 @@ class FlowConfig:
             v = getattr(self, key)
             need(len(v) == 2 and all(math.isfinite(c) for c in v), key, "must be two finite numbers")
         need(math.hypot(*self.initial_velocity) <= self.max_speed, "initial_velocity", "exceeds the Mach limit")
+        need(math.hypot(*self.body_force) <= MAX_BODY_FORCE, "body_force",
+             f"|F| = {math.hypot(*self.body_force):.3g} is above {MAX_BODY_FORCE:g}: from rest such a force "
+             f"drives the flow past the Mach limit within {self.max_speed / MAX_BODY_FORCE:.0f} steps")
         return self
