@@ -118,11 +118,11 @@ def check_output(path, option: str = "output", *, inputs=(), others=(), force: b
             raise OutputError(f"{label} already exists; {hint}")
     folder = _folder(path)
     if not folder.is_dir():
-        raise OutputError(f"{label}: folder {str(folder)!r} does not exist")
+        raise OutputError(f"{option}: directory {str(folder)!r} does not exist; cannot write {path.name!r} there")
     if len(path.name.encode()) > 255:
         raise OutputError(f"{label}: the file name is too long")
     if not os.access(folder, os.W_OK | os.X_OK):
-        raise OutputError(f"{label}: folder {str(folder)!r} is not writable")
+        raise OutputError(f"{option}: directory {str(folder)!r} is not writable; cannot write {path.name!r} there")
     clean_stale_temporaries(folder)
     return path
 
@@ -204,3 +204,14 @@ def write_or_rescue(path, write, option: str = "output") -> pathlib.Path:
         except OSError as exc2:
             where = f"and the rescue copy failed too ({exc2.strerror or exc2})"
         raise OutputError(f"{option}: cannot write {str(path)!r} ({reason}); {where}") from None
+
+
+def save_json(path, data, option: str = "--json") -> pathlib.Path:
+    """`write_json_atomic` through `write_or_rescue`: a failed write is one line saying where the
+    results went."""
+    return write_or_rescue(path, lambda target: write_json_atomic(target, data), option)
+
+
+def save_text(path, text: str, option: str = "output") -> pathlib.Path:
+    """`write_text_atomic` through `write_or_rescue`."""
+    return write_or_rescue(path, lambda target: write_text_atomic(target, text), option)

@@ -771,9 +771,11 @@ class MainWindow(QMainWindow):
 
     def _try(self, fn, title):
         """fn()'s result, or None after a one-line dialog when it raised OSError or ValueError."""
+        from feelflow.app.errors import UserError
+
         try:
             return fn()
-        except (OSError, ValueError) as exc:   # ValueError: ShapeError, SessionError (one line each)
+        except (OSError, ValueError, UserError) as exc:   # ShapeError, SessionError, UserError: one line each
             QMessageBox.warning(self, title, str(exc))
             return None
 

@@ -203,7 +203,7 @@ def _fmt(v) -> str:
 def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
     """Write `data` through `feelflow.app.files.atomic_path` (temp file beside, fsync, os.replace): never
     half a file. SessionError naming the path if it cannot (the old file is left as it was)."""
-    from feelflow.app.files import atomic_path
+    from feelflow.app.files import atomic_path, rescue_path
 
     path = Path(path)
     if path.is_dir():
@@ -212,7 +212,13 @@ def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
         with atomic_path(path, suffix=".tmp") as tmp:
             tmp.write_bytes(data)
     except OSError as exc:
-        raise SessionError(f"{path}: cannot write {what} ({exc.strerror or exc})") from None
+        try:   # the work is not lost: it goes to a new file in the temp folder
+            saved = rescue_path(path)
+            saved.write_bytes(data)
+            where = f"it was saved to {saved} instead"
+        except OSError:
+            where = "no rescue copy could be written either"
+        raise SessionError(f"{path}: cannot write {what} ({exc.strerror or exc}); {where}") from None
     return path
 
 
@@ -607,11 +613,11 @@ def _validate_parameters(parameters, config: FlowConfig) -> list:
     return out
 
 
-def export_csv(session: Session, path, values=None) -> Path:
+def export_csv(session: Session, path, values=None, rows: int | None = None) -> Path:
     """Write the force series as CSV (`force_columns`), atomically; `values` replaces the
-    recorded forces (e.g. a replay's)."""
+    recorded forces (e.g. a replay's); `rows` keeps only the first rows (a diverged replay's)."""
     lines = [",".join(force_columns(session.models))]
-    lines += [",".join(row) for row in session.csv_rows(values)]
+    lines += [",".join(row) for row in session.csv_rows(values)][:rows]
     return atomic_write_bytes(path, ("\n".join(lines) + "\n").encode(), "CSV file")
 
 
