@@ -124,8 +124,10 @@ def loads_json(data: bytes, source: str):
         doc = json.loads(text, parse_int=_int, parse_constant=constant)
     except json.JSONDecodeError as exc:
         raise UserError(f"{source}: not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg})") from None
-    except (ValueError, RecursionError) as exc:
-        raise UserError(f"{source}: not valid JSON: {str(exc).splitlines()[0] if str(exc) else 'too deep'}") from None
+    except RecursionError:
+        raise UserError(f"{source}: nested more than {MAX_DEPTH} levels deep") from None
+    except ValueError as exc:
+        raise UserError(f"{source}: not valid JSON: {str(exc).splitlines()[0]}") from None
     check_document(doc, source)
     return doc
 
@@ -138,8 +140,12 @@ def loads_toml(data: bytes, source: str):
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise UserError(f"{source}: not valid TOML: {str(exc).splitlines()[0]}") from None
-    except (ValueError, RecursionError) as exc:
-        raise UserError(f"{source}: not valid TOML: {str(exc).splitlines()[0] if str(exc) else 'too deep'}") from None
+    except RecursionError:
+        raise UserError(f"{source}: nested more than {MAX_DEPTH} levels deep") from None
+    except ValueError as exc:
+        if "integer string conversion" in str(exc):
+            raise UserError(f"{source}: an integer is too large (at most 2**53)") from None
+        raise UserError(f"{source}: not valid TOML: {str(exc).splitlines()[0]}") from None
     check_document(doc, source)
     return doc
 
