@@ -95,8 +95,8 @@ def check_output(path, option: str = "output", *, inputs=(), others=(), force: b
     temporaries in the folder are removed."""
     path = pathlib.Path(path)
     label = f"{option}: {str(path)!r}"
-    if not str(path) or path.name in ("", ".", ".."):
-        raise OutputError(f"{label}: not a file name")
+    if not str(path) or path.name in ("", ".", "..") or "\x00" in str(path):
+        raise OutputError(f"{option}: {str(path)!r} is not a file name")
     for other in inputs:
         if other is not None and _same_file(path, other):
             raise OutputError(f"{label} is an input of this command; it would be destroyed (choose another name)")

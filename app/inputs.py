@@ -35,6 +35,8 @@ def check_regular_file(path, what: str = "file", max_bytes: int | None = None) -
         raise UserError(f"{src}: no such {what}") from None
     except OSError as exc:
         raise UserError(f"{src}: cannot be read ({exc.strerror or exc})") from None
+    except ValueError:   # a NUL byte in the name
+        raise UserError(f"{src!r}: not a valid file name") from None
     if stat.S_ISDIR(st.st_mode):
         raise UserError(f"{src}: is a directory, not a {what}")
     if not stat.S_ISREG(st.st_mode):

@@ -102,6 +102,8 @@ def _read_shape_text(path: Path) -> str:
         st = os.stat(path)
     except OSError as exc:
         raise ShapeError(f"{path}: cannot read shape file ({exc.strerror or exc})") from None
+    except ValueError:   # a NUL byte in the name
+        raise ShapeError(f"{str(path)!r}: not a valid file name") from None
     if not stat.S_ISREG(st.st_mode):
         raise ShapeError(f"{path}: not a regular file (a folder, pipe or device); refused")
     if st.st_size > MAX_FILE_BYTES:

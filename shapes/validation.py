@@ -37,11 +37,18 @@ def finite_number(name: str, value) -> float:
     return number
 
 
+#: largest size of a body, cells: the largest grid side (solver/config.py); a larger body could
+#: never be placed, and a parametric outline sampled per cell would take minutes to build
+MAX_SIZE = 8192.0
+
+
 def positive_number(name: str, value) -> float:
-    """A finite number > 0."""
+    """A finite number in (0, MAX_SIZE]."""
     number = finite_number(name, value)
     if number <= 0.0:
         raise ShapeError(f"{name} must be positive, got {number:g}")
+    if number > MAX_SIZE:
+        raise ShapeError(f"{name} must be at most {MAX_SIZE:g} cells (the largest grid), got {number:g}")
     return number
 
 

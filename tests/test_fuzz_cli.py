@@ -124,4 +124,4 @@ def test_fuzz_command_lines(first, tmp_path, monkeypatch, capsys, good_session, 
         for p, data in inputs.items():   # an input of the command is never changed
             assert p.read_bytes() == data, (seed, argv, p.name)
         assert (folder / "pipe").is_fifo()
-    assert any(c == 0 for c in codes) and any(c == 2 for c in codes), codes
+    assert any(c == 2 for c in codes), codes   # the mutations do reach the checks

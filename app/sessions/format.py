@@ -267,7 +267,7 @@ def load_session(path) -> Session:
         fail("no such session file")
     except PermissionError:
         fail("cannot be read (permission denied)")
-    except (zipfile.BadZipFile, EOFError, OSError):
+    except (zipfile.BadZipFile, EOFError, OSError, ValueError, NotImplementedError, RuntimeError):
         fail("not a FeelFlow session file (not a zip archive; truncated or another kind of file)")
     with zf:
         names = set(zf.namelist())
