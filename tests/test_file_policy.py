@@ -249,3 +249,37 @@ def test_a_named_pipe_as_input_is_refused_at_once(tmp_path, argv):
     assert r.returncode == 2, r.stderr
     assert "not a regular file" in r.stderr and "Traceback" not in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1
+
+
+def test_run_whose_csv_cannot_be_written_keeps_the_work(scene, tmp_path, capsys, monkeypatch):
+    """The simulation is done when the disk fills: the rows go to a rescue file (named in the one
+    line), and the session is still recorded; a session that cannot be written is rescued too."""
+    out, session = tmp_path / "f.csv", tmp_path / "s.ffsession"
+    real_replace = os.replace
+    failing = {out}
+
+    def full_disk(src, dst):
+        if pathlib.Path(dst) in failing:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real_replace(src, dst)
+    monkeypatch.setattr(files.os, "replace", full_disk)
+    assert cli_main(["run", str(scene), "--out", str(out), "--record", str(session)]) == 2
+    line = one_error_line(capsys.readouterr().err)
+    assert str(out) in line and "No space left" in line
+    rescued = pathlib.Path(line.split("saved to ")[1].split(" instead")[0])
+    try:
+        assert rescued.read_text().startswith("step,x,y")
+    finally:
+        rescued.unlink()
+    assert not out.exists() and session.exists()
+    failing.add(session)
+    session.unlink()
+    assert cli_main(["run", str(scene), "--out", str(tmp_path / "g.csv"), "--record", str(session)]) == 2
+    line = one_error_line(capsys.readouterr().err)
+    assert str(session) in line and "saved to" in line and f"the forces are in {tmp_path / 'g.csv'}" in line
+    rescued = pathlib.Path(line.split("saved to ")[1].split(" instead")[0])
+    try:
+        from feelflow.app.sessions import load_session
+        load_session(rescued)
+    finally:
+        rescued.unlink()

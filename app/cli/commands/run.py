@@ -99,14 +99,21 @@ def main(args) -> int:
     finally:
         solver.close()
 
-    write_csv_atomic(out, header, rows)
+    csv_error = None
+    try:
+        write_csv_atomic(out, header, rows)
+    except UserError as exc:   # the rows went to a rescue file; the session is still saved
+        csv_error = exc
     if recorder is not None:
         from feelflow.app.sessions import SessionError
 
         try:
             recorder.save(args.record)
         except SessionError as exc:
-            raise UserError(f"--record: {exc}; the forces are in {out}") from None
+            forces = "the forces too could not be written" if csv_error else f"the forces are in {out}"
+            raise UserError(f"--record: {exc}; {forces}") from None
+    if csv_error is not None:
+        raise csv_error
     if diverged is not None:
         print(f"feelflow: the simulation diverged within steps {diverged[0]}..{diverged[1]} ({diverged[2]}); "
               f"the {len(rows)} rows before it are in {out}. Lower the speeds or raise the viscosity "
