@@ -117,6 +117,8 @@ def test_scene_bounds_and_ignored_settings(tmp_path):
         ({"flow": {"body_force": [0.5, 0.0]}}, "flow.body_force"),
         ({"flow": {"x_boundary": "periodic", "inflow_speed": 0.05}}, "flow.inflow_speed: has no effect"),
         ({"flow": {"x_boundary": "periodic", "sponge_cells": 4}}, "flow.sponge_cells: has no effect"),
+        ({"flow": {"sponge_absorb": 0.1}}, "flow.sponge_absorb: has no effect without an absorbing layer"),
+        ({"flow": {"collision": "bgk", "trt_magic": 0.25}}, "flow.trt_magic: has no effect"),
         ({"run": {"steps": 10 ** 9}}, "run.steps"),
         ({"grid": {"nx": 8192, "ny": 8192}}, "nodes"),
         ({"body": {"kind": "cylinder", "diameter": "6", "x": 20, "y": 16}}, "body.diameter"),
