@@ -15,7 +15,7 @@ from functools import lru_cache
 import numpy as np
 
 from feelflow.shapes.base import Shape, ShapeError
-from feelflow.shapes.validation import (check_extent, check_in_domain, check_pose, finite_number, positive_number,
+from feelflow.shapes.validation import (MAX_SIZE, check_extent, check_in_domain, check_pose, finite_number, positive_number,
                                unit_direction)
 
 #: points closer than this to an edge count as on the boundary (and so inside)
@@ -277,6 +277,10 @@ def _vertex_tuple(vertices) -> tuple[tuple[float, float], ...]:
     if not np.all(np.isfinite(arr)):
         k = int(np.argmax(~np.all(np.isfinite(arr), axis=1)))
         raise ShapeError(f"polygon vertex {k} is not finite: ({arr[k, 0]}, {arr[k, 1]})")
+    if np.abs(arr).max() > MAX_SIZE:   # body-local: such a body fits no grid (and overflows the area sums)
+        k = int(np.argmax(np.abs(arr).max(axis=1)))
+        raise ShapeError(f"polygon vertex {k} lies {np.abs(arr[k]).max():.3g} cells from the body's reference "
+                         f"point, more than {MAX_SIZE:g} (the largest grid)")
     return tuple((float(px), float(py)) for px, py in arr)
 
 

@@ -17,6 +17,7 @@ import pathlib
 import random
 import signal
 import traceback
+import warnings
 
 import pytest
 
@@ -196,7 +197,8 @@ def check_cli(argv, capsys, scratch: pathlib.Path, *, allow_nan: bool = False, w
 
     capsys.readouterr()
     try:
-        with time_limit(TIME_LIMIT):
+        with time_limit(TIME_LIMIT), warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")   # a warning would be two more lines on a user's stderr
             try:
                 rc = cli_main([str(a) for a in argv])
             except SystemExit as exc:
@@ -207,6 +209,8 @@ def check_cli(argv, capsys, scratch: pathlib.Path, *, allow_nan: bool = False, w
         pytest.fail(f"{what}: {argv}: raised\n{traceback.format_exc()}")
     out, err = capsys.readouterr()
     assert "Traceback" not in err + out, (what, argv, err)
+    shown = [w for w in caught if not issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning))]
+    assert not shown, (what, argv, [f"{w.category.__name__}: {w.message}" for w in shown][:3])
     if rc == 0:
         _finite_outputs(scratch, allow_nan)
     else:
