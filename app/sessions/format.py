@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from feelflow.app.sessions.bounds import MAX_FILE_BYTES, MAX_JSON_BYTES, check_npz, member_limits
 from feelflow.solver.config import ConfigError, FlowConfig
 
 FORMAT = "feelflow-session"
@@ -39,14 +40,6 @@ MEMBERS = (MANIFEST, PARAMETERS, INPUTS, FORCES)
 #: largest uncompressed member we read (a zip bomb is refused before it is inflated); the
 #: array members are bounded tighter, by the rows and grid the manifest declares
 MAX_MEMBER_BYTES = 1 << 30
-#: largest JSON member (manifest, parameters) and largest session file, bytes
-MAX_JSON_BYTES = 16 << 20
-MAX_FILE_BYTES = 1 << 30
-#: most input samples, parameter changes or force rows a session may declare: a million rows of
-#: forces are about 100 MB of arrays, more than a day of recording at 10 rows a second
-MAX_ROWS = 1_000_000
-#: room for the .npy headers and zip records of one .npz member, bytes
-NPZ_OVERHEAD = 4096
 
 #: parameter name -> what its value is (docs/sessions.md, "Parameter changes")
 PARAMETER_NAMES = ("body", "inflow_speed", "nu", "force_models", "pause", "resume", "reset", "rebuild")
@@ -294,7 +287,7 @@ def load_session(path) -> Session:
         read(MANIFEST, MAX_JSON_BYTES)
         read(PARAMETERS, MAX_JSON_BYTES)
         manifest = _json_member(data[MANIFEST], MANIFEST, fail)
-        limits = _member_limits(manifest, fail)
+        limits = member_limits(manifest, fail, MANIFEST, (INPUTS, FORCES, STATE))
         for member in (INPUTS, FORCES) + ((STATE,) if STATE in names else ()):
             read(member, limits[member])
     parameters = _json_member(data[PARAMETERS], PARAMETERS, fail)
@@ -322,84 +315,8 @@ def _json_member(raw: bytes, member: str, fail):
         fail(str(exc))
 
 
-def _count(d, key: str, fail, where: str) -> int:
-    v = d.get(key) if isinstance(d, dict) else None
-    if isinstance(v, bool) or not isinstance(v, int) or v < 0:
-        fail(f"{MANIFEST}: {where}{key} must be a non-negative integer, got {repr(v)[:20]}")
-    return v
-
-
-def _member_limits(manifest, fail) -> dict:
-    """Bytes each array member may inflate to, from the counts and grid the manifest declares,
-    after bounding those by what a machine can do (MAX_ROWS; app/inputs.py's grid and steps)."""
-    from feelflow.app.errors import UserError
-    from feelflow.app.inputs import check_work
-
-    if not isinstance(manifest, dict) or not isinstance(manifest.get("counts"), dict):
-        fail(f"{MANIFEST}: 'counts' is missing or not a dict")
-    counts = manifest["counts"]
-    n = {k: _count(counts, k, fail, "counts.") for k in ("inputs", "parameters", "forces", "steps")}
-    for key in ("inputs", "parameters", "forces"):
-        if n[key] > MAX_ROWS:
-            fail(f"{MANIFEST}: counts.{key} is {n[key]}, more than a session may hold ({MAX_ROWS})")
-    if n["forces"] > n["steps"]:
-        fail(f"{MANIFEST}: counts.forces is {n['forces']} but a force row covers at least one of the "
-             f"{n['steps']} steps")
-    scene = manifest.get("scene")
-    config = scene.get("config") if isinstance(scene, dict) else None
-    nx = _count(config, "nx", fail, "scene.config.")
-    ny = _count(config, "ny", fail, "scene.config.")
-    try:
-        check_work(max(nx, 1), max(ny, 1), n["steps"], MANIFEST, "counts.steps")
-    except UserError as exc:
-        fail(str(exc))
-    forces = manifest.get("forces")
-    models = forces.get("models") if isinstance(forces, dict) else None
-    columns = 2 * len(models) if isinstance(models, list) and len(models) <= 16 else 32
-    return {INPUTS: NPZ_OVERHEAD + n["inputs"] * 8 * 8,
-            FORCES: NPZ_OVERHEAD + n["forces"] * 8 * (7 + columns),
-            STATE: NPZ_OVERHEAD + 9 * nx * ny * 8}
-
-
-def _check_npz(raw: bytes, member: str, spec: dict, fail) -> None:
-    """The member is a zip of .npy arrays whose headers are plausible before any is read: known
-    names, numeric dtypes, and data no larger than the bytes actually there (a crafted header
-    cannot make numpy allocate terabytes)."""
-    buf = io.BytesIO(raw)
-    if not zipfile.is_zipfile(buf):
-        fail(f"{member} is not an .npz archive (a plain .npy or another file)")
-    try:
-        with zipfile.ZipFile(buf) as zf:
-            infos = zf.infolist()
-            if len(infos) > 16:
-                fail(f"{member} holds {len(infos)} entries, more than a session member has")
-            for info in infos:
-                if info.file_size > len(raw) * 1100 or info.file_size > MAX_MEMBER_BYTES:
-                    fail(f"{member}: entry {info.filename[:40]!r} claims {info.file_size} bytes")
-                with zf.open(info) as fh:
-                    version = np.lib.format.read_magic(fh)
-                    if version == (1, 0):
-                        shape, _, dtype = np.lib.format.read_array_header_1_0(fh, max_header_size=4096)
-                    elif version == (2, 0):
-                        shape, _, dtype = np.lib.format.read_array_header_2_0(fh, max_header_size=4096)
-                    else:
-                        fail(f"{member}: entry {info.filename[:40]!r} has .npy version {version}")
-                    header = fh.tell()
-                if dtype.hasobject or dtype.kind not in "iuf":
-                    fail(f"{member}: entry {info.filename[:40]!r} holds {dtype} data (numbers only; never pickle)")
-                count = math.prod(shape)
-                if count * dtype.itemsize != info.file_size - header:
-                    fail(f"{member}: entry {info.filename[:40]!r} declares shape {shape[:4]} but holds "
-                         f"{info.file_size - header} bytes of data")
-    except SessionError:
-        raise
-    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, NotImplementedError,
-            RuntimeError) as exc:
-        fail(f"{member} is not a readable .npz archive ({str(exc).splitlines()[0][:80] if str(exc) else type(exc).__name__})")
-
-
 def _npz_member(raw: bytes, member: str, spec: dict, fail) -> dict:
-    _check_npz(raw, member, spec, fail)
+    check_npz(raw, member, fail)
     try:
         with np.load(io.BytesIO(raw), allow_pickle=False) as npz:
             names = set(npz.files)
