@@ -226,7 +226,7 @@ def repo_snapshot() -> dict:
     skip = {".venv", ".git", "__pycache__", ".pytest_cache", "feelflow.egg-info", "build", "dist"}
     snap = {}
     for folder, dirs, names in os.walk(ROOT):
-        dirs[:] = [d for d in dirs if d not in skip]
+        dirs[:] = [d for d in dirs if d not in skip and not d.endswith("_cache")]   # tools' caches
         for n in names:
             p = os.path.join(folder, n)
             try:
