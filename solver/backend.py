@@ -46,6 +46,13 @@ def physical_speed_limit(config: FlowConfig) -> float:
     return min(SPEED_FACTOR * config.max_speed, MAX_PHYSICAL_SPEED)
 
 
+def physical_density_deviation(config: FlowConfig) -> float:
+    """The largest |rho - 1| of a physical flow of `config`: DENSITY_DEVIATION, or twice the Mach
+    limit where that is more (a body started at Ma sends out a pulse of about Ma, rho u / c_s),
+    never beyond 0.9."""
+    return min(0.9, max(DENSITY_DEVIATION, 2.0 * config.mach_limit))
+
+
 class Solver(ABC):
     """A D2Q9 lattice with at most one rigid body (docs/algorithm.md)."""
 
@@ -168,7 +175,7 @@ class Solver(ABC):
 
     def check_physical(self) -> None:
         """Raise SolverDiverged when the flow has left the physical range (max |u| above
-        `physical_speed_limit`, density outside 1 +- DENSITY_DEVIATION), long before it reaches NaN.
+        `physical_speed_limit`, |rho - 1| above `physical_density_deviation`), long before NaN.
         Reads the whole field (one read-back on the gl backend); checked once per solver step."""
         if getattr(self, "_physical_checked_at", None) == self.time:
             return
@@ -182,10 +189,11 @@ class Solver(ABC):
         if u_max > limit:
             raise SolverDiverged(self.time, f"max |u| = {u_max:.3g} is far above the Mach limit "
                                             f"(physical range |u| <= {limit:.3g})")
-        if dev > DENSITY_DEVIATION:
+        allowed = physical_density_deviation(self.config)
+        if dev > allowed:
             lo, hi = float(np.min(rho)), float(np.max(rho))
             raise SolverDiverged(self.time, f"the density reaches {hi if hi - 1.0 >= 1.0 - lo else lo:.3g}, "
-                                            f"far from 1 (physical range 1 +- {DENSITY_DEVIATION:g})")
+                                            f"far from 1 (physical range 1 +- {allowed:g})")
         self._physical_checked_at = self.time
 
     def close(self) -> None:
