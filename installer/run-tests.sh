@@ -13,9 +13,9 @@ if [ $# -gt 0 ]; then
   run "$@"
   exit $?
 fi
-run -m "not slow and not device and not gui and not bundle"
+run -m "not slow and not device and not gui and not bundle and not fuzz"
 rc_core=$?
-run -m "gui and not slow and not device and not bundle"
+run -m "gui and not slow and not device and not bundle and not fuzz"
 rc_gui=$?
 [ $rc_gui -eq 5 ] && rc_gui=0   # no gui tests collected is not a failure
 echo "feelflow tests: unit+gl exit ${rc_core}, gui exit ${rc_gui}"

@@ -15,7 +15,7 @@ from functools import lru_cache
 import numpy as np
 
 from feelflow.shapes.base import Shape, ShapeError
-from feelflow.shapes.validation import (check_extent, check_in_domain, check_pose, finite_number, positive_number,
+from feelflow.shapes.validation import (MAX_SIZE, check_extent, check_in_domain, check_pose, finite_number, positive_number,
                                unit_direction)
 
 #: points closer than this to an edge count as on the boundary (and so inside)
@@ -247,18 +247,40 @@ class PolygonalShape(Shape):
     user_vertices = False
 
 
+#: most vertices a polygon may have: the simplicity check is O(n^2) and the rasteriser walks
+#: every edge for every link, so 1000 vertices (finer than any 2D lattice body needs) stay fast
+MAX_VERTICES = 1000
+
+
+def _is_real(c) -> bool:
+    return isinstance(c, (int, float, np.integer, np.floating)) and not isinstance(c, (bool, np.bool_))
+
+
 def _vertex_tuple(vertices) -> tuple[tuple[float, float], ...]:
+    if isinstance(vertices, (list, tuple)):
+        if len(vertices) > MAX_VERTICES:
+            raise ShapeError(f"polygon has {len(vertices)} vertices, at most {MAX_VERTICES}")
+        if not all(isinstance(v, (list, tuple)) and len(v) == 2 and all(map(_is_real, v)) for v in vertices):
+            raise ShapeError("polygon vertices must be a list of (x, y) number pairs (not text or true/false)")
+    elif isinstance(vertices, np.ndarray) and vertices.dtype.kind not in "iuf":
+        raise ShapeError("polygon vertices must be a list of (x, y) number pairs")
     try:
         arr = np.asarray(vertices, dtype=np.float64)
     except (TypeError, ValueError):
         raise ShapeError("polygon vertices must be a list of (x, y) number pairs") from None
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise ShapeError("polygon vertices must be a list of (x, y) number pairs")
+    if arr.shape[0] > MAX_VERTICES:
+        raise ShapeError(f"polygon has {arr.shape[0]} vertices, at most {MAX_VERTICES}")
     if arr.shape[0] < 3:
         raise ShapeError(f"polygon needs at least 3 vertices, got {arr.shape[0]}")
     if not np.all(np.isfinite(arr)):
         k = int(np.argmax(~np.all(np.isfinite(arr), axis=1)))
         raise ShapeError(f"polygon vertex {k} is not finite: ({arr[k, 0]}, {arr[k, 1]})")
+    if np.abs(arr).max() > MAX_SIZE:   # body-local: such a body fits no grid (and overflows the area sums)
+        k = int(np.argmax(np.abs(arr).max(axis=1)))
+        raise ShapeError(f"polygon vertex {k} lies {np.abs(arr[k]).max():.3g} cells from the body's reference "
+                         f"point, more than {MAX_SIZE:g} (the largest grid)")
     return tuple((float(px), float(py)) for px, py in arr)
 
 

@@ -15,24 +15,40 @@ from feelflow.shapes.base import Shape, ShapeError
 MIN_EXTENT = 2.0
 
 
+def _kind_of(value) -> str:
+    """What a wrong value is, for a message (never its possibly huge text)."""
+    if isinstance(value, (bool, np.bool_)):
+        return "true/false"
+    if isinstance(value, str):
+        return f"text {value[:20]!r}"
+    return f"a {type(value).__name__}"
+
+
 def finite_number(name: str, value) -> float:
     """`value` as a float; ShapeError if it is not a finite real number."""
-    if isinstance(value, bool):
-        raise ShapeError(f"{name} must be a number, got {value!r}")
+    if isinstance(value, (bool, np.bool_, str, bytes)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ShapeError(f"{name} must be a number, got {_kind_of(value)}")
     try:
         number = float(value)
-    except (TypeError, ValueError):
-        raise ShapeError(f"{name} must be a number, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise ShapeError(f"{name} must be a finite number, got one too large") from None
     if not math.isfinite(number):
         raise ShapeError(f"{name} must be a finite number, got {number}")
     return number
 
 
+#: largest size of a body, cells: the largest grid side (solver/config.py); a larger body could
+#: never be placed, and a parametric outline sampled per cell would take minutes to build
+MAX_SIZE = 8192.0
+
+
 def positive_number(name: str, value) -> float:
-    """A finite number > 0."""
+    """A finite number in (0, MAX_SIZE]."""
     number = finite_number(name, value)
     if number <= 0.0:
         raise ShapeError(f"{name} must be positive, got {number:g}")
+    if number > MAX_SIZE:
+        raise ShapeError(f"{name} must be at most {MAX_SIZE:g} cells (the largest grid), got {number:g}")
     return number
 
 

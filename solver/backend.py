@@ -31,6 +31,28 @@ class SolverDiverged(RuntimeError):
         self.step = step
 
 
+#: the flow has left the lattice's physical range (and will blow up) when any node moves faster
+#: than SPEED_FACTOR times the Mach limit's speed (c_s Ma_max; the flow near a body reaches about
+#: twice the stream's) or its density is further than DENSITY_DEVIATION from rho_0 = 1 (a
+#: compressibility error of order Ma^2, a few per cent inside the Mach limit): Krueger et al.,
+#: "The Lattice Boltzmann Method" (2017), sec. 4.5 and 7.1 (Mach number and stability)
+SPEED_FACTOR = 4.0
+MAX_PHYSICAL_SPEED = 0.8
+DENSITY_DEVIATION = 0.5
+
+
+def physical_speed_limit(config: FlowConfig) -> float:
+    """The largest |u| a physical flow of `config` reaches (SPEED_FACTOR x its Mach limit)."""
+    return min(SPEED_FACTOR * config.max_speed, MAX_PHYSICAL_SPEED)
+
+
+def physical_density_deviation(config: FlowConfig) -> float:
+    """The largest |rho - 1| of a physical flow of `config`: DENSITY_DEVIATION, or twice the Mach
+    limit where that is more (a body started at Ma sends out a pulse of about Ma, rho u / c_s),
+    never beyond 0.9."""
+    return min(0.9, max(DENSITY_DEVIATION, 2.0 * config.mach_limit))
+
+
 class Solver(ABC):
     """A D2Q9 lattice with at most one rigid body (docs/science/algorithm.md)."""
 
@@ -150,6 +172,29 @@ class Solver(ABC):
         from feelflow.solver.lattice import RHO0
 
         return float(self.shifted_distributions().sum(dtype=np.float64)) + RHO0 * self.config.nx * self.config.ny
+
+    def check_physical(self) -> None:
+        """Raise SolverDiverged when the flow has left the physical range (max |u| above
+        `physical_speed_limit`, |rho - 1| above `physical_density_deviation`), long before NaN.
+        Reads the whole field (one read-back on the gl backend); checked once per solver step."""
+        if getattr(self, "_physical_checked_at", None) == self.time:
+            return
+        rho, ux, uy = self.macroscopic()
+        limit = physical_speed_limit(self.config)
+        speed2 = ux * ux + uy * uy
+        u_max = float(np.sqrt(np.max(speed2))) if speed2.size else 0.0
+        dev = float(np.max(np.abs(rho - 1.0))) if rho.size else 0.0
+        if not (np.isfinite(u_max) and np.isfinite(dev)):
+            raise SolverDiverged(self.time, "density is no longer finite")
+        if u_max > limit:
+            raise SolverDiverged(self.time, f"max |u| = {u_max:.3g} is far above the Mach limit "
+                                            f"(physical range |u| <= {limit:.3g})")
+        allowed = physical_density_deviation(self.config)
+        if dev > allowed:
+            lo, hi = float(np.min(rho)), float(np.max(rho))
+            raise SolverDiverged(self.time, f"the density reaches {hi if hi - 1.0 >= 1.0 - lo else lo:.3g}, "
+                                            f"far from 1 (physical range 1 +- {allowed:g})")
+        self._physical_checked_at = self.time
 
     def close(self) -> None:
         """Release resources (GL objects); the solver is unusable after."""

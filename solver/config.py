@@ -17,6 +17,10 @@ COLLISIONS = ("bgk", "trt")
 EQUILIBRIA = ("compressible", "incompressible")
 PROFILES = ("uniform", "parabolic")
 DTYPES = ("float64", "float32")
+#: a body force F (Guo et al. 2002) adds F to each node's momentum per step: it may not exceed
+#: the Mach limit's speed, and between no-slip walls its steady Poiseuille flow,
+#: u_max = F H^2 / (8 nu), may not exceed this many times that speed
+BODY_FORCE_SPEED_FACTOR = 2.0
 
 
 class ConfigError(ValueError):
@@ -100,4 +104,13 @@ class FlowConfig:
             v = getattr(self, key)
             need(len(v) == 2 and all(math.isfinite(c) for c in v), key, "must be two finite numbers")
         need(math.hypot(*self.initial_velocity) <= self.max_speed, "initial_velocity", "exceeds the Mach limit")
+        force = math.hypot(*self.body_force)
+        need(force <= self.max_speed, "body_force",
+             f"|F| = {force:.3g} is above {self.max_speed:.3g}: it alone would push the flow past the Mach "
+             f"limit in a single step")
+        if self.y_boundary == "no_slip":   # the steady channel flow it drives: u_max = F H^2 / (8 nu)
+            u_max = abs(self.body_force[0]) * self.ny ** 2 / (8 * self.nu)
+            need(u_max <= BODY_FORCE_SPEED_FACTOR * self.max_speed, "body_force",
+                 f"F_x = {self.body_force[0]:.3g} drives a channel flow of u_max = F H^2 / (8 nu) = {u_max:.3g}, "
+                 f"far above the Mach limit's {self.max_speed:.3g}")
         return self

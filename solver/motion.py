@@ -111,7 +111,8 @@ class MotionRunner:
         self._placed = (self.t, velocity)
 
     def advance(self, n: int) -> dict[str, tuple[float, float]]:
-        """Run n steps along the script; the force per model averaged over them."""
+        """Run n steps along the script; the force per model averaged over them. Raises
+        `SolverDiverged` when the flow has left the physical range (`Solver.check_physical`)."""
         total: dict[str, list[float]] = {}
 
         def add(forces, weight):
@@ -137,4 +138,7 @@ class MotionRunner:
             add(self.solver.forces(), k)
             self.t += k
             remaining -= k
+        check = getattr(self.solver, "check_physical", None)
+        if check is not None:   # SolverDiverged when the flow left the physical range
+            check()
         return {name: (acc[0] / n, acc[1] / n) for name, acc in total.items()}

@@ -187,7 +187,7 @@ def main(args) -> int:
             print(f"{label}: observed order of the C_D error at fixed tau {orders}")
     print(markdown_tables(result))
     if getattr(args, "json", None):
-        from feelflow.app.files import write_json_atomic
+        from feelflow.app.files import save_json
 
-        write_json_atomic(args.json, result)
+        save_json(args.json, result)
     return 0

@@ -242,7 +242,7 @@ def main(args) -> int:
           f"loop as a thread {c['thread']['worst_p99_jitter_ms']:.2f} ms, "
           f"as a child process {c['process']['worst_p99_jitter_ms']:.2f} ms")
     if args.json:
-        from feelflow.app.files import write_json_atomic
+        from feelflow.app.files import save_json
 
-        write_json_atomic(args.json, r)
+        save_json(args.json, r)
     return 0 if r["force_within_max"] else 1

@@ -9,7 +9,6 @@ time; the CPU figure is steadier on a shared machine). Figures from a busy machi
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
 import time
@@ -80,10 +79,9 @@ def main(argv=None) -> int:
     for r in rows:
         print(f"| {r['grid']} | {r['dtype']} | {r['scene']} | {r['mlups']} | {r['mlups_per_cpu_s']} |")
     if args.json:
-        tmp = args.json + ".tmp"
-        with open(tmp, "w") as fh:
-            json.dump({"numpy": np.__version__, "cpus": os.cpu_count(), "results": rows}, fh, indent=1)
-        os.replace(tmp, args.json)
+        from feelflow.app.files import save_json
+
+        save_json(args.json, {"numpy": np.__version__, "cpus": os.cpu_count(), "results": rows})
     return 0
 
 

@@ -6,7 +6,6 @@ drags it) and reports the median and the fastest of `--repeats` batches.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import platform
@@ -73,8 +72,9 @@ def main(argv=None) -> int:
         print(f"{name:30s} {med * 1e3:10.3f} {best * 1e3:8.3f} {results[-1]['solid_nodes']:6d} "
               f"{results[-1]['cut_links']:9d}")
     if args.json:
-        with open(args.json, "w", encoding="utf-8") as f:
-            json.dump(results, f, indent=2)
+        from feelflow.app.files import save_json
+
+        save_json(args.json, results)   # the output policy: atomic, a failed write says where it went
     return 0
 
 

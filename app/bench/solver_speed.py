@@ -346,7 +346,7 @@ def main(args) -> int:
             print(f"gl / numpy, {key}: {ratio:.2f}x" + (f" (median of the rounds: {', '.join(f'{v:.2f}' for v in each)})"
                                                    if len(each) > 1 else ""))
     if getattr(args, "json", None):
-        from feelflow.app.files import write_json_atomic
+        from feelflow.app.files import save_json
 
-        write_json_atomic(args.json, result)
+        save_json(args.json, result)
     return 0

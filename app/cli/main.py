@@ -24,8 +24,16 @@ COMMANDS = {
 }
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with a bad command line reported like every other user error: one line, exit 2."""
+
+    def error(self, message):
+        self.exit(2, f"feelflow: {message.splitlines()[0] if message else 'bad command line'} "
+                     f"(see '{self.prog} --help')\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="feelflow", description="FeelFlow: a desktop wind tunnel you can touch")
+    parser = _Parser(prog="feelflow", description="FeelFlow: a desktop wind tunnel you can touch")
     parser.add_argument("--selftest", action="store_true",
                         help="open the real window, exercise it and exit 0 only if everything worked")
     parser.add_argument("--screenshot", metavar="PATH", help="with --selftest: save a screenshot")
@@ -59,7 +67,7 @@ def main(argv=None) -> int:
                 raise
             args._missing = "gui"
         else:
-            sub = argparse.ArgumentParser()
+            sub = _Parser()
             module.add_arguments(sub)
             for key, value in vars(sub.parse_args([])).items():
                 if not hasattr(args, key):

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import math
 import re
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 from feelflow.app.errors import UserError
+from feelflow.app.inputs import MAX_STEPS, check_work
 from feelflow.solver.motion import MOVES, MotionScript, Phase, phase_velocity
 from feelflow.solver import units
 from feelflow.solver.backend import BACKENDS
@@ -99,8 +99,10 @@ class _Table:
         if isinstance(v, bool) or not isinstance(v, int):
             self.reader.fail(self.key(key), f"must be an integer, got {_show(v)}")
         if (lo is not None and v < lo) or (hi is not None and v > hi):
-            rng = f"in {lo}..{hi}" if lo is not None and hi is not None else (
-                f">= {lo}" if lo is not None else f"<= {hi}")
+            if lo is not None and hi is not None and hi < 1_000_000:
+                rng = f"in {lo}..{hi}"
+            else:
+                rng = f">= {lo}" if lo is not None and v < lo else f"<= {hi}"
             self.reader.fail(self.key(key), f"must be an integer {rng}, got {v}")
         return v
 
@@ -158,22 +160,11 @@ def _show(value) -> str:
 
 def load_scene(path) -> Scene:
     """Read and validate a scene file; UserError (one line) on any problem."""
+    from feelflow.app.inputs import load_toml
+
     path = Path(path)
-    source = str(path)
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise UserError(f"{source}: no such scene file") from None
-    except IsADirectoryError:
-        raise UserError(f"{source}: is a directory, not a scene file") from None
-    except PermissionError:
-        raise UserError(f"{source}: cannot be read (permission denied)") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise UserError(f"{source}: not valid TOML: {str(exc).splitlines()[0]}") from None
-    except UnicodeDecodeError:
-        raise UserError(f"{source}: not valid TOML: not UTF-8 text") from None
-    return scene_from_dict(data, source)
+    data = load_toml(path, "scene file")   # regular file, size, depth and number bounds first
+    return scene_from_dict(data, str(path))
 
 
 def scene_from_dict(data: dict, source: str = "scene") -> Scene:
@@ -193,9 +184,21 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
     dtype = flow.choice("dtype", DTYPES, "float64")
     x_boundary = flow.choice("x_boundary", X_BOUNDARIES, "tunnel")
     walls = flow.choice("walls", Y_BOUNDARIES, "no_slip")
+    if x_boundary == "periodic":   # a periodic domain has no inlet: its settings would be ignored
+        for key in ("inflow_speed", "inflow_profile", "inflow_ramp_steps", "sponge_cells",
+                    "sponge_strength", "sponge_absorb"):
+            if flow.has(key):
+                reader.fail(f"flow.{key}", "has no effect with flow.x_boundary = \"periodic\" (no inlet); "
+                                           "remove it, or drive the flow with flow.body_force")
+    if not flow.data.get("sponge_cells"):   # no absorbing layer: its settings would be ignored
+        for key in ("sponge_strength", "sponge_absorb"):
+            if flow.has(key) and x_boundary != "periodic":
+                reader.fail(f"flow.{key}", "has no effect without an absorbing layer (flow.sponge_cells > 0)")
+    if collision == "bgk" and flow.has("trt_magic"):
+        reader.fail("flow.trt_magic", "has no effect with flow.collision = \"bgk\" (it is TRT's parameter)")
     inflow_speed = flow.number("inflow_speed", 0.05 if x_boundary == "tunnel" else 0.0, nonnegative=True)
     inflow_profile = flow.choice("inflow_profile", PROFILES, "uniform")
-    ramp = flow.integer("inflow_ramp_steps", 1000, lo=0)
+    ramp = flow.integer("inflow_ramp_steps", 1000, lo=0, hi=MAX_STEPS)
     sponge_cells = flow.integer("sponge_cells", 0, lo=0)
     sponge_strength = flow.number("sponge_strength", 10.0, positive=True)
     sponge_absorb = flow.number("sponge_absorb", 0.0, nonnegative=True)
@@ -235,12 +238,12 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
             reader.fail("output.forces", f"unknown force model {m!r}; choose from {', '.join(MODELS)}")
     if len(set(models)) != len(models):
         reader.fail("output.forces", "names a force model twice")
-    interval = output.integer("interval", 100, lo=1)
+    interval = output.integer("interval", 100, lo=1, hi=MAX_STEPS)
     output.done()
 
     run = top.table("run")
     default_steps = script.total_steps if script.total_steps > 0 else None
-    steps = run.integer("steps", default_steps if default_steps else MISSING, lo=1)
+    steps = run.integer("steps", default_steps if default_steps else MISSING, lo=1, hi=MAX_STEPS)
     backend = run.choice("backend", sorted(BACKENDS), "numpy")
     run.done()
     top.done()
@@ -263,11 +266,12 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
             message = f"gives nu = {nu:.4g}, which is {message}"
         reader.fail(key, message)
 
+    check_work(nx, ny, steps, source, "run.steps")
     for i, phase in enumerate(phases):
         if math.hypot(*phase.velocity) > config.max_speed:
             reader.fail(f"motion[{i}]", f"body speed {math.hypot(*phase.velocity):.4g} exceeds the Mach limit "
                                         f"{config.max_speed:.4f} (Ma {config.mach_limit})")
-    _check_path_inside(reader, body, script, steps, nx, ny)
+    check_path_inside(source, body, script, steps, nx, ny)
 
     return Scene(source=source, config=config, body=body, motion=script, force_models=tuple(models),
                  output_interval=interval, steps=steps, backend=backend,
@@ -332,7 +336,7 @@ def _phases(reader: _Reader, motion, inflow_speed: float) -> list[Phase]:
     phases = []
     for i, item in enumerate(motion):
         t = _Table(reader, item, f"motion[{i}]")
-        steps = t.integer("steps", lo=1)
+        steps = t.integer("steps", lo=1, hi=MAX_STEPS)
         if t.has("velocity") and t.has("move"):
             reader.fail(t.key("move"), "give either move or velocity, not both")
         if t.has("velocity"):
@@ -348,8 +352,10 @@ def _phases(reader: _Reader, motion, inflow_speed: float) -> list[Phase]:
     return phases
 
 
-def _check_path_inside(reader: _Reader, body, script: MotionScript, steps: int, nx: int, ny: int) -> None:
-    """The body must stay inside the domain (with a margin) for the whole run."""
+def check_path_inside(source: str, body, script: MotionScript, steps: int, nx: int, ny: int) -> None:
+    """The body must stay inside the domain (with a margin) for the whole run of `steps` steps
+    (the scene's, or a command line's --steps); UserError naming `source` otherwise."""
+    reader = _Reader(source)
     xmin, ymin, xmax, ymax = body.bounding_box()
     for t, (dx, dy) in script.extreme_displacements(steps):
         if (xmin + dx < EDGE_MARGIN or ymin + dy < EDGE_MARGIN

@@ -11,7 +11,6 @@ import math
 import os
 import platform
 import time
-import tomllib
 from pathlib import Path
 
 from feelflow.app.errors import UserError
@@ -36,15 +35,12 @@ QUICK = {"phase_steps": 40, "steps": 80, "ramp": 20}
 
 def load_scene_with(path: Path, *, phase_steps=None, steps=None, inflow_speed=None, ramp=None, interval=None):
     """A scene file with some keys replaced, validated like any scene (app/model/scene.py)."""
+    from feelflow.app.inputs import load_toml
     from feelflow.app.model.scene import scene_from_dict
 
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise UserError(f"{path}: no such scene file (the report needs the scenes shipped in scenes/)") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise UserError(f"{path}: not valid TOML: {str(exc).splitlines()[0]}") from None
+    if not Path(path).exists():
+        raise UserError(f"{path}: no such scene file (the report needs the scenes shipped in scenes/)")
+    data = load_toml(path, "scene file")   # the input policy: regular file, bounds (app/inputs.py)
     if phase_steps is not None:
         for phase in data.get("motion", []):
             phase["steps"] = phase_steps

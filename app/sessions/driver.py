@@ -130,6 +130,7 @@ class SessionSolver:
         body = self._body_row()
         try:
             self._solver.step(n)
+            self._check_physical()
         except SolverDiverged as exc:
             done = max(1, min(n, exc.step - start))
             self._record_row(done, {m: (math.nan, math.nan) for m in self.models}, body)
@@ -161,10 +162,22 @@ class SessionSolver:
         part["done"] += k
         if part["done"] < row_steps:
             return False
+        try:
+            self._check_physical()
+        except SolverDiverged:
+            self._part = None
+            self._record_row(row_steps, {m: (math.nan, math.nan) for m in self.models}, part["body"])
+            raise
         self._part = None
         self._record_row(row_steps, {m: (sx / row_steps, sy / row_steps) for m, (sx, sy) in sums.items()},
                          part["body"])
         return True
+
+    def _check_physical(self) -> None:
+        """SolverDiverged when the flow left the physical range (solver.backend.Solver.check_physical)."""
+        check = getattr(self._solver, "check_physical", None)
+        if check is not None:
+            check()
 
     @property
     def partial_steps(self) -> int:

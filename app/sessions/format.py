@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from feelflow.app.sessions.bounds import MAX_FILE_BYTES, MAX_JSON_BYTES, check_npz, member_limits
 from feelflow.solver.config import ConfigError, FlowConfig
 
 FORMAT = "feelflow-session"
@@ -36,7 +37,8 @@ INPUTS = "inputs.npz"
 FORCES = "forces.npz"
 STATE = "state.npz"  # only when the recording started on a running flow (manifest "start")
 MEMBERS = (MANIFEST, PARAMETERS, INPUTS, FORCES)
-#: largest uncompressed member we read (a zip bomb is refused before it is inflated)
+#: largest uncompressed member we read (a zip bomb is refused before it is inflated); the
+#: array members are bounded tighter, by the rows and grid the manifest declares
 MAX_MEMBER_BYTES = 1 << 30
 
 #: parameter name -> what its value is (docs/reference/session-format.md, "Parameter changes")
@@ -194,7 +196,7 @@ def _fmt(v) -> str:
 def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
     """Write `data` through `feelflow.app.files.atomic_path` (temp file beside, fsync, os.replace): never
     half a file. SessionError naming the path if it cannot (the old file is left as it was)."""
-    from feelflow.app.files import atomic_path
+    from feelflow.app.files import atomic_path, rescue_path
 
     path = Path(path)
     if path.is_dir():
@@ -203,7 +205,13 @@ def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
         with atomic_path(path, suffix=".tmp") as tmp:
             tmp.write_bytes(data)
     except OSError as exc:
-        raise SessionError(f"{path}: cannot write {what} ({exc.strerror or exc})") from None
+        try:   # the work is not lost: it goes to a new file in the temp folder
+            saved = rescue_path(path)
+            saved.write_bytes(data)
+            where = f"it was saved to {saved} instead"
+        except OSError:
+            where = "no rescue copy could be written either"
+        raise SessionError(f"{path}: cannot write {what} ({exc.strerror or exc}); {where}") from None
     return path
 
 
@@ -239,15 +247,20 @@ def load_session(path) -> Session:
     def fail(message):
         raise SessionError(f"{src}: {message}")
 
-    if path.is_dir():
-        fail("is a directory, not a session file")
+    from feelflow.app.errors import UserError
+    from feelflow.app.inputs import check_regular_file
+
+    try:   # a regular file of bounded size, checked before opening (a pipe never blocks)
+        check_regular_file(path, "session file", MAX_FILE_BYTES)
+    except UserError as exc:
+        raise SessionError(str(exc)) from None
     try:
         zf = zipfile.ZipFile(path)
     except FileNotFoundError:
         fail("no such session file")
     except PermissionError:
         fail("cannot be read (permission denied)")
-    except (zipfile.BadZipFile, EOFError, OSError):
+    except (zipfile.BadZipFile, EOFError, OSError, ValueError, NotImplementedError, RuntimeError):
         fail("not a FeelFlow session file (not a zip archive; truncated or another kind of file)")
     with zf:
         names = set(zf.namelist())
@@ -255,16 +268,28 @@ def load_session(path) -> Session:
         if missing:
             fail(f"not a complete session file: member {missing[0]} is missing")
         data = {}
-        for member in MEMBERS + ((STATE,) if STATE in names else ()):
+
+        def read(member, limit):
             info = zf.getinfo(member)
-            if info.file_size > MAX_MEMBER_BYTES:
-                fail(f"{member} is {info.file_size} bytes uncompressed (limit {MAX_MEMBER_BYTES})")
+            if info.file_size > limit:
+                fail(f"{member} is {info.file_size} bytes uncompressed, more than this session can hold "
+                     f"({limit} bytes, from the rows and grid it declares)")
             try:
-                data[member] = zf.read(member)
+                with zf.open(member) as fh:   # never more than the bound, whatever the header says
+                    raw = fh.read(limit + 1)
             except (zipfile.BadZipFile, zlib.error, EOFError, OSError, NotImplementedError,
                     RuntimeError) as exc:
                 fail(f"{member} is damaged ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})")
-    manifest = _json_member(data[MANIFEST], MANIFEST, fail)
+            if len(raw) > limit:
+                fail(f"{member} inflates to more than {limit} bytes")
+            data[member] = raw
+
+        read(MANIFEST, MAX_JSON_BYTES)
+        read(PARAMETERS, MAX_JSON_BYTES)
+        manifest = _json_member(data[MANIFEST], MANIFEST, fail)
+        limits = member_limits(manifest, fail, MANIFEST, (INPUTS, FORCES, STATE))
+        for member in (INPUTS, FORCES) + ((STATE,) if STATE in names else ()):
+            read(member, limits[member])
     parameters = _json_member(data[PARAMETERS], PARAMETERS, fail)
     starts = isinstance(manifest, dict) and manifest.get("start") is not None
     if starts and STATE not in data:
@@ -280,15 +305,18 @@ def load_session(path) -> Session:
 
 
 def _json_member(raw: bytes, member: str, fail):
+    """Strict JSON (app/inputs.py: depth, integer size, no NaN)."""
+    from feelflow.app.errors import UserError
+    from feelflow.app.inputs import loads_json
+
     try:
-        return json.loads(raw.decode("utf-8"), parse_constant=lambda c: fail(f"{member}: {c} is not allowed"))
-    except UnicodeDecodeError:
-        fail(f"{member} is not UTF-8 text")
-    except json.JSONDecodeError as exc:
-        fail(f"{member} is not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg})")
+        return loads_json(raw, member)
+    except UserError as exc:
+        fail(str(exc))
 
 
 def _npz_member(raw: bytes, member: str, spec: dict, fail) -> dict:
+    check_npz(raw, member, fail)
     try:
         with np.load(io.BytesIO(raw), allow_pickle=False) as npz:
             names = set(npz.files)
@@ -502,11 +530,11 @@ def _validate_parameters(parameters, config: FlowConfig) -> list:
     return out
 
 
-def export_csv(session: Session, path, values=None) -> Path:
+def export_csv(session: Session, path, values=None, rows: int | None = None) -> Path:
     """Write the force series as CSV (`force_columns`), atomically; `values` replaces the
-    recorded forces (e.g. a replay's)."""
+    recorded forces (e.g. a replay's); `rows` keeps only the first rows (a diverged replay's)."""
     lines = [",".join(force_columns(session.models))]
-    lines += [",".join(row) for row in session.csv_rows(values)]
+    lines += [",".join(row) for row in session.csv_rows(values)][:rows]
     return atomic_write_bytes(path, ("\n".join(lines) + "\n").encode(), "CSV file")
 
 

@@ -19,6 +19,7 @@ def add_arguments(parser):
     parser.add_argument("target", nargs="?", default="solver", choices=sorted(TARGETS),
                         help="what to measure (default: solver)")
     parser.add_argument("--json", metavar="PATH", help="also write the results as JSON")
+    parser.add_argument("--force", action="store_true", help="replace --json if it exists")
     parser.add_argument("--device", metavar="URL", default="sim://haply2diy",
                         help="haptics: the device to run the loop against (default: a simulator)")
     parser.add_argument("--seconds", type=float, default=None, help="how long to measure")
@@ -34,4 +35,15 @@ def add_arguments(parser):
 
 
 def main(args) -> int:
+    import math
+
+    from feelflow.app.errors import UserError
+    from feelflow.app.files import check_output
+
+    if args.seconds is not None and not (math.isfinite(args.seconds) and 0 < args.seconds <= 3600):
+        raise UserError(f"--seconds: must be a number in (0, 3600], got {args.seconds!r}")
+    if args.rounds is not None and args.rounds > 100:   # (fewer than 1: the solver bench says so)
+        raise UserError(f"--rounds: at most 100, got {args.rounds!r}")
+    if args.json:   # before the measuring starts
+        check_output(args.json, "--json", force=args.force)
     return importlib.import_module(TARGETS[args.target]).main(args)

@@ -37,6 +37,7 @@ def add_arguments(parser):
                         help="lessons: also run each one plain (no absorbing layer, wind everywhere from the "
                              "first step, sudden wind changes); scenes: also without the absorbing layer")
     parser.add_argument("--json", default=None, metavar="PATH", help="lessons, scenes: also write the runs as JSON")
+    parser.add_argument("--force", action="store_true", help="replace --json if it exists")
     parser.add_argument("--scenes", default="scenes", metavar="DIR", help="folder holding the scenes (default: scenes)")
     parser.add_argument("--out", default="docs/science", metavar="DIR",
                         help="folder for seed-report.md and seed-report/ (default: docs/science)")
@@ -45,6 +46,10 @@ def add_arguments(parser):
 
 
 def main(args) -> int:
+    from feelflow.app.files import check_output
+
+    if args.json:   # before any run
+        check_output(args.json, "--json", force=args.force)
     if args.target == "lessons":
         return lessons(args)
     if args.target == "scenes":
@@ -141,9 +146,9 @@ def _print_runs(runs: list[dict], table: str, json_path: str | None) -> int:
     import json
 
     from feelflow.app.bench.solver_speed import machine
-    from feelflow.app.files import write_text_atomic
+    from feelflow.app.files import save_text
 
     print(table)
     if json_path:
-        write_text_atomic(json_path, json.dumps({"machine": machine(), "runs": runs}, indent=1) + "\n")
+        save_text(json_path, json.dumps({"machine": machine(), "runs": runs}, indent=1) + "\n", "--json")
     return 0

@@ -26,6 +26,9 @@ def add_arguments(parser):
     parser.add_argument("--out", default="forces.csv", metavar="PATH", help="CSV file to write (default: forces.csv)")
     parser.add_argument("--record", default=None, metavar="FILE.ffsession",
                         help="also record the run as a session file (docs/reference/session-format.md)")
+    parser.add_argument("--force", action="store_true",
+                        help="replace --out / --record if they exist (never the scene itself; "
+                             "without --force an existing file is refused before the run starts)")
 
 
 def positive_int_option(name: str, text):
@@ -39,17 +42,17 @@ def positive_int_option(name: str, text):
     return value
 
 
-def write_csv_atomic(path: Path, header, rows) -> None:
-    """Write a CSV next to its destination, then rename it into place (never half a file)."""
-    directory = path.parent if str(path.parent) else Path(".")
-    if not directory.is_dir():
-        raise UserError(f"--out: directory {str(directory)!r} does not exist")
-    from feelflow.app.files import atomic_path
+def write_csv_atomic(path: Path, header, rows, option: str = "--out") -> Path:
+    """Write a CSV next to its destination, then rename it into place (never half a file); if
+    that fails, the rows go to a rescue file and OutputError (one line) says where."""
+    from feelflow.app.files import atomic_path, write_or_rescue
 
-    with atomic_path(path, suffix=".tmp") as tmp, open(tmp, "w", newline="") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(header)
-        writer.writerows(rows)
+    def write(target):
+        with atomic_path(target, suffix=".tmp") as tmp, open(tmp, "w", newline="") as fh:
+            writer = csv.writer(fh)
+            writer.writerow(header)
+            writer.writerows(rows)
+    return write_or_rescue(path, write, option)
 
 
 def _fmt(v: float) -> str:
@@ -60,22 +63,34 @@ def main(args) -> int:
     from feelflow.app.headless import make_solver
     from feelflow.app.model.scene import load_scene
 
+    from feelflow.app.files import check_output
+    from feelflow.app.inputs import check_work
+    from feelflow.app.model.scene import check_path_inside
+
     scene = load_scene(args.scene)
-    warn_outside_stable_region(scene, args.scene)
     backend = args.backend if args.backend is not None else scene.backend
+    from feelflow.solver.backend import BACKENDS
+    if backend not in BACKENDS:   # before the run and its outputs
+        raise UserError(f"--backend: must be one of {', '.join(sorted(BACKENDS))}, got {backend!r}")
     steps = positive_int_option("--steps", args.steps) if args.steps is not None else scene.steps
-    out = Path(args.out)
-    if out.is_dir():
-        raise UserError(f"--out: {args.out!r} is a directory")
-    if not (out.parent if str(out.parent) else Path(".")).is_dir():
-        raise UserError(f"--out: directory {str(out.parent)!r} does not exist")
+    if args.steps is not None:   # the command line's steps: the same bounds as the scene's
+        check_work(scene.config.nx, scene.config.ny, steps, "--steps", "--steps")
+        check_path_inside(f"{args.scene} with --steps {steps}", scene.body, scene.motion, steps,
+                          scene.config.nx, scene.config.ny)
+    # every output is checked before the run: never an input, never twice, never a device
+    out = check_output(args.out, "--out", inputs=[args.scene], force=args.force)
+    if args.record:
+        check_output(args.record, "--record", inputs=[args.scene], others=[args.out], force=args.force)
+    warn_outside_stable_region(scene, args.scene)
 
     solver = make_solver(backend, scene.config)
     recorder = None
     if args.record:
+        from feelflow.app.inputs import read_bytes
         from feelflow.app.sessions import record_headless
 
-        solver, recorder = record_headless(solver, scene, scene_toml=Path(args.scene).read_text())
+        toml_text = read_bytes(args.scene, "scene file").decode("utf-8")
+        solver, recorder = record_headless(solver, scene, scene_toml=toml_text)
     try:
         # a blow-up is detected and reported in one line, not as floating-point warnings
         with warnings.catch_warnings(), np.errstate(all="ignore"):
@@ -84,16 +99,23 @@ def main(args) -> int:
     finally:
         solver.close()
 
-    write_csv_atomic(out, header, rows)
+    csv_error = None
+    try:
+        write_csv_atomic(out, header, rows)
+    except UserError as exc:   # the rows went to a rescue file; the session is still saved
+        csv_error = exc
     if recorder is not None:
         from feelflow.app.sessions import SessionError
 
         try:
             recorder.save(args.record)
         except SessionError as exc:
-            raise UserError(str(exc)) from None
+            forces = "the forces too could not be written" if csv_error else f"the forces are in {out}"
+            raise UserError(f"--record: {exc}; {forces}") from None
+    if csv_error is not None:
+        raise csv_error
     if diverged is not None:
-        print(f"feelflow: the simulation diverged (NaN) within steps {diverged[0]}..{diverged[1]}; "
+        print(f"feelflow: the simulation diverged within steps {diverged[0]}..{diverged[1]} ({diverged[2]}); "
               f"the {len(rows)} rows before it are in {out}. Lower the speeds or raise the viscosity "
               f"or the resolution.", file=sys.stderr)
         return 1
@@ -130,8 +152,8 @@ def warn_outside_stable_region(scene, name) -> bool:
 def run_scene(scene, solver, steps: int):
     """Step `scene` in `solver` along its motion script for `steps` steps.
 
-    Returns (header, rows, wall seconds, None or (first, last) step of the interval in which the
-    flow diverged)."""
+    Returns (header, rows, wall seconds, None or (first, last step of the interval in which the
+    flow diverged, why)); the rows stop at the last interval whose flow was physical."""
     from feelflow.solver import backend as backends
     from feelflow.solver.motion import MotionRunner
 
@@ -148,12 +170,13 @@ def run_scene(scene, solver, steps: int):
         n = min(scene.output_interval, steps - t0)
         velocity = scene.motion.velocity_at(t0 + n - 1)
         try:
-            forces = runner.advance(n)
-        except diverged_error:
-            return header, rows, time.perf_counter() - start, (t0, t0 + n)
+            forces = runner.advance(n)   # checks the flow's physical range (Solver.check_physical)
+        except diverged_error as exc:
+            detail = str(exc).split(": ", 1)[-1].split(" (lower")[0]
+            return header, rows, time.perf_counter() - start, (t0, t0 + n, detail)
         values = [v for m in scene.force_models for v in forces[m]]
         if not all(math.isfinite(v) for v in values) or not math.isfinite(solver.total_mass()):
-            return header, rows, time.perf_counter() - start, (t0, t0 + n)
+            return header, rows, time.perf_counter() - start, (t0, t0 + n, "NaN")
         x, y = runner.position
         rows.append([runner.t] + [_fmt(v) for v in (x, y, *velocity, *values)])
     return header, rows, time.perf_counter() - start, None

@@ -7,9 +7,13 @@ Format: docs/reference/session-format.md. A bad file is one line on stderr and e
 from __future__ import annotations
 
 import json
+import math
 import sys
 
+import numpy as np
+
 from feelflow.app.errors import UserError
+from feelflow.app.files import check_output
 
 
 def add_arguments(parser):
@@ -25,10 +29,14 @@ def add_arguments(parser):
                    help="exit 1 unless the replay reproduces the recorded forces within --tolerance")
     p.add_argument("--tolerance", default="1e-12", metavar="REL",
                    help="--check: largest deviation relative to the largest recorded force (default 1e-12)")
+    p.add_argument("--force", action="store_true",
+                   help="replace --out if it exists (never the session itself)")
     p = sub.add_parser("export", help="write the recorded force series as CSV and/or the manifest as JSON")
     p.add_argument("file", metavar="FILE")
     p.add_argument("--csv", default=None, metavar="PATH", help="the force series (columns as `feelflow run`)")
     p.add_argument("--manifest", default=None, metavar="PATH", help="the manifest as JSON")
+    p.add_argument("--force", action="store_true",
+                   help="replace --csv / --manifest if they exist (never the session itself)")
 
 
 def _load(path):
@@ -90,8 +98,10 @@ def replay(args) -> int:
         tolerance = float(args.tolerance)
     except ValueError:
         raise UserError(f"--tolerance: must be a number, got {args.tolerance!r}") from None
-    if not tolerance >= 0:
-        raise UserError(f"--tolerance: must be zero or positive, got {args.tolerance!r}")
+    if not tolerance >= 0 or not math.isfinite(tolerance):
+        raise UserError(f"--tolerance: must be a finite number, zero or positive, got {args.tolerance!r}")
+    if args.out:
+        check_output(args.out, "--out", inputs=[args.file], force=args.force)
     s = _load(args.file)
     backend = args.backend or s.backend
     factory = _make_factory(backend)
@@ -99,14 +109,20 @@ def replay(args) -> int:
         result = run_replay(s, backend, factory=factory)
     except SessionError as exc:
         raise UserError(str(exc)) from None
+    rows = None
+    if result.diverged_at is not None:   # rows after the last physical one are dropped
+        rows = int(np.count_nonzero(s.forces["step"] < result.diverged_at))
     if args.out:
-        _write(export_csv, s, args.out, result.values)
+        _write(export_csv, s, args.out, result.values, rows)
     same = "same backend" if backend == s.backend else f"recorded on {s.backend}"
     print(f"{args.file}: replayed {s.steps} steps on {backend} ({same}); largest force deviation "
           f"{result.max_deviation:.3g} ({result.relative_deviation:.3g} of the largest recorded force "
           f"{result.max_force:.4g})" + (f"; wrote {args.out}" if args.out else ""))
     if result.diverged_at is not None:
-        print(f"feelflow: the replay diverged at step {result.diverged_at}", file=sys.stderr)
+        kept = f"; the {rows} rows before it are in {args.out}" if args.out else ""
+        print(f"feelflow: the replay diverged at step {result.diverged_at} (the flow left the physical "
+              f"range){kept}", file=sys.stderr)
+        return 1
     if args.check and not result.relative_deviation <= tolerance:
         print(f"feelflow: replay check failed: relative deviation {result.relative_deviation:.3g} "
               f"> tolerance {tolerance:g}", file=sys.stderr)
@@ -119,6 +135,10 @@ def export(args) -> int:
 
     if not args.csv and not args.manifest:
         raise UserError("session export: give --csv PATH and/or --manifest PATH")
+    if args.csv:
+        check_output(args.csv, "--csv", inputs=[args.file], force=args.force)
+    if args.manifest:
+        check_output(args.manifest, "--manifest", inputs=[args.file], others=[args.csv], force=args.force)
     s = _load(args.file)
     if args.csv:
         _write(export_csv, s, args.csv)

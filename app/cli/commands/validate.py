@@ -24,10 +24,16 @@ def add_arguments(parser):
                              "default: each case's own")
     parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
     parser.add_argument("--json", default=None, metavar="PATH", help="also write the results as JSON")
+    parser.add_argument("--force", action="store_true", help="replace --json if it exists")
     parser.add_argument("--quick", action="store_true", help="small grids and short runs (the test-suite versions)")
     parser.add_argument("--refine", action="store_true",
                         help="the Schaefer-Turek cases with the cylinder and its near wake in a patch of twice the "
                              "resolution (numpy only; solver/refinement.py); default cases: those two")
+
+
+#: the largest --resolution (cells per diameter): the Schaefer-Turek channel is 22 x 4.1
+#: diameters, so 400 cells a diameter is already 3.6 million nodes (app/inputs.py's MAX_NODES)
+MAX_RESOLUTION = 400
 
 
 def machine_description() -> str:
@@ -65,7 +71,7 @@ def write_json_atomic(path: Path, data) -> None:
         raise UserError(f"--json: directory {str(directory)!r} does not exist")
     from feelflow.app import files
 
-    files.write_json_atomic(path, data)
+    files.save_json(path, data, "--json")
 
 
 def refinable(name: str) -> bool:
@@ -95,6 +101,8 @@ def run_case(name: str, factory, resolution, quick: bool, backend: str, refine: 
             warnings.simplefilter("ignore", RuntimeWarning)
             extra = {"refine": True} if refine else {}
             result = module.run(factory, resolution=resolution, quick=quick, backend=backend, **extra)
+    except ValueError as exc:   # ConfigError, ShapeError: the resolution gives an impossible grid
+        raise UserError(f"--resolution: {name}: {str(exc).splitlines()[0]}") from None
     except backends.SolverDiverged as exc:
         n = resolution or (module.QUICK_RESOLUTION if quick else module.DEFAULT_RESOLUTION)
         result = CaseResult(name, backend, n, quantities={"stable": 0.0, "diverged_at_step": float(exc.step)},
@@ -129,10 +137,13 @@ def main(args) -> int:
                 check(resolution)
             except ValueError as exc:
                 raise UserError(f"--resolution: {name}: {exc}") from None
-    if args.json is not None and Path(args.json).is_dir():
-        raise UserError(f"--json: {args.json!r} is a directory")
-    if args.json is not None and not (Path(args.json).parent if str(Path(args.json).parent) else Path(".")).is_dir():
-        raise UserError(f"--json: directory {str(Path(args.json).parent)!r} does not exist")
+    if resolution is not None and resolution > MAX_RESOLUTION:
+        raise UserError(f"--resolution: at most {MAX_RESOLUTION} cells per diameter (a larger grid would not "
+                        f"fit this machine's memory), got {resolution}")
+    if args.json is not None:   # before the cases run
+        from feelflow.app.files import check_output
+
+        check_output(args.json, "--json", force=args.force)
 
     def factory(config):
         return make_solver(args.backend, config)

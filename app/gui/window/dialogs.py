@@ -4,12 +4,14 @@ from __future__ import annotations
 
 from PySide6.QtWidgets import QMessageBox, QWidget
 
+from feelflow.app.errors import UserError
+
 
 def attempt(parent: QWidget, fn, title: str):
-    """fn()'s result, or None after a one-line dialog when it raised OSError or ValueError
-    (ValueError: ShapeError, SessionError, ConfigError, each one line)."""
+    """fn()'s result, or None after a one-line dialog when it raised OSError, ValueError
+    (ShapeError, SessionError, ConfigError) or UserError, each one line."""
     try:
         return fn()
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, UserError) as exc:
         QMessageBox.warning(parent, title, str(exc))
         return None

@@ -4,11 +4,15 @@ defaults one by one."""
 from __future__ import annotations
 
 import json
+import math
 from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QSettings
 
+from feelflow.app.errors import UserError
+from feelflow.app.inputs import MAX_NODES, loads_json
 from feelflow.app.model.simulation import Params
+from feelflow.shapes.polygon import MAX_VERTICES
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
@@ -26,15 +30,18 @@ class WindowSettings:
         d = Params()
         s = self.qsettings
 
-        def get(key, default, kind):
+        def get(key, default, kind):   # a settings file is input too: bad values fall back
             try:
-                return kind(s.value(key, default))
-            except (TypeError, ValueError):
+                value = kind(s.value(key, default))
+            except (TypeError, ValueError, OverflowError):
                 return default
-        grid = str(s.value("grid", f"{d.grid[0]}x{d.grid[1]}"))
+            return value if kind is not float or math.isfinite(value) else default
+        grid = str(s.value("grid", f"{d.grid[0]}x{d.grid[1]}"))[:32]
         try:
             grid = tuple(int(v) for v in grid.split("x"))
         except ValueError:
+            grid = d.grid
+        if len(grid) != 2 or not all(8 <= v <= 8192 for v in grid) or grid[0] * grid[1] > MAX_NODES:
             grid = d.grid
         return Params(grid=grid if len(grid) == 2 else d.grid, shape=get("shape", d.shape, str),
                       size=get("size", d.size, float), angle_deg=get("angle_deg", d.angle_deg, float),
@@ -44,10 +51,13 @@ class WindowSettings:
 
     def polygon(self):
         """The remembered polygon's vertices (body frame), or None."""
-        try:
-            verts = json.loads(str(self.qsettings.value("polygon", "null")))
-            return [(float(x), float(y)) for x, y in verts] if verts else None
-        except (TypeError, ValueError):
+        try:   # bounded like every input (app/inputs.py); a bad value is forgotten
+            verts = loads_json(str(self.qsettings.value("polygon", "null")).encode(), "settings")
+            if not verts or len(verts) > MAX_VERTICES:
+                return None
+            pts = [(float(x), float(y)) for x, y in verts]
+            return pts if all(map(math.isfinite, (c for v in pts for c in v))) else None
+        except (TypeError, ValueError, OverflowError, UserError):
             return None
 
     def display_mode(self, modes) -> str:

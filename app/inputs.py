@@ -1,0 +1,182 @@
+"""Every file FeelFlow reads goes through here first: one input policy (docs/reference/files.md).
+
+A path must name a regular file (checked with `stat` before opening, so a named pipe never
+blocks and a device is never read), no larger than the type's bound; text is parsed only after
+the bound, and the parsed document is checked for nesting depth and for numbers a scene or
+shape could never need (integers of more than 15 digits, lists of more than `MAX_ITEMS`).
+Problems are a `UserError`, one line naming the file and what is wrong.
+"""
+from __future__ import annotations
+
+import json
+import os
+import stat
+import tomllib
+
+from feelflow.app.errors import UserError
+
+#: largest scene (TOML) or JSON document read, bytes (the largest example scene is ~2 KB)
+MAX_TEXT_BYTES = 1 << 20
+#: deepest nesting of tables/lists a document may have (a scene needs 4)
+MAX_DEPTH = 16
+#: largest |integer| in a document (2**53: every integer a float can hold exactly)
+MAX_INTEGER = 2 ** 53
+#: most items in one list (a polygon's vertices: shapes.polygon.MAX_VERTICES)
+MAX_ITEMS = 10_000
+
+
+def check_regular_file(path, what: str = "file", max_bytes: int | None = None) -> int:
+    """The file's size; UserError when `path` is missing, not a regular file, or larger than
+    `max_bytes`. Never opens the file (a FIFO cannot block)."""
+    src = str(path)
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise UserError(f"{src}: no such {what}") from None
+    except OSError as exc:
+        raise UserError(f"{src}: cannot be read ({exc.strerror or exc})") from None
+    except ValueError:   # a NUL byte in the name
+        raise UserError(f"{src!r}: not a valid file name") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise UserError(f"{src}: is a directory, not a {what}")
+    if not stat.S_ISREG(st.st_mode):
+        raise UserError(f"{src}: not a regular file (a pipe, device or socket); refused")
+    if max_bytes is not None and st.st_size > max_bytes:
+        raise UserError(f"{src}: {st.st_size} bytes, more than a {what} can be ({max_bytes} bytes)")
+    return st.st_size
+
+
+def read_bytes(path, what: str = "file", max_bytes: int = MAX_TEXT_BYTES) -> bytes:
+    """The file's bytes after `check_regular_file`; opened non-blocking, read up to the bound."""
+    check_regular_file(path, what, max_bytes)
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        raise UserError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    with os.fdopen(fd, "rb") as fh:
+        data = fh.read(max_bytes + 1)
+    if len(data) > max_bytes:
+        raise UserError(f"{path}: more than a {what} can be ({max_bytes} bytes)")
+    return data
+
+
+def check_document(doc, source: str) -> None:
+    """Bound nesting depth, integer size and list length of a parsed document (iteratively)."""
+    stack = [(doc, 1)]
+    while stack:
+        value, depth = stack.pop()
+        if isinstance(value, (dict, list)):
+            if depth > MAX_DEPTH:
+                raise UserError(f"{source}: nested more than {MAX_DEPTH} levels deep")
+            items = value.values() if isinstance(value, dict) else value
+            if isinstance(value, list) and len(value) > MAX_ITEMS:
+                raise UserError(f"{source}: a list of {len(value)} items (at most {MAX_ITEMS})")
+            stack.extend((v, depth + 1) for v in items)
+        elif isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_INTEGER:
+            raise UserError(f"{source}: the integer {str(value)[:12]}... is too large (at most 2**53)")
+
+
+def _text(data: bytes, source: str, kind: str) -> str:
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise UserError(f"{source}: not valid {kind}: not UTF-8 text") from None
+
+
+def _int(text: str):
+    if len(text.lstrip("+-")) > 16:
+        raise ValueError(f"the integer {text[:12]}... is too large (at most 2**53)")
+    return int(text)
+
+
+def _scan_depth(text: str, source: str, opens: str) -> None:
+    """Refuse brackets nested deeper than MAX_DEPTH before a recursive parser sees them (strings
+    are skipped roughly: a bracket inside a quoted string may count, which only errs strict)."""
+    depth = 0
+    in_string = None
+    escape = False
+    for ch in text:
+        if in_string:
+            if escape:
+                escape = False
+            elif ch == "\\" and in_string == '"':
+                escape = True
+            elif ch == in_string or ch == "\n":
+                in_string = None
+            continue
+        if ch in "\"'":
+            in_string = ch
+        elif ch in opens:
+            depth += 1
+            if depth > MAX_DEPTH:
+                raise UserError(f"{source}: nested more than {MAX_DEPTH} levels deep")
+        elif ch in "]}":
+            depth = max(0, depth - 1)
+
+
+def loads_json(data: bytes, source: str):
+    """Strict JSON: UTF-8, no NaN/Infinity, integers of at most 16 digits, bounded depth."""
+    text = _text(data, source, "JSON")
+    _scan_depth(text, source, "[{")
+
+    def constant(name):
+        raise ValueError(f"{name} is not allowed")
+
+    try:
+        doc = json.loads(text, parse_int=_int, parse_constant=constant)
+    except json.JSONDecodeError as exc:
+        raise UserError(f"{source}: not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg})") from None
+    except RecursionError:
+        raise UserError(f"{source}: nested more than {MAX_DEPTH} levels deep") from None
+    except ValueError as exc:
+        raise UserError(f"{source}: not valid JSON: {str(exc).splitlines()[0]}") from None
+    check_document(doc, source)
+    return doc
+
+
+def loads_toml(data: bytes, source: str):
+    """TOML after the same bounds as `loads_json` (depth scanned before parsing)."""
+    text = _text(data, source, "TOML")
+    _scan_depth(text, source, "[{")
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise UserError(f"{source}: not valid TOML: {str(exc).splitlines()[0]}") from None
+    except RecursionError:
+        raise UserError(f"{source}: nested more than {MAX_DEPTH} levels deep") from None
+    except ValueError as exc:
+        if "integer string conversion" in str(exc):
+            raise UserError(f"{source}: an integer is too large (at most 2**53)") from None
+        raise UserError(f"{source}: not valid TOML: {str(exc).splitlines()[0]}") from None
+    check_document(doc, source)
+    return doc
+
+
+def load_json(path, what: str = "JSON file", max_bytes: int = MAX_TEXT_BYTES):
+    return loads_json(read_bytes(path, what, max_bytes), str(path))
+
+
+def load_toml(path, what: str = "TOML file", max_bytes: int = MAX_TEXT_BYTES):
+    return loads_toml(read_bytes(path, what, max_bytes), str(path))
+
+
+# --- counts a file may declare, by what this kind of machine can do ------------------------
+#: most lattice nodes (nx * ny) a scene or session may ask for: 2**22 nodes hold about 600 MB of
+#: float64 populations (two copies of 9 per node), a tenth of a small laptop's memory
+MAX_NODES = 1 << 22
+#: most steps one run or session may declare (about 3 hours at 1000 steps per second)
+MAX_STEPS = 10_000_000
+#: most node updates (nodes x steps) one run may ask for: about 2 hours at 30 MLUPS
+MAX_NODE_STEPS = 2 * 10 ** 11
+
+
+def check_work(nx: int, ny: int, steps: int, source: str, key: str = "steps") -> None:
+    """UserError when a grid or a number of steps is beyond MAX_NODES / MAX_STEPS / MAX_NODE_STEPS."""
+    if nx * ny > MAX_NODES:
+        raise UserError(f"{source}: grid {nx} x {ny} has {nx * ny} nodes, more than {MAX_NODES} "
+                        f"(about 600 MB of populations)")
+    if steps > MAX_STEPS:
+        raise UserError(f"{source}: {key}: {steps} steps, more than {MAX_STEPS} (about 3 hours of running)")
+    if nx * ny * steps > MAX_NODE_STEPS:
+        raise UserError(f"{source}: {key}: {steps} steps on {nx} x {ny} nodes is more than {MAX_NODE_STEPS:.0e} "
+                        f"node updates (about 2 hours at 30 MLUPS)")
