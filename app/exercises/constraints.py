@@ -38,9 +38,11 @@ def area(shape: Shape) -> float:
 def posed(exercise, shape: Shape, scale: int = 1) -> Shape:
     """The shape as the scoring run sees it: centroid at the exercise's body position, then
     every length times `scale` (the same body at `scale` times the resolution)."""
-    cx, cy = centroid(shape)
+    # placed from the shape's own description, not from where it was: the same shape gives the
+    # same digits wherever it was drawn or saved
+    cx, cy = centroid(shape.moved(x=0.0, y=0.0))
     bx, by = exercise.scene.body_x, exercise.scene.body_y
-    shape = shape.moved(x=shape.x + bx - cx, y=shape.y + by - cy)
+    shape = shape.moved(x=bx - cx, y=by - cy)
     if scale == 1:
         return shape
     d = shape.to_dict()
@@ -71,12 +73,23 @@ def thickness(shape: Shape, spacing: float = 0.25) -> float:
     inside = shape.contains(px, py)
     if not inside.any():
         return 0.0
-    return 2.0 * float(shape.boundary_distance(px[inside], py[inside]).max())
+    d = shape.boundary_distance(px[inside], py[inside])
+    k = int(np.argmax(d))
+    # refine around the best sample: the largest circle's centre lies within a sample spacing
+    fine = np.linspace(-spacing, spacing, 21)
+    fx, fy = np.meshgrid(px[inside][k] + fine, py[inside][k] + fine)
+    keep = shape.contains(fx, fy)
+    return 2.0 * max(float(d[k]), float(shape.boundary_distance(fx[keep], fy[keep]).max()))
+
+
+#: solid pieces smaller than this many nodes do not count (a sharp tip leaves a lone node)
+MIN_PIECE_NODES = 4
 
 
 def solid_pieces(shape: Shape, nx: int, ny: int) -> int:
-    """How many separate pieces the body's solid nodes form on the scoring grid (8-connected
-    flood fill): 1 for a body the lattice resolves, more where a part is thinner than a cell."""
+    """How many separate pieces of at least MIN_PIECE_NODES solid nodes the body forms on the
+    scoring grid (8-connected flood fill): 1 for a body the lattice resolves, more where a
+    part of it (a neck, not a sharp tip) is thinner than a cell."""
     from feelflow.shapes.raster import rasterise
 
     raster = rasterise(shape, nx, ny)
@@ -84,17 +97,19 @@ def solid_pieces(shape: Shape, nx: int, ny: int) -> int:
     pieces = 0
     h, w = solid.shape
     while solid.any():
-        pieces += 1
         stack = [tuple(np.argwhere(solid)[0])]
         solid[stack[0]] = False
+        size = 0
         while stack:
             j, i = stack.pop()
+            size += 1
             for dj in (-1, 0, 1):
                 for di in (-1, 0, 1):
                     a, b = j + dj, i + di
                     if 0 <= a < h and 0 <= b < w and solid[a, b]:
                         solid[a, b] = False
                         stack.append((a, b))
+        pieces += size >= MIN_PIECE_NODES
     return pieces
 
 

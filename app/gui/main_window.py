@@ -23,6 +23,7 @@ from feelflow.app.gui.qt_runtime import make_none_immortal
 
 make_none_immortal()  # before any Qt object: see app/qt_runtime.py
 
+from feelflow.app.gui.exercise_controller import ExerciseController  # noqa: E402
 from feelflow.app.gui.force_plot import ForcePlot  # noqa: E402
 from feelflow.app.model.presets import PRESETS
 from feelflow.app.model.bodies import default_polygon
@@ -85,6 +86,7 @@ class MainWindow(QMainWindow):
         self.replay_label = QLabel()   # "Replaying <name>: step N / M" (hidden by passing messages)
         self.statusBar().addWidget(self.replay_label, 1)
         self.replay_label.hide()
+        self.exercises = ExerciseController(self)   # the Exercises menu and panel
         self._build_menus()
 
         self.params = params or self._params_from_settings()
@@ -172,6 +174,7 @@ class MainWindow(QMainWindow):
         self.save_settings()
         self.timer.stop()
         self.slow_timer.stop()
+        self.exercises.shutdown()
         if self.replay is not None:
             self._make_current()
             self.replay.close()
@@ -273,6 +276,7 @@ class MainWindow(QMainWindow):
         p = bar.addMenu("&Presets")
         for key, preset in PRESETS.items():
             self._action(p, preset.title, lambda _=False, k=key: self.apply_preset(k))
+        self.exercises.build_menu(bar, p)
         self.replay_toolbar = QToolBar("Replay", self)   # shown only while a session replays
         self.replay_toolbar.setMovable(False)
         self.replay_toolbar.addAction(self.pause_action)

@@ -79,6 +79,7 @@ class Viewport(QOpenGLWidget):
         self.mode = "speed"
         self.show_arrows = True
         self.editing = False
+        self.body_edge = None    # a QColor for the body's outline instead of BODY_EDGE, or None
         self.arrow_forces = None       # {"drag": (fx, fy), "lift": (fx, fy)} lattice units
         self.tracers = None
         self.frames = 0
@@ -255,7 +256,8 @@ class Viewport(QOpenGLWidget):
             p.drawLine(a, b)
             p.setBrush(Qt.NoBrush)
             p.drawEllipse(b, 6, 6)
-        p.setPen(QPen(BODY_EDGE, 2.5))
+        # an exercise marks a body that breaks a constraint (app/gui/exercise_controller.py)
+        p.setPen(QPen(self.body_edge or BODY_EDGE, 2.5, Qt.DashLine if self.body_edge else Qt.SolidLine))
         p.setBrush(QBrush(BODY_FILL))
         p.drawPolygon(self.body_outline_points())
         if self.editing and sim.polygon is not None:

@@ -1,4 +1,4 @@
-"""`feelflow gui [SESSION]` (the default command) and `feelflow --selftest [--screenshot PATH] [--seconds S]`.
+"""`feelflow gui [SESSION] [--exercise FILE]` (the default command) and `feelflow --selftest [--screenshot PATH] [--seconds S]`.
 
 `feelflow gui FILE.ffsession` opens the window and replays that session in it as soon as the live
 tunnel runs (what File > Replay session does); the desktop entry's `Exec=... gui %f` uses it, so
@@ -25,6 +25,8 @@ def add_arguments(parser):
     parser.add_argument("--backend", choices=("gl", "numpy"), default=None,
                         help=f"solver backend (default {DEFAULT_BACKEND}; numpy uploads the field every frame)")
     parser.add_argument("--fresh", action="store_true", help="ignore remembered settings")
+    parser.add_argument("--exercise", default=None, metavar="FILE",
+                        help="open this exercise file (exercises/*.toml) once the window runs")
 
 
 def has_display() -> bool:
@@ -58,10 +60,23 @@ def replay_when_ready(window, path) -> None:
     window.simulationReady.connect(start)
 
 
+def open_exercise_when_ready(window, path) -> None:
+    """Open the exercise at `path` once, when the window's live simulation first runs."""
+    def start():
+        window.simulationReady.disconnect(start)
+        window.exercises.open(path)
+    window.simulationReady.connect(start)
+
+
 def main(args) -> int:
     session = getattr(args, "session", None)
     if session is not None and not os.path.isfile(session):
         raise UserError(f"{session}: no such session file")
+    exercise = getattr(args, "exercise", None)
+    if exercise is not None:   # a bad exercise file is one line and exit 2, before any window
+        from feelflow.app.exercises.format import load_exercise
+
+        load_exercise(exercise)
     if not has_display():
         raise UserError("no display to open the window on (DISPLAY is not set); "
                         "use 'feelflow run' for a headless run, or run under xvfb-run")
@@ -90,6 +105,8 @@ def main(args) -> int:
     window = MainWindow(backend=backend, settings=settings)
     if session is not None:
         replay_when_ready(window, session)
+    if exercise is not None:
+        open_exercise_when_ready(window, exercise)
     if selftest:
         from feelflow.app.gui.selftest import SelfTest
 
