@@ -364,3 +364,15 @@ def test_ranking_is_the_same_at_twice_the_resolution(tmp_path):
     r = feelflow("exercise", "check", "--convergence", TINY)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "the same" in r.stdout
+
+
+def test_gui_exercise_option_checks_the_file_first(tmp_path):
+    p = tmp_path / "bad.toml"
+    p.write_text("title = 'x'\n")
+    r = feelflow("gui", "--exercise", p)
+    assert r.returncode == 2 and "instructions: missing" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_list_names_the_shipped_exercises():
+    r = feelflow("exercise", "list")
+    assert r.returncode == 0 and len(r.stdout.strip().splitlines()) == len(SHIPPED)

@@ -28,6 +28,8 @@ def add_arguments(parser):
     p.add_argument("shapes", metavar="SHAPES", nargs="+", help="shape JSON files or folders of them")
     p.add_argument("--out", default="scores.csv", metavar="PATH", help="CSV file to write (default: scores.csv)")
     p.add_argument("--workers", default=None, metavar="N", help="processes (default: every core)")
+    p.add_argument("--scale", default=None, metavar="N",
+                   help="score at N times the exercise's resolution (default 1; 2 to confirm a close ranking)")
     p = sub.add_parser("check", help="validate an exercise file and score its reference solutions")
     p.add_argument("exercise", metavar="EXERCISE.toml")
     p.add_argument("--convergence", action="store_true",
@@ -38,12 +40,14 @@ def add_arguments(parser):
     sub.add_parser("list", help="list the shipped exercises")
 
 
-def _workers(text):
-    if text is None:
-        return None
+def _positive(name, text):
     from feelflow.app.cli.commands.run import positive_int_option
 
-    return positive_int_option("--workers", text)
+    return positive_int_option(name, text)
+
+
+def _workers(text):
+    return None if text is None else _positive("--workers", text)
 
 
 class ProgressBar:
@@ -108,11 +112,12 @@ def _score(exercise, args) -> int:
         raise UserError(f"--out: directory {str(out.parent)!r} does not exist")
     files = grading.shape_files(args.shapes)
     workers = _workers(args.workers) or grading.default_workers()
+    scale = 1 if args.scale is None else _positive("--scale", args.scale)
+    s = exercise.scene.scaled(scale)
     print(_machine_line())
     print(f"{exercise.title}: scoring {len(files)} shape files on {min(workers, len(files))} processes "
-          f"(numpy float64, {exercise.scene.nx} x {exercise.scene.ny}, {exercise.scene.steps} steps each)",
-          flush=True)
-    rows, wall = grading.grade(exercise, files, workers, progress=ProgressBar("shapes"))
+          f"(numpy float64, {s.nx} x {s.ny}, {s.steps} steps each)", flush=True)
+    rows, wall = grading.grade(exercise, files, workers, scales=(scale,), progress=ProgressBar("shapes"))
     rows = grading.ranked(exercise, rows)
     with atomic_path(out, suffix=".tmp") as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
