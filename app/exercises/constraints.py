@@ -36,22 +36,21 @@ def area(shape: Shape) -> float:
 
 
 def posed(exercise, shape: Shape, scale: int = 1) -> Shape:
-    """The shape as the scoring run sees it: centroid at the exercise's body position, then
-    every length times `scale` (the same body at `scale` times the resolution)."""
-    # placed from the shape's own description, not from where it was: the same shape gives the
-    # same digits wherever it was drawn or saved
+    """The shape as the scoring run sees it: every length times `scale` (the same body at
+    `scale` times the resolution), its area centroid at the (scaled) body position. Placed from
+    the shape's own description, not from where it was drawn or saved, so the same shape gives
+    the same digits wherever it came from."""
+    if scale != 1:
+        d = shape.to_dict()
+        for key in LENGTH_KEYS:
+            if key in d:
+                d[key] = d[key] * scale
+        if "vertices" in d:
+            d["vertices"] = [[vx * scale, vy * scale] for vx, vy in d["vertices"]]
+        shape = from_dict(d)
+    scene = exercise.scene.scaled(scale)
     cx, cy = centroid(shape.moved(x=0.0, y=0.0))
-    bx, by = exercise.scene.body_x, exercise.scene.body_y
-    shape = shape.moved(x=bx - cx, y=by - cy)
-    if scale == 1:
-        return shape
-    d = shape.to_dict()
-    for key in LENGTH_KEYS:
-        if key in d:
-            d[key] = d[key] * scale
-    if "vertices" in d:
-        d["vertices"] = [[vx * scale, vy * scale] for vx, vy in d["vertices"]]
-    return from_dict(d)
+    return shape.moved(x=scene.body_x - cx, y=scene.body_y - cy)
 
 
 def frontal_height(shape: Shape) -> float:

@@ -74,7 +74,7 @@ class ScoringScene:
     """The tunnel a shape is scored in, at the exercise's own resolution (scale 1).
 
     Lengths in cells, times in steps. `scaled(s)` gives the same flow at s times the resolution:
-    lengths and steps times s, the inflow speed kept, so Re and Ma are the same and the viscosity
+    lengths (positions measured from the walls) and steps times s, the inflow speed kept, so Re and Ma are the same and the viscosity
     grows by s (diffusive time grows like s: the flow needs s times the steps to the same state).
     """
 
@@ -99,7 +99,10 @@ class ScoringScene:
         return units.viscosity_for_reynolds(self.reynolds, self.inflow_speed, self.reference_length)
 
     def scaled(self, s: int) -> "ScoringScene":
-        return replace(self, nx=self.nx * s, ny=self.ny * s, body_x=self.body_x * s, body_y=self.body_y * s,
+        # node i sits at (i + 1/2) cells from the wall at -1/2: a position scales about that wall,
+        # so a body centred in the tunnel stays centred (and symmetric on the lattice)
+        return replace(self, nx=self.nx * s, ny=self.ny * s, body_x=(self.body_x + 0.5) * s - 0.5,
+                       body_y=(self.body_y + 0.5) * s - 0.5,
                        reference_length=self.reference_length * s, steps=self.steps * s,
                        average_steps=self.average_steps * s, sample_interval=self.sample_interval * s,
                        sponge_cells=self.sponge_cells * s, scale=self.scale * s)
