@@ -35,6 +35,7 @@ class Row:
     reason: str = ""
     scale: int = 1
     averaging: str = ""
+    cpu_seconds: float = 0.0
 
     @property
     def ok(self) -> bool:
@@ -81,7 +82,7 @@ def score_file(exercise, path, scale: int = 1) -> Row:
     if problems:
         return Row(name, BREAKS, verdict="; ".join(problems), reason=problems[0], scale=scale)
     r = scoring.score_shape(exercise, shape, scale)
-    return Row(name, r.status, r.score, "ok", r.cd, r.cl, r.steps, r.seconds, r.reason, scale, r.averaging)
+    return Row(name, r.status, r.score, "ok", r.cd, r.cl, r.steps, r.seconds, r.reason, scale, r.averaging, r.cpu_seconds)
 
 
 def _worker(job) -> Row:

@@ -50,6 +50,7 @@ class Result:
     averaging: str = ""
     hit: bool | None = None          # target objectives: within the tolerance
     scale: int = 1
+    cpu_seconds: float = 0.0         # the process's CPU time for the run (what a quiet core needs)
 
     @property
     def ok(self) -> bool:
@@ -57,7 +58,7 @@ class Result:
 
     def to_dict(self) -> dict:
         return {k: getattr(self, k) for k in ("status", "score", "cd", "cl", "steps", "seconds", "reason",
-                                              "averaging", "hit", "scale")}
+                                              "averaging", "hit", "scale", "cpu_seconds")}
 
 
 @dataclass
@@ -142,7 +143,7 @@ def score_shape(exercise, shape, scale: int = 1, progress=None, cancelled=None) 
 
     s = exercise.scene.scaled(scale)
     body = posed(exercise, shape, scale)
-    start = time.perf_counter()
+    start, cpu0 = time.perf_counter(), time.process_time()
     solver = create_solver("numpy", s.flow_config())
     cd, cl = [], []
     try:
@@ -169,13 +170,15 @@ def score_shape(exercise, shape, scale: int = 1, progress=None, cancelled=None) 
     finally:
         solver.close()
     seconds = time.perf_counter() - start
+    cpu = time.process_time() - cpu0
     window = s.average_steps // s.sample_interval
     avg = average(np.array(cd[-window:]), np.array(cl[-window:]), s.settle_tolerance)
     if not avg.settled:
-        return Result(NOT_SETTLED, steps=s.steps, seconds=seconds, reason=avg.how, averaging=avg.how, scale=scale)
+        return Result(NOT_SETTLED, steps=s.steps, seconds=seconds, reason=avg.how, averaging=avg.how, scale=scale,
+                      cpu_seconds=cpu)
     score, hit = objective_score(exercise.objective, avg.cd, avg.cl)
     return Result(SCORED, score=score, cd=avg.cd, cl=avg.cl, steps=s.steps, seconds=seconds,
-                  averaging=avg.how, hit=hit, scale=scale)
+                  averaging=avg.how, hit=hit, scale=scale, cpu_seconds=cpu)
 
 
 def rank_key(objective, result: Result):

@@ -163,7 +163,7 @@ def _check(exercise, args) -> int:
         failed |= not match
         print(f"reference {ref.label}: score {r.score:.{SCORE_DIGITS}f} (recorded {ref.score:.{SCORE_DIGITS}f}"
               f"{'' if match else ', DIFFERS'}), C_D {r.cd:.4f}, C_L {r.cl:.4f}, {r.steps} steps, "
-              f"{r.seconds:.1f} s ({r.averaging})")
+              f"{r.seconds:.1f} s wall, {r.cpu_seconds:.1f} s CPU ({r.averaging})")
     if args.convergence:
         failed |= _convergence(exercise, paths, by, bool(args.markdown))
     print(f"wall time {wall:.1f} s for {len(rows)} runs on {min(workers, len(rows))} processes")
