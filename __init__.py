@@ -7,7 +7,8 @@ holds every part while the repository keeps one top-level folder per part:
 - `feelflow.shapes`   bodies and their rasterisation onto the lattice
 - `feelflow.haptics`  devices and the 1 kHz force loop
 - `feelflow.app`      the tunnel model, sessions, window, command line, reports, benchmarks
-- `shaders/`, `scenes/`  package data: GLSL programs, scene files and lessons
+- `shaders/`, `scenes/`, `exercises/`  package data: GLSL programs, scene files and lessons,
+  exercise files with their shapes
 """
 from pathlib import Path
 
@@ -18,3 +19,4 @@ __version__ = "0.1.0"
 PACKAGE_DIR = Path(__file__).resolve().parent
 SHADER_DIR = PACKAGE_DIR / "shaders"
 SCENE_DIR = PACKAGE_DIR / "scenes"
+EXERCISE_DIR = PACKAGE_DIR / "exercises"

@@ -35,7 +35,7 @@ def test_pyproject_lists_every_package_folder():
             continue
         if rel.parts:
             found.add(".".join(("feelflow",) + rel.parts))
-    data = {"feelflow.shaders", "feelflow.scenes", "feelflow.scenes.presets"}
+    data = {"feelflow.shaders", "feelflow.scenes", "feelflow.scenes.presets", "feelflow.exercises"}
     assert _listed_packages() == found | data
 
 
@@ -61,7 +61,7 @@ def test_wheel_holds_one_namespace_with_its_data(wheel):
     tops = {n.split("/")[0] for n in names if not n.startswith("feelflow-")}
     assert tops == {"feelflow"}
     for data in ("feelflow/shaders/lbm_step.glsl", "feelflow/scenes/default.toml",
-                 "feelflow/scenes/presets/vortex_street.toml"):
+                 "feelflow/scenes/presets/vortex_street.toml", "feelflow/exercises/least_drag.toml"):
         assert data in names
     shaders = {p.name for p in (ROOT / "shaders").glob("*.glsl")}
     assert {n.split("/")[-1] for n in names if n.startswith("feelflow/shaders/")} == shaders

@@ -21,6 +21,7 @@ COMMANDS = {
     "devices": "list haptic devices: serial ports, HID devices, simulators",
     "report": "reports: the seed's experiments (Markdown), how steady the lessons and example scenes are",
     "session": "inspect, replay or export a recorded session file",
+    "exercise": "shape-editing exercises: score a class's shapes, check an exercise file",
 }
 
 

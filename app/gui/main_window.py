@@ -33,6 +33,7 @@ from feelflow.app.gui.qt_runtime import make_none_immortal
 make_none_immortal()  # before any Qt object: see app/gui/qt_runtime.py
 
 from feelflow.app.gui import first_start  # noqa: E402
+from feelflow.app.gui.exercise_controller import ExerciseController  # noqa: E402
 from feelflow.app.gui.force_plot import ForcePlot  # noqa: E402
 from feelflow.app.gui.side_panel import SidePanel  # noqa: E402
 from feelflow.app.gui.display_modes import DISPLAY_MODES  # noqa: E402
@@ -87,6 +88,7 @@ class MainWindow(QMainWindow):
         self.flow = FlowController(self)
         self.exports = ExportController(self)
         self.lessons = LessonController(self)
+        self.exercises = ExerciseController(self)   # the Exercises menu and panel
         self.actions = build_menus(self)
 
         self.params = params or self.store.params()
@@ -207,6 +209,7 @@ class MainWindow(QMainWindow):
     def closeEvent(self, ev):
         self.store.save(self)
         self.loop.stop()
+        self.exercises.shutdown()
         self.replays.close()
         self.inputs.close_device()
         super().closeEvent(ev)

@@ -61,7 +61,9 @@ class Overlay:
             p.drawLine(a, b)
             p.setBrush(Qt.NoBrush)
             p.drawEllipse(b, 6, 6)
-        p.setPen(QPen(BODY_EDGE, 2.5))
+        # an exercise marks a body that breaks a constraint (app/gui/exercise_controller.py)
+        edge = self.view.body_edge
+        p.setPen(QPen(edge or BODY_EDGE, 2.5, Qt.DashLine if edge else Qt.SolidLine))
         p.setBrush(QBrush(BODY_FILL))
         p.drawPolygon(v.body_outline_points())
         if v.editing and sim.polygon is not None:

@@ -62,6 +62,7 @@ class Viewport(QOpenGLWidget):
         self.mode = "speed"
         self.show_arrows = True
         self.editing = False
+        self.body_edge = None    # a QColor for the body's outline instead of the usual, or None
         self.arrow_forces = None       # {"drag": (fx, fy), "lift": (fx, fy)} lattice units
         self.tracers = None
         self.frames = 0

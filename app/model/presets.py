@@ -45,3 +45,9 @@ PRESETS = {
     "models": Lesson("Force models compared", "models_compared.toml",
                      note="All three force models on one plot: dashed lines are lift."),
 }
+
+#: the Presets menu's Exercises entry: (title, the shipped exercise it opens; app/exercises,
+#: exercises/*.toml). Exercises are scored, not run as a lesson, so the entry is not in PRESETS
+#: (which `feelflow report lessons` runs).
+EXERCISES_ENTRY = ("Exercises: design a body and score it", "least_drag.toml")
+

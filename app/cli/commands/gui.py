@@ -1,4 +1,4 @@
-"""`feelflow gui [SESSION]` (the default command) and `feelflow --selftest [--screenshot PATH] [--seconds S]`.
+"""`feelflow gui [SESSION] [--exercise FILE]` (the default command) and `feelflow --selftest [--screenshot PATH] [--seconds S]`.
 
 `feelflow gui FILE.ffsession` opens the window and replays that session in it as soon as the live
 tunnel runs (what File > Replay session does); the desktop entry's `Exec=... gui %f` uses it, so
@@ -26,6 +26,8 @@ def add_arguments(parser):
     parser.add_argument("--backend", choices=("gl", "numpy"), default=None,
                         help=f"solver backend (default {DEFAULT_BACKEND}; numpy uploads the field every frame)")
     parser.add_argument("--fresh", action="store_true", help="ignore remembered settings")
+    parser.add_argument("--exercise", default=None, metavar="FILE",
+                        help="open this exercise file (exercises/*.toml) once the window runs")
 
 
 def set_surface_format():
@@ -49,10 +51,23 @@ def replay_when_ready(window, path) -> None:
     window.simulationReady.connect(start)
 
 
+def open_exercise_when_ready(window, path) -> None:
+    """Open the exercise at `path` once, when the window's live simulation first runs."""
+    def start():
+        window.simulationReady.disconnect(start)
+        window.exercises.open(path)
+    window.simulationReady.connect(start)
+
+
 def main(args) -> int:
     session = getattr(args, "session", None)
     if session is not None and not os.path.isfile(session):
         raise UserError(f"{session}: no such session file")
+    exercise = getattr(args, "exercise", None)
+    if exercise is not None:   # a bad exercise file is one line and exit 2, before any window
+        from feelflow.app.exercises.format import load_exercise
+
+        load_exercise(exercise)
     from feelflow.app.gui.first_start import display_problem
 
     problem = display_problem()
@@ -87,6 +102,8 @@ def main(args) -> int:
         from feelflow.app.gui.first_start import offer_lessons
 
         offer_lessons(window, settings, first_start=session is None)   # the lesson chooser
+    if exercise is not None:
+        open_exercise_when_ready(window, exercise)
     if selftest:
         from feelflow.app.gui.selftest import SelfTest
 

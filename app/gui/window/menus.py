@@ -83,6 +83,7 @@ def build_menus(w: "MainWindow") -> Actions:
     p = bar.addMenu("&Presets")
     for key, preset in PRESETS.items():
         add_action(w, p, preset.title, lambda _=False, k=key: w.lessons.apply(k))
+    w.exercises.build_menu(bar, p)   # the Exercises menu, and its entry in Presets
     toolbar = QToolBar("Replay", w)   # shown only while a session replays
     toolbar.setMovable(False)
     toolbar.addAction(pause)

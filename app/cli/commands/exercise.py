@@ -1,0 +1,204 @@
+"""`feelflow exercise score|check|list`: grade a class's shapes, validate an exercise file.
+
+`score EXERCISE.toml SHAPES...` scores shape files (or folders of them) on every core with a
+progress bar on stderr, writes one CSV row per file (app/files.py atomic write) and prints a
+ranked table, the wall time and the time per shape. `check EXERCISE.toml` validates the file and
+scores its reference solutions (exit 1 when one misses its recorded score); `--convergence`
+also scores the [check] shapes, all at the exercise's resolution and at twice it, and exits 1
+unless the ranking is the same (docs/guide/exercises.md quotes its tables).
+Format: docs/reference/exercise-format.md. Bad input is one line on stderr and exit 2.
+"""
+from __future__ import annotations
+
+import csv
+import sys
+import time
+from pathlib import Path
+
+from feelflow.app.errors import UserError
+
+#: a reference's score must equal the recorded one to its four printed decimals
+SCORE_DIGITS = 4
+
+
+def add_arguments(parser):
+    sub = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
+    p = sub.add_parser("score", help="score shape files (or folders of them) and rank them")
+    p.add_argument("exercise", metavar="EXERCISE.toml")
+    p.add_argument("shapes", metavar="SHAPES", nargs="+", help="shape JSON files or folders of them")
+    p.add_argument("--out", default="scores.csv", metavar="PATH", help="CSV file to write (default: scores.csv)")
+    p.add_argument("--workers", default=None, metavar="N", help="processes (default: every core)")
+    p.add_argument("--scale", default=None, metavar="N",
+                   help="score at N times the exercise's resolution (default 1; 2 to confirm a close ranking)")
+    p = sub.add_parser("check", help="validate an exercise file and score its reference solutions")
+    p.add_argument("exercise", metavar="EXERCISE.toml")
+    p.add_argument("--convergence", action="store_true",
+                   help="also score the [check] shapes; everything at 1x and 2x the resolution; "
+                        "exit 1 unless the ranking is the same")
+    p.add_argument("--markdown", action="store_true", help="--convergence: print the table as Markdown")
+    p.add_argument("--workers", default=None, metavar="N", help="processes (default: every core)")
+    sub.add_parser("list", help="list the shipped exercises")
+
+
+def _positive(name, text):
+    from feelflow.app.cli.commands.run import positive_int_option
+
+    return positive_int_option(name, text)
+
+
+def _workers(text):
+    return None if text is None else _positive("--workers", text)
+
+
+class ProgressBar:
+    """`[#####.....] done/total` on stderr, redrawn in place."""
+
+    def __init__(self, what: str, width: int = 30):
+        self.what, self.width, self.start = what, width, time.perf_counter()
+
+    def __call__(self, done: int, total: int):
+        filled = int(self.width * done / total)
+        elapsed = time.perf_counter() - self.start
+        sys.stderr.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} {self.what}, "
+                         f"{elapsed:.0f} s")
+        if done == total:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+
+def _fmt(v, digits=SCORE_DIGITS):
+    return "-" if v is None else f"{v:.{digits}f}"
+
+
+def _machine_line() -> str:
+    import os
+
+    from feelflow.app.bench.solver_speed import machine
+
+    m = machine()
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    return f"machine: {m['cpu']}, {m['cores']} cores, load average {load:.2f} at the start"
+
+
+def main(args) -> int:
+    if args.action == "list":
+        return _list()
+    from feelflow.app.exercises.format import load_exercise
+
+    exercise = load_exercise(args.exercise)
+    if args.action == "score":
+        return _score(exercise, args)
+    return _check(exercise, args)
+
+
+def _list() -> int:
+    from feelflow import EXERCISE_DIR
+    from feelflow.app.exercises.format import load_exercise
+
+    for p in sorted(EXERCISE_DIR.glob("*.toml")):
+        ex = load_exercise(p)
+        print(f"{p.name:22s} {ex.title} ({ex.objective.kind}; {p})")
+    return 0
+
+
+def _score(exercise, args) -> int:
+    from feelflow.app.exercises import grading
+    from feelflow.app.files import atomic_path
+
+    out = Path(args.out)
+    if out.is_dir():
+        raise UserError(f"--out: {args.out!r} is a directory")
+    if not (out.parent if str(out.parent) else Path(".")).is_dir():
+        raise UserError(f"--out: directory {str(out.parent)!r} does not exist")
+    files = grading.shape_files(args.shapes)
+    workers = _workers(args.workers) or grading.default_workers()
+    scale = 1 if args.scale is None else _positive("--scale", args.scale)
+    s = exercise.scene.scaled(scale)
+    print(_machine_line())
+    print(f"{exercise.title}: scoring {len(files)} shape files on {min(workers, len(files))} processes "
+          f"(numpy float64, {s.nx} x {s.ny}, {s.steps} steps each)", flush=True)
+    rows, wall = grading.grade(exercise, files, workers, scales=(scale,), progress=ProgressBar("shapes"))
+    rows = grading.ranked(exercise, rows)
+    with atomic_path(out, suffix=".tmp") as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(grading.CSV_HEADER)
+        writer.writerows(grading.csv_rows(rows))
+    o = exercise.objective
+    print(f"\nobjective: {o.kind} (score = {o.quantity}, {o.better} is better"
+          + (f"; hit within {o.tolerance:g} of {o.target:g}" if o.target is not None else "") + ")")
+    print(f"{'rank':>4s}  {'score':>9s}  {'C_D':>7s}  {'C_L':>8s}  {'s':>6s}  file / verdict")
+    for i, r in enumerate(rows, 1):
+        verdict = "" if r.ok else f"  [{r.status}: {r.reason}]"
+        print(f"{(str(i) if r.ok else '-'):>4s}  {_fmt(r.score):>9s}  {_fmt(r.cd, 3):>7s}  {_fmt(r.cl, 4):>8s}  "
+              f"{r.seconds:6.1f}  {r.file}{verdict}")
+    run_s = [r.seconds for r in rows if r.steps]
+    per = f"; each scored shape's run took {sum(run_s) / len(run_s):.1f} s on average" if run_s else ""
+    print(f"\n{out}: {len(rows)} rows. Wall time {wall:.1f} s for {len(files)} shapes on "
+          f"{min(workers, len(files))} processes: {wall / len(files):.2f} s per shape{per}.")
+    return 0
+
+
+def _check(exercise, args) -> int:
+    from feelflow.app.exercises import grading
+
+    workers = _workers(args.workers) or grading.default_workers()
+    print(_machine_line())
+    s = exercise.scene
+    print(f"{exercise.source}: valid. {exercise.title}: {s.nx} x {s.ny}, Re {s.reynolds:g}, "
+          f"U {s.inflow_speed:g}, L {s.reference_length:g} cells, {s.steps} steps; objective "
+          f"{exercise.objective.kind}", flush=True)
+    refs = [r.path for r in exercise.references]
+    paths = refs + (list(exercise.check_shapes) if args.convergence else [])
+    scales = (1, 2) if args.convergence else (1,)
+    rows, wall = grading.grade(exercise, paths, workers, scales, progress=ProgressBar("runs"))
+    by = {(r.file, r.scale): r for r in rows}
+    failed = False
+    for ref in exercise.references:
+        r = by[(str(ref.path), 1)]
+        if not r.ok:
+            print(f"reference {ref.label}: {r.status}: {r.reason}")
+            failed = True
+            continue
+        match = round(r.score, SCORE_DIGITS) == round(ref.score, SCORE_DIGITS)
+        failed |= not match
+        print(f"reference {ref.label}: score {r.score:.{SCORE_DIGITS}f} (recorded {ref.score:.{SCORE_DIGITS}f}"
+              f"{'' if match else ', DIFFERS'}), C_D {r.cd:.4f}, C_L {r.cl:.4f}, {r.steps} steps, "
+              f"{r.seconds:.1f} s wall, {r.cpu_seconds:.1f} s CPU ({r.averaging})")
+    if args.convergence:
+        failed |= _convergence(exercise, paths, by, bool(args.markdown))
+    print(f"wall time {wall:.1f} s for {len(rows)} runs on {min(workers, len(rows))} processes")
+    return 1 if failed else 0
+
+
+def _convergence(exercise, paths, by, markdown: bool) -> bool:
+    """Print both resolutions' scores, ranks and differences; True when the rankings differ."""
+    from feelflow.app.exercises import grading
+
+    ranks = {}
+    for scale in (1, 2):
+        ok = grading.ranked(exercise, [by[(str(p), scale)] for p in paths])
+        ranks[scale] = {r.file: i for i, r in enumerate(ok, 1) if r.ok}
+    s = exercise.scene
+    head = ["shape", f"score {s.nx}x{s.ny}", "rank", f"score {2 * s.nx}x{2 * s.ny}", "rank", "difference",
+            "s (1x)", "s (2x)"]
+    lines = []
+    for p in sorted(paths, key=lambda p: ranks[1].get(str(p), 999)):
+        a, b = by[(str(p), 1)], by[(str(p), 2)]
+        diff = (f"{b.score - a.score:+.4f} ({(b.score - a.score) / abs(a.score):+.1%})"
+                if a.ok and b.ok and a.score else "-")
+        lines.append([Path(p).name, _fmt(a.score) if a.ok else a.status, str(ranks[1].get(str(p), "-")),
+                      _fmt(b.score) if b.ok else b.status, str(ranks[2].get(str(p), "-")), diff,
+                      f"{a.seconds:.1f}", f"{b.seconds:.1f}"])
+    if markdown:
+        print("| " + " | ".join(head) + " |")
+        print("|" + " --- |" * len(head))
+        for row in lines:
+            print("| " + " | ".join(row) + " |")
+    else:
+        print("  ".join(f"{h:>14s}" if i else f"{h:36s}" for i, h in enumerate(head)))
+        for row in lines:
+            print("  ".join(f"{c:>14s}" if i else f"{c:36s}" for i, c in enumerate(row)))
+    same = [f for f, _ in sorted(ranks[1].items(), key=lambda kv: kv[1])] == \
+           [f for f, _ in sorted(ranks[2].items(), key=lambda kv: kv[1])]
+    print(f"ranking at {s.nx}x{s.ny} and {2 * s.nx}x{2 * s.ny}: {'the same' if same else 'DIFFERENT'}")
+    return not same

@@ -1,0 +1,139 @@
+"""Grading a class: score many shape files on every core, one row per file, ranked.
+
+A file that is not a valid shape file, or a shape that breaks a constraint, gets its row with
+the reason; it never stops the grading. Scores come from `scoring.score_shape` (numpy float64),
+the same function the window calls, so a shape scores the same digits here and there.
+"""
+from __future__ import annotations
+
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+from feelflow.app.errors import UserError
+from feelflow.app.exercises import scoring
+
+#: row status besides scoring's SCORED / NOT_SETTLED
+BREAKS = "breaks a constraint"
+INVALID = "not a shape file"
+CSV_HEADER = ["rank", "file", "status", "score", "verdict", "cd", "cl", "steps", "seconds", "reason"]
+
+
+@dataclass
+class Row:
+    file: str
+    status: str
+    score: float | None = None
+    verdict: str = "ok"
+    cd: float | None = None
+    cl: float | None = None
+    steps: int = 0
+    seconds: float = 0.0
+    reason: str = ""
+    scale: int = 1
+    averaging: str = ""
+    cpu_seconds: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return self.status == scoring.SCORED
+
+
+def shape_files(paths) -> list[Path]:
+    """The shape files named: files as given, folders' *.json files (sorted); UserError for a
+    path that does not exist or when nothing is left."""
+    out = []
+    for p in map(Path, paths):
+        if p.is_dir():
+            out += sorted(q for q in p.iterdir() if q.suffix.lower() == ".json" and q.is_file())
+        elif p.exists():
+            out.append(p)
+        else:
+            raise UserError(f"{p}: no such shape file or folder")
+    if not out:
+        raise UserError("no shape files (*.json) among " + ", ".join(map(str, paths)))
+    return out
+
+
+@lru_cache(maxsize=8)
+def _exercise(path: str):
+    from feelflow.app.exercises.format import load_exercise
+
+    return load_exercise(path)
+
+
+def score_file(exercise, path, scale: int = 1) -> Row:
+    """One shape file's row (never raises for a bad shape file or a broken constraint)."""
+    from feelflow.app.exercises.constraints import check_shape
+    from feelflow.shapes.base import ShapeError
+    from feelflow.shapes.io import load_shape
+
+    name = str(path)
+    try:
+        shape = load_shape(path)
+    except ShapeError as exc:
+        text = str(exc).splitlines()[0]
+        return Row(name, INVALID, verdict="-", reason=text[len(name) + 2:] if text.startswith(name + ": ") else text,
+                   scale=scale)
+    problems = check_shape(exercise, shape)
+    if problems:
+        return Row(name, BREAKS, verdict="; ".join(problems), reason=problems[0], scale=scale)
+    r = scoring.score_shape(exercise, shape, scale)
+    return Row(name, r.status, r.score, "ok", r.cd, r.cl, r.steps, r.seconds, r.reason, scale, r.averaging, r.cpu_seconds)
+
+
+def _worker(job) -> Row:
+    exercise_path, path, scale = job
+    return score_file(_exercise(exercise_path), path, scale)
+
+
+def default_workers() -> int:
+    return os.cpu_count() or 1
+
+
+def grade(exercise, paths, workers: int | None = None, scales=(1,), progress=None) -> tuple[list[Row], float]:
+    """Score every (file, scale) on `workers` processes (default: every core). Returns the rows
+    in the order of `paths` x `scales` and the wall seconds. `progress(done, total)` after each."""
+    if exercise.path is None:
+        raise ValueError("grading needs an exercise loaded from a file")
+    jobs = [(str(exercise.path), str(p), s) for p in paths for s in scales]
+    workers = max(1, min(workers or default_workers(), len(jobs)))
+    start = time.perf_counter()
+    rows: list[Row | None] = [None] * len(jobs)
+    if workers == 1:
+        for i, job in enumerate(jobs):
+            rows[i] = _worker(job)
+            if progress:
+                progress(i + 1, len(jobs))
+    else:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            futures = {pool.submit(_worker, job): i for i, job in enumerate(jobs)}
+            for n, fut in enumerate(as_completed(futures), 1):
+                rows[futures[fut]] = fut.result()
+                if progress:
+                    progress(n, len(jobs))
+    return rows, time.perf_counter() - start
+
+
+def ranked(exercise, rows: list[Row]) -> list[Row]:
+    """Best first (scoring.rank_key); not settled, broken and invalid last; ties by file name."""
+    order = {scoring.SCORED: 0, scoring.NOT_SETTLED: 1, BREAKS: 2, INVALID: 3}
+
+    def key(r: Row):
+        if r.ok:
+            return (0, r.score if exercise.objective.better == "lower" else -r.score, r.file)
+        return (order.get(r.status, 4), 0.0, r.file)
+    return sorted(rows, key=key)
+
+
+def csv_rows(rows: list[Row]) -> list[list]:
+    """CSV cells; numbers with repr() digits (every digit, so reruns compare exactly)."""
+    out = []
+    for rank, r in enumerate(rows, 1):
+        out.append([rank if r.ok else "", r.file, r.status, "" if r.score is None else repr(r.score), r.verdict,
+                    "" if r.cd is None else repr(r.cd), "" if r.cl is None else repr(r.cl), r.steps,
+                    f"{r.seconds:.2f}", r.reason])
+    return out

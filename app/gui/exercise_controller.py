@@ -1,0 +1,361 @@
+"""Exercise mode in the window: the Exercises menu, the exercise panel beside the flow, live
+constraint checks while the student edits (the body outlined in red while one is broken), Score
+it in a worker thread (progress, Cancel) and the attempts file next to the student's work.
+
+The score is `feelflow.app.exercises.scoring.score_shape` on numpy float64, the function
+`feelflow exercise score` calls, so the window and the command line give the same digits. The
+live flow in the viewport is the window's own (gl or numpy, float32) and only shows the flow.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from PySide6.QtCore import QObject, QThread, QTimer, Qt, Signal
+from PySide6.QtGui import QAction, QColor
+from PySide6.QtWidgets import QDockWidget, QFileDialog, QMessageBox
+
+from feelflow import EXERCISE_DIR
+from feelflow.app.errors import UserError
+from feelflow.app.exercises import scoring
+from feelflow.app.gui.exercise_panel import PARAMETERS, ExercisePanel
+from feelflow.shapes.base import ShapeError
+
+BROKEN_EDGE = QColor(230, 40, 40)
+CHECK_INTERVAL_MS = 250
+
+
+class ScoreWorker(QThread):
+    """Runs one scoring in a thread; the window keeps drawing (numpy releases the GIL in its
+    array kernels)."""
+
+    progressed = Signal(float)
+    scored = Signal(object)        # scoring.Result
+    failed = Signal(str)
+
+    def __init__(self, exercise, shape, parent=None):
+        super().__init__(parent)
+        self.exercise, self.shape = exercise, shape
+        self._cancel = False
+
+    def cancel(self):
+        self._cancel = True
+
+    def run(self):
+        try:
+            result = scoring.score_shape(self.exercise, self.shape, progress=self.progressed.emit,
+                                         cancelled=lambda: self._cancel)
+        except scoring.Cancelled:
+            self.failed.emit("cancelled")
+        except Exception as exc:  # noqa: BLE001 - shown in one line in the panel, not a traceback
+            self.failed.emit(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+        else:
+            self.scored.emit(result)
+
+
+class ExerciseController(QObject):
+    """Owns the open exercise, its panel (a dock) and its attempts; `window` is the MainWindow."""
+
+    attemptAdded = Signal(object)   # attempts.Attempt
+
+    def __init__(self, window):
+        super().__init__(window)
+        self.window = window
+        self.exercise = None
+        self.attempts = None
+        self.panel = None
+        self.dock = None
+        self.worker = None
+        self.problems: list[str] = []
+        self.param_shape = None      # the built-in body the parameter fields describe
+        self.last_result = None
+        self.timer = QTimer(self)
+        self.timer.setInterval(CHECK_INTERVAL_MS)
+        self.timer.timeout.connect(self.refresh_constraints)
+
+    # --- menus -------------------------------------------------------------------------------
+    def build_menu(self, bar, presets_menu=None):
+        from feelflow.app.exercises.format import load_exercise
+        from feelflow.app.model.presets import EXERCISES_ENTRY
+
+        menu = bar.addMenu("E&xercises")
+        for path in sorted(EXERCISE_DIR.glob("*.toml")):
+            try:
+                title = load_exercise(path).title
+            except UserError:
+                continue
+            self._action(menu, title, lambda _=False, p=path: self.open(p))
+        menu.addSeparator()
+        self._action(menu, "Open exercise file\u2026", self.open_dialog)
+        self._action(menu, "Work folder for attempts\u2026", self.work_folder_dialog)
+        self.close_action = self._action(menu, "Close exercise", self.close)
+        self.close_action.setEnabled(False)
+        if presets_menu is not None:
+            presets_menu.addSeparator()
+            title, name = EXERCISES_ENTRY
+            self._action(presets_menu, title, lambda _=False: self.open(EXERCISE_DIR / name))
+        return menu
+
+    def _action(self, menu, text, slot):
+        act = QAction(text, self.window)
+        act.triggered.connect(slot)
+        menu.addAction(act)
+        return act
+
+    @property
+    def work_folder(self) -> Path:
+        default = Path.home() / "FeelFlow" / "exercises"
+        return Path(self.window.settings.value("exercises/work_folder", str(default)))
+
+    @work_folder.setter
+    def work_folder(self, folder):
+        self.window.settings.setValue("exercises/work_folder", str(folder))
+
+    def work_folder_dialog(self, _=False):
+        folder = QFileDialog.getExistingDirectory(self.window, "Work folder for attempts", str(self.work_folder))
+        if folder:
+            self.work_folder = folder
+            if self.exercise is not None:
+                self._load_attempts()
+
+    def open_dialog(self, _=False):
+        path, _ = QFileDialog.getOpenFileName(self.window, "Open exercise", str(EXERCISE_DIR), "Exercises (*.toml)")
+        if path:
+            self.open(path)
+
+    # --- opening -----------------------------------------------------------------------------
+    def open(self, path) -> bool:
+        """Load the exercise, set the tunnel up as it is scored, install its starting shape and
+        show its panel; a dialog (one line) for a bad file."""
+        from feelflow.app.exercises.format import load_exercise
+        from feelflow.app.model.scene import scene_from_dict
+        from feelflow.shapes.io import load_shape
+
+        w = self.window
+        if w.sim is None or w.replays.refuse("exercises run in the live tunnel"):
+            return False
+        if self.worker is not None:
+            QMessageBox.information(w, "Scoring is running", "Wait for the score or cancel it first.")
+            return False
+        try:
+            exercise = load_exercise(path)
+            start = load_shape(exercise.start)
+            s = exercise.scene
+            scene = scene_from_dict({
+                "grid": {"nx": s.nx, "ny": s.ny},
+                "flow": {"nu": s.nu, "inflow_speed": s.inflow_speed, "walls": s.walls, "dtype": "float32",
+                         "inflow_ramp_steps": 0, "initial_velocity": [s.inflow_speed, 0.0],
+                         "sponge_cells": s.sponge_cells, "sponge_absorb": 0.1},
+                "body": {"kind": "cylinder", "diameter": s.reference_length, "x": s.body_x, "y": s.body_y},
+                "run": {"steps": s.steps}}, exercise.source)
+            w.make_current()
+            w.sim.load_scene(scene)
+        except (UserError, ShapeError, ValueError) as exc:
+            w.flow.refuse_dialog("This exercise cannot be opened", exc)
+            return False
+        self.exercise = exercise
+        w.undo.clear()
+        w.bodies.set_hold_still(True)
+        self._ensure_panel()
+        self.panel.show_exercise(exercise)
+        self.dock.show()
+        self.install_shape(start)
+        self._load_attempts()
+        self.close_action.setEnabled(True)
+        w.panel.show_params(w.sim.params, w.loop.display_mode)
+        w.flow.after_rebuild()
+        w.loop.set_paused(False)
+        self.timer.start()
+        self.refresh_constraints()
+        w.statusBar().showMessage(f"Exercise: {exercise.title}", 10000)
+        return True
+
+    def _ensure_panel(self):
+        if self.panel is not None:
+            return
+        self.panel = ExercisePanel()
+        self.panel.scoreRequested.connect(self.score)
+        self.panel.cancelRequested.connect(self.cancel)
+        self.panel.attemptChosen.connect(self.load_attempt)
+        self.panel.parametersChanged.connect(self._parameters_changed)
+        self.dock = QDockWidget("Exercise", self.window)
+        self.dock.setObjectName("exercise_dock")
+        self.dock.setWidget(self.panel)
+        self.dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetClosable)
+        self.window.addDockWidget(Qt.LeftDockWidgetArea, self.dock)
+        self.window.resizeDocks([self.dock], [340], Qt.Horizontal)
+
+    def _load_attempts(self):
+        from feelflow.app.exercises.attempts import Attempts
+
+        try:
+            self.attempts = Attempts(self.exercise, self.work_folder)
+        except UserError as exc:
+            QMessageBox.warning(self.window, "The attempts file cannot be read",
+                                f"{exc}\nNew attempts are not saved until it is fixed or moved away.")
+            self.attempts = None
+        self._show_attempts()
+
+    def _show_attempts(self):
+        if self.attempts is None:
+            self.panel.set_attempts([], None, "nowhere: the attempts file is unreadable")
+        else:
+            self.panel.set_attempts(self.attempts.items, self.attempts.best(), str(self.attempts.path))
+
+    def close(self, _=False):
+        if self.worker is not None:
+            self.cancel()
+        self.timer.stop()
+        self.exercise = None
+        self.window.viewport.body_edge = None
+        if self.dock is not None:
+            self.dock.hide()
+        self.close_action.setEnabled(False)
+
+    # --- the shape -----------------------------------------------------------------------------
+    def current_shape(self):
+        """The shape the student has now: the edited polygon, or the parameter fields' body."""
+        if self.exercise is None:
+            return None
+        if "polygon" in self.exercise.kinds and self.window.sim.params.shape == "polygon":
+            return self.window.sim.shape
+        return self.param_shape
+
+    def install_shape(self, shape):
+        """Put a shape (a start shape, a loaded attempt) into the editor and the tunnel."""
+        w = self.window
+        if shape.kind in PARAMETERS:
+            self.panel.set_parameters(shape)
+            return self._parameters_changed()
+        w.make_current()
+        w.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in shape.vertices],
+                        angle_deg=math.degrees(shape.angle))
+        self.param_shape = None
+        w.panel.show_params(w.sim.params, w.loop.display_mode)
+        w.viewport.update()
+        self.refresh_constraints()
+        return True
+
+    def _parameters_changed(self):
+        """Build the body from the parameter fields and show it in the tunnel (as a polygon with
+        the body's exact vertices, or a cylinder)."""
+        from feelflow.shapes.io import from_dict
+
+        w = self.window
+        try:
+            shape = from_dict(self.panel.parameters())
+        except ShapeError as exc:
+            self.problems = [str(exc).splitlines()[0]]
+            self.panel.set_problems(self.problems)
+            return False
+        self.param_shape = shape
+        try:
+            w.make_current()
+            if shape.kind == "cylinder":
+                w.sim.set_shape(kind="cylinder", size=shape.diameter, angle_deg=math.degrees(shape.angle))
+            else:
+                w.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in shape.local_vertices],
+                                angle_deg=math.degrees(shape.angle))
+        except (ShapeError, ValueError):
+            pass    # too big for the tunnel: the constraints say so
+        w.panel.show_params(w.sim.params, w.loop.display_mode)
+        w.viewport.update()
+        self.refresh_constraints()
+        return True
+
+    def refresh_constraints(self):
+        """Check the shape now against the exercise; show what is broken, outline the body."""
+        from feelflow.app.exercises.constraints import check_shape
+
+        if self.exercise is None or self.panel is None:
+            return
+        shape = self.current_shape()
+        try:
+            problems = check_shape(self.exercise, shape) if shape is not None else ["no shape yet"]
+        except (ShapeError, ValueError) as exc:
+            problems = [str(exc).splitlines()[0]]
+        if problems != self.problems or not self.panel.constraints.text():
+            self.problems = problems
+            self.panel.set_problems(problems)
+        edge = BROKEN_EDGE if problems else None
+        if self.window.viewport.body_edge != edge:
+            self.window.viewport.body_edge = edge
+            self.window.viewport.update()
+
+    # --- scoring -------------------------------------------------------------------------------
+    def score(self, _=False) -> bool:
+        """Score the current shape in a worker thread; refused (with the reasons) while a
+        constraint is broken."""
+        if self.exercise is None or self.worker is not None:
+            return False
+        self.refresh_constraints()
+        if self.problems:
+            QMessageBox.warning(self.window, "This shape cannot be scored yet",
+                                "It breaks the exercise's constraints:\n- " + "\n- ".join(self.problems))
+            return False
+        shape = self.current_shape()
+        self.worker = ScoreWorker(self.exercise, shape, self)
+        self.worker.progressed.connect(self.panel.set_progress)
+        self.worker.scored.connect(lambda result, s=shape: self._scored(s, result))
+        self.worker.failed.connect(self._failed)
+        self.worker.finished.connect(self._worker_done)
+        self.panel.set_running(True)
+        self.panel.result.setText("Scoring: the tunnel runs the exercise's scoring simulation (numpy, float64)\u2026")
+        self.worker.start()
+        return True
+
+    def cancel(self, _=False):
+        if self.worker is not None:
+            self.worker.cancel()
+
+    def _worker_done(self):
+        self.worker.deleteLater()
+        self.worker = None
+        self.panel.set_running(False, not self.problems)
+
+    def _failed(self, message):
+        self.panel.result.setText("Scoring cancelled." if message == "cancelled" else f"Scoring failed: {message}")
+        self.panel.set_progress(0.0)
+
+    def _scored(self, shape, result):
+        self.last_result = result
+        ex = self.exercise
+        if result.ok:
+            o = ex.objective
+            lines = [f"<b>Score {result.score:.4f}</b> ({o.quantity}; C_D {result.cd:.4f}, C_L {result.cl:.4f}; "
+                     f"{result.steps} steps, {result.seconds:.1f} s)"]
+            if result.hit is not None:
+                lines.append("A hit: within the tolerance." if result.hit else "Not a hit yet: outside the tolerance.")
+            for ref in ex.references:
+                better = result.score < ref.score if o.better == "lower" else result.score > ref.score
+                same = round(result.score, 4) == round(ref.score, 4)
+                word = "the same as" if same else ("better than" if better else "behind")
+                lines.append(f"{word} the reference \u201c{ref.label}\u201d ({ref.score:.4f})")
+            lines.append(f"<small>{result.averaging}</small>")
+            self.panel.result.setText("<br>".join(lines))
+        else:
+            self.panel.result.setText(f"<b>Not settled</b>: {result.reason}. No score is given for this run.")
+        if self.attempts is not None:
+            try:
+                attempt = self.attempts.add(shape, result)
+            except OSError as exc:
+                QMessageBox.warning(self.window, "The attempt could not be saved", str(exc))
+            else:
+                self.attemptAdded.emit(attempt)
+        self._show_attempts()
+
+    def load_attempt(self, index: int) -> bool:
+        if self.attempts is None or not 0 <= index < len(self.attempts.items) or self.worker is not None:
+            return False
+        try:
+            shape = self.attempts.items[index].load_shape()
+        except ShapeError as exc:
+            QMessageBox.warning(self.window, "This attempt cannot be loaded", str(exc))
+            return False
+        return self.install_shape(shape)
+
+    def shutdown(self):
+        """Stop a running scoring and wait for its thread (the window is closing)."""
+        if self.worker is not None:
+            self.worker.cancel()
+            self.worker.wait()

@@ -1,0 +1,108 @@
+"""An exercise in the real window (Xvfb): open it, edit the polygon, break a constraint (the
+panel says why, the outline changes, Score it is refused), fix it, score it in the worker
+thread, see the attempt listed and saved, load it back; the window's score has the digits
+`feelflow exercise score` gives the same shape."""
+from __future__ import annotations
+
+import json
+import pathlib
+
+import pytest
+
+pytestmark = pytest.mark.gui
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+TINY = ROOT / "tests" / "data" / "exercises" / "tiny.toml"
+SQUARE = [(-3.0, -3.0), (3.0, -3.0), (3.0, 3.0), (-3.0, 3.0)]
+TALL = [(-3.0, -5.0), (3.0, -5.0), (3.0, 5.0), (-3.0, 5.0)]          # 10 cells high: too tall
+ARROW = [(-3.0, 0.0), (0.0, -3.0), (4.0, -3.0), (4.0, 3.0), (0.0, 3.0)]   # 6 high, pointed nose
+
+
+def test_edit_violate_fix_score_and_list_the_attempt(window, qtbot, tmp_path, monkeypatch):
+    from PySide6.QtCore import Qt
+    from PySide6.QtWidgets import QMessageBox
+
+    from feelflow.app.exercises import grading
+    from feelflow.shapes.io import save_shape
+
+    warnings = []
+    monkeypatch.setattr(QMessageBox, "warning", lambda *a, **k: warnings.append(a[2]))
+    ex = window.exercises
+    ex.work_folder = tmp_path / "work"
+    assert ex.open(TINY)
+    panel = ex.panel
+    assert panel.isVisible() and "Tiny test exercise" in panel.title.text()
+    assert "Least drag" in panel.instructions.toPlainText()
+    assert (window.sim.config.nx, window.sim.config.ny) == (64, 32)
+    qtbot.waitUntil(lambda: "All constraints met" in panel.constraints.text(), timeout=5000)
+
+    # violate: too tall
+    assert window.edit_polygon(TALL)
+    qtbot.waitUntil(lambda: "Not ready" in panel.constraints.text(), timeout=5000)
+    assert "frontal height" in panel.constraints.text() and "10.00 cells" in panel.constraints.text()
+    assert window.viewport.body_edge is not None
+    assert not panel.score_button.isEnabled()
+    assert not ex.score() and "frontal height" in warnings[-1]
+
+    # fix it
+    assert window.edit_polygon(ARROW)
+    qtbot.waitUntil(lambda: "All constraints met" in panel.constraints.text(), timeout=5000)
+    assert window.viewport.body_edge is None and panel.score_button.isEnabled()
+
+    # score in the worker thread: the window keeps running while it does
+    frames = window.viewport.frames
+    qtbot.mouseClick(panel.score_button, Qt.LeftButton)
+    assert panel.cancel_button.isEnabled()
+    qtbot.waitUntil(lambda: panel.attempts.count() == 1 and ex.worker is None, timeout=300000)
+    assert window.viewport.frames > frames
+    result = ex.last_result
+    assert result.ok and "Score" in panel.result.text()
+    assert "\u2605 best" in panel.attempts.item(0).text() and f"{result.score:.4f}" in panel.attempts.item(0).text()
+    saved = json.loads((tmp_path / "work" / "tiny.attempts.json").read_text())
+    assert saved["attempts"][0]["score"] == result.score
+
+    # the command line's path gives the same digits for the same shape
+    shape_file = tmp_path / "arrow.json"
+    save_shape(shape_file, ex.attempts.items[0].load_shape())
+    row = grading.score_file(ex.exercise, shape_file)
+    assert row.score == result.score and row.cd == result.cd and row.cl == result.cl
+
+    # edit again, then load the attempt back into the editor
+    assert window.edit_polygon(SQUARE)
+    panel.attempts.setCurrentRow(0)
+    qtbot.mouseClick(panel.load_button, Qt.LeftButton)
+    assert [tuple(v) for v in window.sim.polygon] == ARROW
+
+    # cancel a second scoring: no attempt is added
+    assert ex.score()
+    ex.cancel()
+    qtbot.waitUntil(lambda: ex.worker is None, timeout=60000)
+    assert "cancelled" in panel.result.text() and panel.attempts.count() == 1
+
+
+def test_exercise_on_a_built_in_body_uses_the_parameter_fields(window, qtbot, tmp_path):
+    ex = window.exercises
+    ex.work_folder = tmp_path / "work"
+    assert ex.open(ROOT / "exercises" / "lift_to_drag.toml")
+    panel = ex.panel
+    assert panel.shape_box.isVisible()
+    qtbot.waitUntil(lambda: "All constraints met" in panel.constraints.text(), timeout=5000)
+    panel.angle.setValue(30.0)        # outside -12..12
+    qtbot.waitUntil(lambda: "the angle is 30.0 degrees" in panel.constraints.text(), timeout=5000)
+    panel.angle.setValue(-4.0)
+    qtbot.waitUntil(lambda: "All constraints met" in panel.constraints.text(), timeout=5000)
+    assert ex.current_shape().kind == "half_airfoil"
+
+
+def test_bad_exercise_file_is_a_dialog(window, tmp_path, monkeypatch):
+    from PySide6.QtWidgets import QMessageBox
+
+    shown = []
+    monkeypatch.setattr(QMessageBox, "warning", lambda *a, **k: shown.append(a[2]))
+    import shutil
+
+    shutil.copytree(TINY.parent / "shapes", tmp_path / "shapes")
+    bad = tmp_path / "bad.toml"
+    bad.write_text(TINY.read_text().replace("kind = \"least_cd\"", "kind = \"fastest\""))
+    assert not window.exercises.open(bad)
+    assert len(shown) == 1 and "objective.kind" in shown[0]
