@@ -30,25 +30,31 @@ class CpuSolver(NumpySolver):
     name = "cpu"
 
     def __init__(self, config):
-        from feelflow.solver import cpu_kernels
+        from feelflow.solver.cpu_kernels import make_kernels
 
         super().__init__(config)
         cfg = self.config
         nx, ny = cfg.nx, cfg.ny
-        self._k = cpu_kernels
         op, om = relaxation_rates(cfg)
         self._op = np.broadcast_to(np.asarray(op, np.float64), (nx,)).copy()
         self._om = np.broadcast_to(np.asarray(om, np.float64), (nx,)).copy()
         keep = absorb_keep(cfg)
-        self._has_keep = keep is not None
         self._keep = np.ones(nx) if keep is None else np.asarray(keep, np.float64)
+        # columns 1 .. xs-1 share column 1's rates and have no absorbing layer: the chunked,
+        # vectorised part of the kernel; xs .. nx-1 (the sponge, the last column) node by node
+        plain = (self._op == self._op[min(1, nx - 1)]) & (self._om == self._om[min(1, nx - 1)]) & (self._keep == 1.0)
+        plain[0] = True
+        xs = 1
+        while xs < nx - 1 and plain[xs]:
+            xs += 1
+        self._xs = xs
         self._no_target = np.zeros(ny)
-        self._trt = cfg.collision == "trt"
-        fx, fy = (float(v) for v in cfg.body_force)
-        self._force = (fx, fy, (fx, fy) != (0.0, 0.0))
+        self._fx, self._fy = (float(v) for v in cfg.body_force)
+        self._stream_collide, self._redo_kernel = make_kernels(
+            cfg.collision == "trt", bool(cfg.incompressible), keep is not None, (self._fx, self._fy) != (0.0, 0.0))
         self._pre = np.zeros_like(self.g)
         self._edge_bits = self._boundary_bits()
-        self._mask_body = self._mask_links = None
+        self._mask_links = None
         self._redo = None
 
     def _boundary_bits(self) -> np.ndarray:
@@ -85,13 +91,11 @@ class CpuSolver(NumpySolver):
         t = self.time
         u_in = self._boundaries(g, pre, t)
         target = self._no_target if u_in is None else np.asarray(u_in, np.float64)
-        fx, fy, has_force = self._force
-        args = (self._op, self._om, self._keep, target, self._trt, self.config.incompressible,
-                self._has_keep, fx, fy, has_force)
-        total = self._k.stream_collide(g, out, *args)
+        rates = (self._op, self._om, self._keep, target)
+        total = self._stream_collide(g, out, *rates, self._xs, self._fx, self._fy)
         iy, ix, bits = self._redo_nodes()
         if len(iy):
-            total += self._k.redo_nodes(g, pre, bits, iy, ix, out, *args)
+            total += self._redo_kernel(g, pre, bits, iy, ix, out, *rates, self._fx, self._fy)
         if self._solid_idx is not None:
             out[:, self._solid_idx[0], self._solid_idx[1]] = self._solid_g
         self.g, self._gin = out, g

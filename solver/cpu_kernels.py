@@ -11,11 +11,19 @@ Compiled with cache=True: the JIT cost (seconds) is paid once per machine.
 """
 from __future__ import annotations
 
-import numba
-import numpy as np
-from numba import prange
+import functools
+import os
 
-from feelflow.solver.lattice import C, RHO0, W
+# numba's OpenMP threads sleep between steps instead of spinning: on a busy 2-core machine the
+# spinning doubled the CPU time per node (docs/science/cpu-backend.md); read when the OpenMP
+# runtime starts, so set before the first parallel kernel runs.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+import numba  # noqa: E402
+import numpy as np
+from numba import prange  # noqa: E402
+
+from feelflow.solver.lattice import C, RHO0, W  # noqa: E402
 
 # The kernels spell the directions out (pull from x - c_i) for speed: hold them to the one
 # definition of the lattice.
@@ -25,7 +33,7 @@ if tuple(map(tuple, C.tolist())) != _ORDER:
 W0, W1, W5 = float(W[0]), float(W[1]), float(W[5])
 R0 = float(RHO0)
 
-_JIT = dict(cache=True, nogil=True, fastmath={"contract", "arcp", "nsz"})
+_JIT = dict(cache=True, nogil=True, error_model="numpy", fastmath={"contract", "arcp", "nsz", "reassoc"})
 
 
 @numba.njit(inline="always", **_JIT)
@@ -93,58 +101,116 @@ def _store(out, y, x, r):
     out[8, y, x] = r[8]
 
 
+#: columns per chunk: the pulled populations and the results of a chunk stay in L1
+CHUNK = 128
+
+
 @numba.njit(inline="always", **_JIT)
-def _node(g, out, y, ym, yp, x, xm, xp, op, om, keep, target, trt, incomp, has_keep, Fx, Fy, has_force):
-    """Pull g_i(x - c_i) for the node (y, x), collide, store; returns drho."""
-    r = _collide(g[0, y, x], g[1, y, xm], g[2, ym, x], g[3, y, xp], g[4, yp, x],
-                 g[5, ym, xm], g[6, ym, xp], g[7, yp, xp], g[8, yp, xm],
-                 op[x], om[x], keep[x], target, trt, incomp, has_keep, Fx, Fy, has_force)
-    _store(out, y, x, r)
-    return r[9]
+def _chunk(b, o, n, op, om, t, trt, incomp, Fx, Fy, has_force):
+    """Collide n nodes of the gathered populations b (9, CHUNK) into o, one pair of rates (op,
+    om) for all: written without per-node branches or arrays beside b and o, so LLVM
+    vectorises it. Returns sum drho."""
+    s = 0.0
+    for k in range(n):
+        r = _collide(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
+                     op, om, 1.0, t, trt, incomp, False, Fx, Fy, has_force)
+        _store_k(o, k, r)
+        s += r[9]
+    return s
 
 
-@numba.njit(parallel=True, **_JIT)
-def stream_collide(g, out, op, om, keep, target, trt, incomp, has_keep, Fx, Fy, has_force):
-    """The whole grid, periodic in x and y, rows in parallel: out = collide(pull(g)).
-    op, om, keep: (nx,) per-column rates and absorbing factor; target: (ny,) its x-velocity.
-    Returns sum drho (the divergence check)."""
-    ny, nx = g.shape[1], g.shape[2]
-    rows = np.zeros(ny)
-    for y in prange(ny):
-        ym = y - 1 if y > 0 else ny - 1
-        yp = y + 1 if y < ny - 1 else 0
-        t = target[y]
-        s = _node(g, out, y, ym, yp, 0, nx - 1, 1 % nx, op, om, keep, t, trt, incomp, has_keep, Fx, Fy, has_force)
-        for x in range(1, nx - 1):
-            s += _node(g, out, y, ym, yp, x, x - 1, x + 1, op, om, keep, t, trt, incomp, has_keep, Fx, Fy, has_force)
-        if nx > 1:
-            s += _node(g, out, y, ym, yp, nx - 1, nx - 2, 0, op, om, keep, t, trt, incomp, has_keep,
-                       Fx, Fy, has_force)
-        rows[y] = s
-    return rows.sum()
+@numba.njit(inline="always", **_JIT)
+def _store_k(o, k, r):
+    o[0, k] = r[0]
+    o[1, k] = r[1]
+    o[2, k] = r[2]
+    o[3, k] = r[3]
+    o[4, k] = r[4]
+    o[5, k] = r[5]
+    o[6, k] = r[6]
+    o[7, k] = r[7]
+    o[8, k] = r[8]
 
 
-@numba.njit(**_JIT)
-def redo_nodes(g, pre, over, ny_, nx_, out, op, om, keep, target, trt, incomp, has_keep, Fx, Fy, has_force):
-    """For each node (ny_[k], nx_[k]) whose bit i of over[k] is set, population i comes from
-    `pre` (what a boundary rule wrote) instead of the periodic pull; collide and store.
-    Returns sum drho over those nodes."""
-    ny, nx = g.shape[1], g.shape[2]
-    f = np.empty(9)
-    total = 0.0
-    for k in range(len(ny_)):
-        y, x, bits = ny_[k], nx_[k], over[k]
-        for i in range(9):
-            if (bits >> i) & 1:
-                f[i] = pre[i, y, x]
-            else:
-                f[i] = g[i, (y - _CY[i]) % ny, (x - _CX[i]) % nx]
-        r = _collide(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], op[x], om[x], keep[x],
-                     target[y], trt, incomp, has_keep, Fx, Fy, has_force)
+@numba.njit(inline="always", **_JIT)
+def _pull(g, y, ym, yp, x, xm, xp):
+    return (g[0, y, x], g[1, y, xm], g[2, ym, x], g[3, y, xp], g[4, yp, x],
+            g[5, ym, xm], g[6, ym, xp], g[7, yp, xp], g[8, yp, xm])
+
+
+@functools.lru_cache(maxsize=None)
+def make_kernels(trt: bool, incomp: bool, has_keep: bool, has_force: bool):
+    """(stream_collide, redo_nodes) compiled for one collision variant: the flags are constants
+    of the compiled code, so the inner loop has no branches (cached per variant)."""
+
+    @numba.njit(inline="always", **_JIT)
+    def _edge(g, out, y, ym, yp, x, op, om, keep, t, Fx, Fy):
+        """One node with periodic neighbours and its own column's rates; returns drho."""
+        nx = g.shape[2]
+        f = _pull(g, y, ym, yp, x, x - 1 if x > 0 else nx - 1, x + 1 if x < nx - 1 else 0)
+        r = _collide(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], op[x], om[x], keep[x], t,
+                     trt, incomp, has_keep, Fx, Fy, has_force)
         _store(out, y, x, r)
-        total += r[9]
-    return total
+        return r[9]
 
+    @numba.njit(parallel=True, **_JIT)
+    def stream_collide(g, out, op, om, keep, target, xs, Fx, Fy):
+        """out = collide(pull(g)) over the whole grid, periodic in x and y, rows in parallel.
+        Columns 1 .. xs-1 share the rates op[1], om[1] (no sponge there) and run in chunks;
+        column 0 and xs .. nx-1 (the sponge: per-column rates, the absorbing layer) node by
+        node. target: (ny,) the absorbing layer's x-velocity. Returns sum drho."""
+        ny, nx = g.shape[1], g.shape[2]
+        rows = np.zeros(ny)
+        op0, om0 = op[min(1, nx - 1)], om[min(1, nx - 1)]
+        for y in prange(ny):
+            ym = y - 1 if y > 0 else ny - 1
+            yp = y + 1 if y < ny - 1 else 0
+            t = target[y]
+            b = np.empty((9, CHUNK))
+            o = np.empty((9, CHUNK))
+            s = 0.0
+            for x0 in range(1, xs, CHUNK):
+                n = min(CHUNK, xs - x0)
+                for k in range(n):
+                    b[0, k] = g[0, y, x0 + k]
+                    b[1, k] = g[1, y, x0 + k - 1]
+                    b[2, k] = g[2, ym, x0 + k]
+                    b[3, k] = g[3, y, x0 + k + 1]
+                    b[4, k] = g[4, yp, x0 + k]
+                    b[5, k] = g[5, ym, x0 + k - 1]
+                    b[6, k] = g[6, ym, x0 + k + 1]
+                    b[7, k] = g[7, yp, x0 + k + 1]
+                    b[8, k] = g[8, yp, x0 + k - 1]
+                s += _chunk(b, o, n, op0, om0, t, trt, incomp, Fx, Fy, has_force)
+                for i in range(9):
+                    for k in range(n):
+                        out[i, y, x0 + k] = o[i, k]
+            s += _edge(g, out, y, ym, yp, 0, op, om, keep, t, Fx, Fy)
+            for x in range(xs, nx):
+                s += _edge(g, out, y, ym, yp, x, op, om, keep, t, Fx, Fy)
+            rows[y] = s
+        return rows.sum()
 
-_CX = np.array([c[0] for c in _ORDER], dtype=np.int64)
-_CY = np.array([c[1] for c in _ORDER], dtype=np.int64)
+    @numba.njit(**_JIT)
+    def redo_nodes(g, pre, over, ny_, nx_, out, op, om, keep, target, Fx, Fy):
+        """For each node (ny_[k], nx_[k]) whose bit i of over[k] is set, population i comes from
+        `pre` (what a boundary rule wrote) instead of the periodic pull; collide and store.
+        Returns sum drho over those nodes."""
+        ny, nx = g.shape[1], g.shape[2]
+        f = np.empty(9)
+        total = 0.0
+        for k in range(len(ny_)):
+            y, x, bits = ny_[k], nx_[k], over[k]
+            ym = y - 1 if y > 0 else ny - 1
+            yp = y + 1 if y < ny - 1 else 0
+            p = _pull(g, y, ym, yp, x, x - 1 if x > 0 else nx - 1, x + 1 if x < nx - 1 else 0)
+            for i in range(9):
+                f[i] = pre[i, y, x] if (bits >> i) & 1 else p[i]
+            r = _collide(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], op[x], om[x], keep[x],
+                         target[y], trt, incomp, has_keep, Fx, Fy, has_force)
+            _store(out, y, x, r)
+            total += r[9]
+        return total
+
+    return stream_collide, redo_nodes
+
