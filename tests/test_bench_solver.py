@@ -46,18 +46,28 @@ def test_cpu_work_cost_is_the_added_time_per_call_within_each_round():
 
 
 def test_bench_alternates_the_backends_in_rounds_and_takes_the_median_ratio(tmp_path, capsys):
-    """`feelflow bench --rounds N`: every scene and grid on both backends in N alternating rounds;
-    a row is the median of its rounds, a speedup the median of the per-round ratios."""
+    """`feelflow bench --rounds N`: every scene and grid on every backend (numpy, cpu, gl) in N
+    alternating rounds; a row is the median of its rounds, a speedup the median of the per-round
+    ratios, the fastest backend the one with the highest median MLUPS."""
     out = tmp_path / "bench.json"
     assert cli_main(["bench", "--quick", "--rounds", "2", "--seconds", "0.01", "--json", str(out)]) == 0
     data = json.loads(out.read_text())
-    assert data["rounds"] == 2 and len(data["results"]) == 12
+    assert data["rounds"] == 2 and len(data["results"]) == 18
     for row in data["results"]:
         if "error" in row:  # no EGL context here: the numpy rows stay
             continue
         assert len(row["rounds_mlups"]) == 2 and row["mlups"] == pytest.approx(np.median(row["rounds_mlups"]), abs=0.01)
     for key, per_round in data["speedups_per_round"].items():
         assert len(per_round) == 2 and data["speedups"][key] == round(float(np.median(per_round)), 2)
+    for backend, speedups in data["speedups_by_backend_per_round"].items():
+        for key, per_round in speedups.items():
+            assert data["speedups_by_backend"][backend][key] == round(float(np.median(per_round)), 2)
+    assert set(data["speedups_by_backend"]["cpu"]) == {f"{s} {g}" for s in ("box", "tunnel")
+                                                       for g in ("256x128", "512x256", "1024x512")}
+    for key, best in data["fastest"].items():
+        scene, grid = key.split()
+        rows = [r for r in data["results"] if r["scene"] == scene and r["grid"] == grid and "error" not in r]
+        assert best["backend"] == max(rows, key=lambda r: r["mlups"])["backend"]
     assert "rounds:" in capsys.readouterr().out
 
 

@@ -20,8 +20,9 @@ from feelflow.app.errors import UserError
 
 def add_arguments(parser):
     parser.add_argument("scene", metavar="SCENE.toml", help="the scene file (keys: docs/scenes.md)")
-    parser.add_argument("--backend", default=None, metavar="numpy|gl",
-                        help="solver backend (default: the scene's run.backend, else numpy)")
+    parser.add_argument("--backend", default=None, metavar="numpy|cpu|gl|auto",
+                        help="solver backend (default: the scene's run.backend, else numpy); auto: the "
+                             "fastest here, timed briefly on the scene's grid and remembered")
     parser.add_argument("--steps", default=None, metavar="N", help="number of steps (default: the scene's)")
     parser.add_argument("--out", default="forces.csv", metavar="PATH", help="CSV file to write (default: forces.csv)")
     parser.add_argument("--record", default=None, metavar="FILE.ffsession",
@@ -57,7 +58,7 @@ def _fmt(v: float) -> str:
 
 
 def main(args) -> int:
-    from feelflow.app.headless import make_solver
+    from feelflow.app.headless import make_solver, resolve_backend
     from feelflow.app.model.scene import load_scene
 
     scene = load_scene(args.scene)
@@ -70,6 +71,7 @@ def main(args) -> int:
     if not (out.parent if str(out.parent) else Path(".")).is_dir():
         raise UserError(f"--out: directory {str(out.parent)!r} does not exist")
 
+    backend = resolve_backend(backend, scene.config)
     solver = make_solver(backend, scene.config)
     recorder = None
     if args.record:
