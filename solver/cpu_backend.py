@@ -36,10 +36,11 @@ class CpuSolver(NumpySolver):
         cfg = self.config
         nx, ny = cfg.nx, cfg.ny
         op, om = relaxation_rates(cfg)
-        self._op = np.broadcast_to(np.asarray(op, np.float64), (nx,)).copy()
-        self._om = np.broadcast_to(np.asarray(om, np.float64), (nx,)).copy()
+        dt = self.dtype  # the kernels compute in the storage's precision, as numpy's Collider
+        self._op = np.broadcast_to(np.asarray(op, dt), (nx,)).copy()
+        self._om = np.broadcast_to(np.asarray(om, dt), (nx,)).copy()
         keep = absorb_keep(cfg)
-        self._keep = np.ones(nx) if keep is None else np.asarray(keep, np.float64)
+        self._keep = np.ones(nx, dt) if keep is None else np.asarray(keep, dt)
         # columns 1 .. xs-1 share column 1's rates and have no absorbing layer: the chunked,
         # vectorised part of the kernel; xs .. nx-1 (the sponge, the last column) node by node
         plain = (self._op == self._op[min(1, nx - 1)]) & (self._om == self._om[min(1, nx - 1)]) & (self._keep == 1.0)
@@ -48,10 +49,11 @@ class CpuSolver(NumpySolver):
         while xs < nx - 1 and plain[xs]:
             xs += 1
         self._xs = xs
-        self._no_target = np.zeros(ny)
-        self._fx, self._fy = (float(v) for v in cfg.body_force)
+        self._no_target = np.zeros(ny, dt)
+        self._fx, self._fy = (dt.type(v) for v in cfg.body_force)
         self._stream_collide, self._redo_kernel = make_kernels(
-            cfg.collision == "trt", bool(cfg.incompressible), keep is not None, (self._fx, self._fy) != (0.0, 0.0))
+            cfg.collision == "trt", bool(cfg.incompressible), keep is not None,
+            tuple(cfg.body_force) != (0.0, 0.0), dt.name)
         self._pre = np.zeros_like(self.g)
         self._edge_bits = self._boundary_bits()
         self._mask_links = None
@@ -90,7 +92,7 @@ class CpuSolver(NumpySolver):
         g, out, pre = self.g, self._gin, self._pre
         t = self.time
         u_in = self._boundaries(g, pre, t)
-        target = self._no_target if u_in is None else np.asarray(u_in, np.float64)
+        target = self._no_target if u_in is None else np.asarray(u_in, self.dtype)
         rates = (self._op, self._om, self._keep, target)
         total = self._stream_collide(g, out, *rates, self._xs, self._fx, self._fy)
         iy, ix, bits = self._redo_nodes()

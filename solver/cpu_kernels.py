@@ -5,7 +5,8 @@ docs/algorithm.md, steps 1-3; the collision is solver/collision.py's, node by no
 (Bhatnagar, Gross & Krook 1954) or TRT (Ginzburg, Verhaeghe & d'Humieres 2008), Guo, Zheng &
 Shi (2002) forcing, the compressible or He & Luo (1997) equilibrium, the outlet sponge's
 per-column rates and absorbing layer. Populations are shifted, g_i = f_i - w_i RHO0; the
-arithmetic is float64 whatever the storage. Lattice order as solver/lattice.py (0 rest, 1-4
+arithmetic is in the storage's precision (float32 as numpy's and gl's, or float64), its
+constants a tuple K = (1/2, 1, 3, w0, w1, w5, RHO0) of that type. Lattice order as solver/lattice.py (0 rest, 1-4
 E N W S, 5-8 NE NW SW SE); the module checks that order on import rather than retyping it.
 Compiled with cache=True: the JIT cost (seconds) is paid once per machine.
 """
@@ -37,21 +38,22 @@ _JIT = dict(cache=True, nogil=True, error_model="numpy", fastmath={"contract", "
 
 
 @numba.njit(inline="always", **_JIT)
-def _pair(fi, fb, cu, deq, hrho, q2, rho, w, op, om, trt, uF, cF, has_force):
+def _pair(fi, fb, cu, deq, hrho, q2, rho, w, op, om, trt, uF, cF, has_force, K):
     """Collide the opposite pair (i, ib) with cu = 3 c_i.u and cF = c_i.F (solver/collision.py)."""
+    half, one, three = K[0], K[1], K[2]
     sym = deq + hrho * (cu * cu - q2)  # feq+ = w sym
     anti = rho * cu                    # feq- = w anti
     if trt:
-        t1 = 0.5 * op * (fi + fb) - op * w * sym
-        t2 = 0.5 * om * (fi - fb) - om * w * anti
+        t1 = half * op * (fi + fb) - op * w * sym
+        t2 = half * om * (fi - fb) - om * w * anti
         ni = fi - t1 - t2
         nb = fb - t1 + t2
     else:
-        ni = fi * (1.0 - op) + op * w * (sym + anti)
-        nb = fb * (1.0 - op) + op * w * (sym - anti)
+        ni = fi * (one - op) + op * w * (sym + anti)
+        nb = fb * (one - op) + op * w * (sym - anti)
     if has_force:
-        ev = (1.0 - 0.5 * op) * w * (3.0 * cF * cu - 3.0 * uF)
-        od = (1.0 - 0.5 * om) * w * 3.0 * cF
+        ev = (one - half * op) * w * (three * cF * cu - three * uF)
+        od = (one - half * om) * w * three * cF
         ni += ev + od
         nb += ev - od
     return ni, nb
@@ -59,32 +61,33 @@ def _pair(fi, fb, cu, deq, hrho, q2, rho, w, op, om, trt, uF, cF, has_force):
 
 @numba.njit(inline="always", **_JIT)
 def _collide(f0, f1, f2, f3, f4, f5, f6, f7, f8, op, om, keep, target, trt, incomp, has_keep,
-             Fx, Fy, has_force):
+             Fx, Fy, has_force, K):
     """One node's collision of shifted pre-collision populations; returns (f*0..f*8, drho)."""
-    drho = 0.0 + f0 + f1 + f2 + f3 + f4 + f5 + f6 + f7 + f8
-    rho = R0 if incomp else R0 + drho
+    half, one, three, w0, w1, w5, r0 = K
+    drho = f0 + f1 + f2 + f3 + f4 + f5 + f6 + f7 + f8
+    rho = r0 if incomp else r0 + drho
     jx = f1 - f3 + f5 - f6 - f7 + f8
     jy = f2 - f4 + f5 + f6 - f7 - f8
     if has_force:
-        jx += 0.5 * Fx
-        jy += 0.5 * Fy
+        jx += half * Fx
+        jy += half * Fy
     ux = jx / rho
     uy = jy / rho
     deq = drho
     if has_keep:  # absorbing layer: relax towards (RHO0, u_target)
         deq = drho * keep
-        ux = ux * keep + target * (1.0 - keep)
+        ux = ux * keep + target * (one - keep)
         uy = uy * keep
-    hrho = 0.5 * rho
-    q2 = 3.0 * (ux * ux + uy * uy)
+    hrho = half * rho
+    q2 = three * (ux * ux + uy * uy)
     uF = ux * Fx + uy * Fy
-    n0 = f0 * (1.0 - op) + op * W0 * (deq - hrho * q2)
+    n0 = f0 * (one - op) + op * w0 * (deq - hrho * q2)
     if has_force:
-        n0 += (1.0 - 0.5 * op) * W0 * (-3.0 * uF)
-    n1, n3 = _pair(f1, f3, 3.0 * ux, deq, hrho, q2, rho, W1, op, om, trt, uF, Fx, has_force)
-    n2, n4 = _pair(f2, f4, 3.0 * uy, deq, hrho, q2, rho, W1, op, om, trt, uF, Fy, has_force)
-    n5, n7 = _pair(f5, f7, 3.0 * (ux + uy), deq, hrho, q2, rho, W5, op, om, trt, uF, Fx + Fy, has_force)
-    n6, n8 = _pair(f6, f8, 3.0 * (uy - ux), deq, hrho, q2, rho, W5, op, om, trt, uF, Fy - Fx, has_force)
+        n0 -= (one - half * op) * w0 * three * uF
+    n1, n3 = _pair(f1, f3, three * ux, deq, hrho, q2, rho, w1, op, om, trt, uF, Fx, has_force, K)
+    n2, n4 = _pair(f2, f4, three * uy, deq, hrho, q2, rho, w1, op, om, trt, uF, Fy, has_force, K)
+    n5, n7 = _pair(f5, f7, three * (ux + uy), deq, hrho, q2, rho, w5, op, om, trt, uF, Fx + Fy, has_force, K)
+    n6, n8 = _pair(f6, f8, three * (uy - ux), deq, hrho, q2, rho, w5, op, om, trt, uF, Fy - Fx, has_force, K)
     return n0, n1, n2, n3, n4, n5, n6, n7, n8, drho
 
 
@@ -106,14 +109,14 @@ CHUNK = 128
 
 
 @numba.njit(inline="always", **_JIT)
-def _chunk(b, o, n, op, om, t, trt, incomp, Fx, Fy, has_force):
+def _chunk(b, o, n, op, om, t, trt, incomp, Fx, Fy, has_force, K):
     """Collide n nodes of the gathered populations b (9, CHUNK) into o, one pair of rates (op,
     om) for all: written without per-node branches or arrays beside b and o, so LLVM
     vectorises it. Returns sum drho."""
     s = 0.0
     for k in range(n):
         r = _collide(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
-                     op, om, 1.0, t, trt, incomp, False, Fx, Fy, has_force)
+                     op, om, op, t, trt, incomp, False, Fx, Fy, has_force, K)
         _store_k(o, k, r)
         s += r[9]
     return s
@@ -139,9 +142,12 @@ def _pull(g, y, ym, yp, x, xm, xp):
 
 
 @functools.lru_cache(maxsize=None)
-def make_kernels(trt: bool, incomp: bool, has_keep: bool, has_force: bool):
-    """(stream_collide, redo_nodes) compiled for one collision variant: the flags are constants
-    of the compiled code, so the inner loop has no branches (cached per variant)."""
+def make_kernels(trt: bool, incomp: bool, has_keep: bool, has_force: bool, dtype: str = "float32"):
+    """(stream_collide, redo_nodes) compiled for one collision variant and storage type: the
+    flags and constants are constants of the compiled code, so the inner loop has no branches
+    (cached per variant). The rates, keep, target and force passed to them are of `dtype`."""
+    T = np.dtype(dtype).type
+    K = (T(0.5), T(1.0), T(3.0), T(W0), T(W1), T(W5), T(R0))
 
     @numba.njit(inline="always", **_JIT)
     def _edge(g, out, y, ym, yp, x, op, om, keep, t, Fx, Fy):
@@ -149,7 +155,7 @@ def make_kernels(trt: bool, incomp: bool, has_keep: bool, has_force: bool):
         nx = g.shape[2]
         f = _pull(g, y, ym, yp, x, x - 1 if x > 0 else nx - 1, x + 1 if x < nx - 1 else 0)
         r = _collide(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], op[x], om[x], keep[x], t,
-                     trt, incomp, has_keep, Fx, Fy, has_force)
+                     trt, incomp, has_keep, Fx, Fy, has_force, K)
         _store(out, y, x, r)
         return r[9]
 
@@ -166,25 +172,23 @@ def make_kernels(trt: bool, incomp: bool, has_keep: bool, has_force: bool):
             ym = y - 1 if y > 0 else ny - 1
             yp = y + 1 if y < ny - 1 else 0
             t = target[y]
-            b = np.empty((9, CHUNK))
-            o = np.empty((9, CHUNK))
+            b = np.empty((9, CHUNK), g.dtype)
+            o = np.empty((9, CHUNK), g.dtype)
             s = 0.0
             for x0 in range(1, xs, CHUNK):
                 n = min(CHUNK, xs - x0)
-                for k in range(n):
-                    b[0, k] = g[0, y, x0 + k]
-                    b[1, k] = g[1, y, x0 + k - 1]
-                    b[2, k] = g[2, ym, x0 + k]
-                    b[3, k] = g[3, y, x0 + k + 1]
-                    b[4, k] = g[4, yp, x0 + k]
-                    b[5, k] = g[5, ym, x0 + k - 1]
-                    b[6, k] = g[6, ym, x0 + k + 1]
-                    b[7, k] = g[7, yp, x0 + k + 1]
-                    b[8, k] = g[8, yp, x0 + k - 1]
-                s += _chunk(b, o, n, op0, om0, t, trt, incomp, Fx, Fy, has_force)
-                for i in range(9):
-                    for k in range(n):
-                        out[i, y, x0 + k] = o[i, k]
+                x1 = x0 + n
+                b[0, :n] = g[0, y, x0:x1]
+                b[1, :n] = g[1, y, x0 - 1:x1 - 1]
+                b[2, :n] = g[2, ym, x0:x1]
+                b[3, :n] = g[3, y, x0 + 1:x1 + 1]
+                b[4, :n] = g[4, yp, x0:x1]
+                b[5, :n] = g[5, ym, x0 - 1:x1 - 1]
+                b[6, :n] = g[6, ym, x0 + 1:x1 + 1]
+                b[7, :n] = g[7, yp, x0 + 1:x1 + 1]
+                b[8, :n] = g[8, yp, x0 - 1:x1 - 1]
+                s += _chunk(b, o, n, op0, om0, t, trt, incomp, Fx, Fy, has_force, K)
+                out[:, y, x0:x1] = o[:, :n]
             s += _edge(g, out, y, ym, yp, 0, op, om, keep, t, Fx, Fy)
             for x in range(xs, nx):
                 s += _edge(g, out, y, ym, yp, x, op, om, keep, t, Fx, Fy)
@@ -197,7 +201,7 @@ def make_kernels(trt: bool, incomp: bool, has_keep: bool, has_force: bool):
         `pre` (what a boundary rule wrote) instead of the periodic pull; collide and store.
         Returns sum drho over those nodes."""
         ny, nx = g.shape[1], g.shape[2]
-        f = np.empty(9)
+        f = np.empty(9, g.dtype)
         total = 0.0
         for k in range(len(ny_)):
             y, x, bits = ny_[k], nx_[k], over[k]
@@ -207,7 +211,7 @@ def make_kernels(trt: bool, incomp: bool, has_keep: bool, has_force: bool):
             for i in range(9):
                 f[i] = pre[i, y, x] if (bits >> i) & 1 else p[i]
             r = _collide(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], op[x], om[x], keep[x],
-                         target[y], trt, incomp, has_keep, Fx, Fy, has_force)
+                         target[y], trt, incomp, has_keep, Fx, Fy, has_force, K)
             _store(out, y, x, r)
             total += r[9]
         return total
