@@ -97,3 +97,18 @@ def test_tunnel_warm_up_outlasts_the_subnormal_start_up_transient():
     run.advance(warmup_steps("tunnel", run.solver.config, quick=False) - 128)
     assert subnormal() == 0
     assert warmup_steps("tunnel", run.solver.config, quick=True) == warmup_steps("box", run.solver.config, False) == 20
+
+
+def test_bench_one_grid_and_a_malformed_one(tmp_path, capsys):
+    """`--grid 64x32` measures that grid only (both scenes, every backend); a malformed grid is
+    one line on stderr before anything runs."""
+    out = tmp_path / "bench.json"
+    assert cli_main(["bench", "--quick", "--grid", "64x32", "--seconds", "0.01", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert {r["grid"] for r in data["results"]} == {"64x32"} and len(data["results"]) == 6
+    assert set(data["fastest"]) == {"box 64x32", "tunnel 64x32"}
+    capsys.readouterr()
+    assert cli_main(["bench", "--grid", "512by256"]) == 2
+    out_text, err = capsys.readouterr()
+    assert err.strip().splitlines() == ["feelflow: --grid: must be NXxNY with both at least 8, e.g. 512x256, "
+                                        "got '512by256'"] and out_text == ""

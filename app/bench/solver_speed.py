@@ -165,7 +165,20 @@ def bench_rounds(quick: bool, rounds: int | None) -> int:
     return rounds
 
 
-def run_bench(quick: bool, seconds: float | None, rounds: int | None = None):
+def bench_grids(texts) -> tuple:
+    """`--grid NXxNY` options as (nx, ny) pairs (default GRIDS); UserError for a malformed one."""
+    if not texts:
+        return GRIDS
+    grids = []
+    for text in texts:
+        parts = str(text).lower().split("x")
+        if len(parts) != 2 or not all(p.isdigit() and int(p) >= 8 for p in parts):
+            raise UserError(f"--grid: must be NXxNY with both at least 8, e.g. 512x256, got {text!r}")
+        grids.append((int(parts[0]), int(parts[1])))
+    return tuple(grids)
+
+
+def run_bench(quick: bool, seconds: float | None, rounds: int | None = None, grids=GRIDS):
     """Every scene and grid on every backend, in `rounds` alternating rounds (numpy, cpu, gl,
     numpy, ...; default 3, --quick 1), each `seconds` long: a row holds the medians of its rounds
     and each round's MLUPS, and a speedup is the median of the per-round ratios to numpy, so
@@ -183,7 +196,7 @@ def run_bench(quick: bool, seconds: float | None, rounds: int | None = None):
     ratios = {b: {} for b in BENCH_BACKENDS if b != "numpy"}
     fastest = {}
     for scene in SCENES:
-        for nx, ny in GRIDS:
+        for nx, ny in grids:
             runs, samples, here = {}, {}, []
             for backend in BENCH_BACKENDS:
                 row = {"scene": scene, "backend": backend, "grid": f"{nx}x{ny}", "nx": nx, "ny": ny}
@@ -569,10 +582,11 @@ def main(args) -> int:
                                          if m is not None else "failed"))
     else:
         bench_rounds(quick, getattr(args, "rounds", None))  # refused before anything is printed or run
+        grids = bench_grids(getattr(args, "grid", None))
         m = machine()
         print(f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}, Python {m['python']}, "
               f"numpy {m['numpy']}, LP_NUM_THREADS {m['LP_NUM_THREADS']}")
-        result = run_bench(quick, seconds, getattr(args, "rounds", None))
+        result = run_bench(quick, seconds, getattr(args, "rounds", None), grids)
         print(f"renderer: {result['renderer']}")
         print(f"memory copy bandwidth: {result['copy_bandwidth_gb_s']} GB/s (read + write) -> D2Q9 bound "
               f"{result['d2q9_bound_mlups']} MLUPS at {BYTES_PER_NODE_STEP} bytes per node and step")
