@@ -44,3 +44,28 @@ def make_solver(backend: str, config):
         raise UserError(f"--backend {backend}: this backend is not available in this version") from None
     except BackendError as exc:
         raise UserError(f"--backend {backend}: {str(exc).splitlines()[0]}") from None
+
+
+def gl_renderer() -> str:
+    """The GL renderer this process's gl backend would run on, or "no GL" where there is none."""
+    try:
+        return str(gl_context().info.get("GL_RENDERER", "unknown"))
+    except UserError:
+        return "no GL"
+
+
+def resolve_backend(backend: str, config, store=None) -> str:
+    """`backend` as given, or for "auto" the fastest backend on this machine for `config`'s grid
+    (app/model/backend_choice.py), remembered per (GL renderer, grid) in the user's cache; prints
+    the choice in one line."""
+    if backend != "auto":
+        return backend
+    from feelflow.app.model.backend_choice import JsonFileStore, choose_backend, default_store_path
+
+    store = store if store is not None else JsonFileStore(default_store_path())
+    try:
+        choice = choose_backend(config, make_solver, store, renderer=gl_renderer())
+    except RuntimeError as exc:
+        raise UserError(f"--backend auto: {exc}") from None
+    print(f"feelflow: {choice.describe(config.nx, config.ny)}", flush=True)
+    return choice.backend

@@ -1,4 +1,4 @@
-"""One solver interface, two backends (`numpy`, `gl`), chosen by an explicit registry.
+"""One solver interface, three backends (`numpy`, `gl`, `cpu`), chosen by an explicit registry.
 
 A backend implements docs/science/algorithm.md. Physics tests are parametrised over `BACKENDS`.
 """
@@ -15,6 +15,7 @@ from feelflow.solver.config import FlowConfig
 BACKENDS: dict[str, str] = {
     "numpy": "feelflow.solver.numpy_backend:NumpySolver",
     "gl": "feelflow.solver.gl_backend:GLSolver",
+    "cpu": "feelflow.solver.cpu_backend:CpuSolver",
 }
 
 

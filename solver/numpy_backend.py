@@ -119,15 +119,28 @@ class NumpySolver(Solver):
 
     def _step_once(self) -> None:
         g, gin = self.g, self._gin
-        cfg = self.config
-        nx = cfg.nx
         t = self.time
-        u_in = None
         # e/f: periodic shift of every population (pull: gin_i(x) = g_i(x - c_i))
         for i in range(Q):
             gi, di = g[i], gin[i]
             for (yd, xd), (ys, xs) in self._roll[i]:
                 di[yd, xd] = gi[ys, xs]
+        u_in = self._boundaries(g, gin, t)
+        total = self._collide(gin, u_in)  # u_in: the absorbing layer's target (tunnels only)
+        if self._solid_idx is not None:
+            gin[:, self._solid_idx[0], self._solid_idx[1]] = self._solid_g
+        self.g, self._gin = gin, g
+        self.time = t + 1
+        if not np.isfinite(total):
+            raise SolverDiverged(t + 1, "density is no longer finite")
+
+    def _boundaries(self, g, gin, t: int):
+        """Rules d, c, b, a: write what the boundaries own into gin (from the post-collision g
+        of step t), in reverse order of priority; return the inlet's u_in(iy, t) (tunnel) or
+        None. The compiled cpu backend calls this too (solver/cpu_backend.py)."""
+        cfg = self.config
+        nx = cfg.nx
+        u_in = None
         if cfg.x_boundary == "tunnel":
             # d: outlet, anti-bounce-back at x = nx - 1/2 with rho = RHO0 (pressure outlet)
             gin[OUTLET_DIRECTIONS, :, nx - 1] = outlet_incoming(g[:, :, nx - 2:])
@@ -144,13 +157,7 @@ class NumpySolver(Solver):
             L = b.links
             ys, xs = b.window_slices()
             gin[L.i, L.iy + b.window[1], L.ix + b.window[0]] = incoming(g[:, ys, xs], L)
-        total = self._collide(gin, u_in)  # u_in: the absorbing layer's target (tunnels only)
-        if self._solid_idx is not None:
-            gin[:, self._solid_idx[0], self._solid_idx[1]] = self._solid_g
-        self.g, self._gin = gin, g
-        self.time = t + 1
-        if not np.isfinite(total):
-            raise SolverDiverged(t + 1, "density is no longer finite")
+        return u_in
 
     def _inflow_ramp(self, t: int) -> float:
         """ramp(t), with the cached profiles (per row, and rule c's per inlet link) rebuilt only

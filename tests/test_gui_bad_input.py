@@ -26,12 +26,12 @@ def test_hostile_files_are_one_line_dialogs(window, tmp_path, monkeypatch):
     text_number.write_text(json.dumps({"format": "feelflow-shape", "version": 1,
                                        "shape": {"kind": "cylinder", "diameter": "32", "x": 40, "y": 30}}))
     for path in (fifo, deep, text_number):
-        assert not window.load_shape(str(path))
+        assert not window.exports.load_shape(str(path))
     assert len(warnings) == 3 and window.sim.shape.kind == kind
     assert "not a regular file" in warnings[0] and "must be a number" in warnings[2]
-    window.save_shape(str(fifo))                      # a pipe is never replaced by a file
+    window.exports.save_shape(str(fifo))                      # a pipe is never replaced by a file
     assert len(warnings) == 4 and "not a regular file" in warnings[3] and fifo.is_fifo()
-    assert window.start_replay(str(fifo)) is False    # a pipe as a session: refused at once
+    assert window.replays.start(str(fifo)) is False    # a pipe as a session: refused at once
     assert len(warnings) == 5 and "not a regular file" in warnings[4]
 
 
@@ -51,4 +51,4 @@ def test_a_hostile_settings_file_falls_back_to_the_defaults(qtbot, tmp_path):
     qtbot.addWidget(w)
     d = Params()
     assert w.params.grid == d.grid and w.params.wind == d.wind
-    assert w._polygon_from_settings() is None
+    assert w.store.polygon() is None

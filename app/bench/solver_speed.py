@@ -1,13 +1,14 @@
-"""`feelflow bench [solver] [--json PATH] [--quick] [--profile]`: solver speed, both backends.
+"""`feelflow bench [solver] [--json PATH] [--quick] [--profile] [--grid NXxNY]`: solver speed, every backend.
 
-In one process, the same scenes on the numpy and the gl backend (EGL standalone context):
+In one process, the same scenes on the numpy, the compiled cpu (numba) and the gl backend (EGL
+standalone context):
 an empty periodic box and a tunnel with a moving cylinder (moved every 10 steps as the window
 does per frame, the reference force computed every step), at 256x128, 512x256 and 1024x512.
 For each: MLUPS (million lattice-node updates per second), steps per second and, for gl, the
-renderer; also MLUPS per CPU-second of this process (all its threads, llvmpipe's included),
-which a busy machine disturbs less than the wall clock. Each scene runs in `--rounds`
-alternating rounds (numpy, gl, numpy, gl, ...): rows give the medians, speedups the median of
-the per-round ratios; every run is measured only after its warm-up (`warmup_steps`: for a tunnel,
+renderer; also MLUPS per CPU-second of this process (all its threads, llvmpipe's and numba's
+included), which a busy machine disturbs less than the wall clock. Each scene runs in `--rounds`
+alternating rounds (numpy, cpu, gl, numpy, cpu, gl, ...): rows give the medians, speedups (each
+backend's, and the fastest backend's, against numpy) the median of the per-round ratios; every run is measured only after its warm-up (`warmup_steps`: for a tunnel,
 its start-up transient). It also measures this machine's memory-copy bandwidth (numpy copy, bytes read +
 written per second) and reports each MLUPS as a fraction of the D2Q9 bound, 72 bytes per node
 and step (9 float32 read + 9 written). GPU work is timed up to `glFinish`.
@@ -30,6 +31,8 @@ from feelflow.app.machine import cpu_name
 
 GRIDS = ((256, 128), (512, 256), (1024, 512))
 SCENES = ("box", "tunnel")
+#: the backends `feelflow bench` compares, numpy (the reference) first
+BENCH_BACKENDS = ("numpy", "cpu", "gl")
 BYTES_PER_NODE_STEP = 72
 MOVE_EVERY = 10
 
@@ -153,11 +156,25 @@ def bench_rounds(quick: bool, rounds: int | None) -> int:
     return rounds
 
 
-def run_bench(quick: bool, seconds: float | None, rounds: int | None = None):
-    """Every scene and grid on both backends, in `rounds` alternating rounds (numpy, gl, numpy,
-    gl, ...; default 3, --quick 1), each `seconds` long: a row holds the medians of its rounds
-    and each round's MLUPS, and a speedup is the median of the per-round ratios, so that a slow
-    spell of this shared machine slows both backends of a round alike."""
+def bench_grids(texts) -> tuple:
+    """`--grid NXxNY` options as (nx, ny) pairs (default GRIDS); UserError for a malformed one."""
+    if not texts:
+        return GRIDS
+    grids = []
+    for text in texts:
+        parts = str(text).lower().split("x")
+        if len(parts) != 2 or not all(p.isdigit() and int(p) >= 8 for p in parts):
+            raise UserError(f"--grid: must be NXxNY with both at least 8, e.g. 512x256, got {text!r}")
+        grids.append((int(parts[0]), int(parts[1])))
+    return tuple(grids)
+
+
+def run_bench(quick: bool, seconds: float | None, rounds: int | None = None, grids=GRIDS):
+    """Every scene and grid on every backend, in `rounds` alternating rounds (numpy, cpu, gl,
+    numpy, ...; default 3, --quick 1), each `seconds` long: a row holds the medians of its rounds
+    and each round's MLUPS, and a speedup is the median of the per-round ratios to numpy, so
+    that a slow spell of this shared machine slows the backends of a round alike. `fastest`
+    names, per scene and grid, the backend with the highest median MLUPS and its ratio."""
     from feelflow.solver.backend import create_solver
 
     seconds = seconds if seconds is not None else (0.3 if quick else 2.0)
@@ -166,11 +183,13 @@ def run_bench(quick: bool, seconds: float | None, rounds: int | None = None):
     bound = bandwidth / BYTES_PER_NODE_STEP / 1e6
     ctx, gl_error = _gl_context()
     renderer = ctx.info.get("GL_RENDERER") if ctx else None
-    rows, ratios = [], {}
+    rows = []
+    ratios = {b: {} for b in BENCH_BACKENDS if b != "numpy"}
+    fastest = {}
     for scene in SCENES:
-        for nx, ny in GRIDS:
+        for nx, ny in grids:
             runs, samples, here = {}, {}, []
-            for backend in ("numpy", "gl"):
+            for backend in BENCH_BACKENDS:
                 row = {"scene": scene, "backend": backend, "grid": f"{nx}x{ny}", "nx": nx, "ny": ny}
                 here.append(row)
                 if backend == "gl" and ctx is None:
@@ -195,14 +214,29 @@ def run_bench(quick: bool, seconds: float | None, rounds: int | None = None):
                     row["renderer"] = renderer
                 rows.append(row)
                 print(_format_row(row), flush=True)
-            if len(samples) == 2:
-                ratios[f"{scene} {nx}x{ny}"] = [round(g["mlups"] / n["mlups"], 3)
-                                               for n, g in zip(samples["numpy"], samples["gl"])]
+            key = f"{scene} {nx}x{ny}"
+            for backend in samples:
+                if backend != "numpy":
+                    ratios[backend][key] = [round(b["mlups"] / n["mlups"], 3)
+                                            for n, b in zip(samples["numpy"], samples[backend])]
+            best = max((r for r in here if "error" not in r), key=lambda r: r["mlups"])
+            per_round = ([1.0] * rounds if best["backend"] == "numpy" else ratios[best["backend"]][key])
+            fastest[key] = {"backend": best["backend"], "ratio_to_numpy": round(float(np.median(per_round)), 2)}
+    by_backend = {b: {k: round(float(np.median(v)), 2) for k, v in r.items()} for b, r in ratios.items()}
     return {"machine": machine(), "renderer": renderer, "copy_bandwidth_gb_s": round(bandwidth / 1e9, 2),
             "d2q9_bound_mlups": round(bound, 1), "bytes_per_node_step": BYTES_PER_NODE_STEP,
-            "seconds_per_case": seconds, "rounds": rounds, "results": rows,
-            "speedups": {k: round(float(np.median(v)), 2) for k, v in ratios.items()},
-            "speedups_per_round": ratios}
+            "loadavg": load_average(), "seconds_per_case": seconds, "rounds": rounds, "results": rows,
+            "speedups": by_backend["gl"], "speedups_per_round": ratios["gl"],
+            "speedups_by_backend": by_backend, "speedups_by_backend_per_round": ratios, "fastest": fastest}
+
+
+def load_average():
+    """The 1, 5 and 15 minute load averages (os.getloadavg), or None where there are none: on a
+    shared machine they say how much the other work disturbed the run."""
+    try:
+        return [round(v, 2) for v in os.getloadavg()]
+    except OSError:
+        return None
 
 
 def _median_of_rounds(samples: list[dict]) -> dict:
@@ -334,17 +368,22 @@ def main(args) -> int:
                   f"CPU-ms, cores idle {100 * th['cores_idle_fraction']:.1f} %")
     else:
         bench_rounds(quick, getattr(args, "rounds", None))  # refused before anything is printed or run
+        grids = bench_grids(getattr(args, "grid", None))
         m = machine()
         print(f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}, Python {m['python']}, "
               f"numpy {m['numpy']}, LP_NUM_THREADS {m['LP_NUM_THREADS']}")
-        result = run_bench(quick, seconds, getattr(args, "rounds", None))
+        result = run_bench(quick, seconds, getattr(args, "rounds", None), grids)
         print(f"renderer: {result['renderer']}")
         print(f"memory copy bandwidth: {result['copy_bandwidth_gb_s']} GB/s (read + write) -> D2Q9 bound "
               f"{result['d2q9_bound_mlups']} MLUPS at {BYTES_PER_NODE_STEP} bytes per node and step")
-        for key, ratio in result["speedups"].items():
-            each = result["speedups_per_round"][key]
-            print(f"gl / numpy, {key}: {ratio:.2f}x" + (f" (median of the rounds: {', '.join(f'{v:.2f}' for v in each)})"
-                                                   if len(each) > 1 else ""))
+        print(f"load average (1, 5, 15 min): {result['loadavg']}")
+        for backend, speedups in result["speedups_by_backend"].items():
+            for key, ratio in speedups.items():
+                each = result["speedups_by_backend_per_round"][backend][key]
+                print(f"{backend} / numpy, {key}: {ratio:.2f}x"
+                      + (f" (median of the rounds: {', '.join(f'{v:.2f}' for v in each)})" if len(each) > 1 else ""))
+        for key, best in result["fastest"].items():
+            print(f"fastest, {key}: {best['backend']}, {best['ratio_to_numpy']:.2f}x numpy")
     if getattr(args, "json", None):
         from feelflow.app.files import save_json
 

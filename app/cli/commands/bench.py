@@ -24,7 +24,9 @@ def add_arguments(parser):
                         help="haptics: the device to run the loop against (default: a simulator)")
     parser.add_argument("--seconds", type=float, default=None, help="how long to measure")
     parser.add_argument("--rounds", type=int, default=None,
-                        help="solver: alternating numpy / gl rounds per scene, medians reported (default 3; --quick 1)")
+                        help="solver: alternating numpy / cpu / gl rounds per scene, medians reported (default 3; --quick 1)")
+    parser.add_argument("--grid", action="append", metavar="NXxNY",
+                        help="solver: only this grid (repeatable; default 256x128, 512x256 and 1024x512)")
     parser.add_argument("--quick", action="store_true", help="solver, accuracy: fewer steps or points (smoke test)")
     parser.add_argument("--backend", action="append", choices=("numpy", "gl"),
                         help="accuracy: only this backend (repeatable; default: numpy float64, numpy float32, gl)")

@@ -20,8 +20,9 @@ from feelflow.app.errors import UserError
 
 def add_arguments(parser):
     parser.add_argument("scene", metavar="SCENE.toml", help="the scene file (keys: docs/reference/scenes.md)")
-    parser.add_argument("--backend", default=None, metavar="numpy|gl",
-                        help="solver backend (default: the scene's run.backend, else numpy)")
+    parser.add_argument("--backend", default=None, metavar="numpy|cpu|gl|auto",
+                        help="solver backend (default: the scene's run.backend, else numpy); auto: the "
+                             "fastest here, timed briefly on the scene's grid and remembered")
     parser.add_argument("--steps", default=None, metavar="N", help="number of steps (default: the scene's)")
     parser.add_argument("--out", default="forces.csv", metavar="PATH", help="CSV file to write (default: forces.csv)")
     parser.add_argument("--record", default=None, metavar="FILE.ffsession",
@@ -60,7 +61,7 @@ def _fmt(v: float) -> str:
 
 
 def main(args) -> int:
-    from feelflow.app.headless import make_solver
+    from feelflow.app.headless import make_solver, resolve_backend
     from feelflow.app.model.scene import load_scene
 
     from feelflow.app.files import check_output
@@ -70,8 +71,8 @@ def main(args) -> int:
     scene = load_scene(args.scene)
     backend = args.backend if args.backend is not None else scene.backend
     from feelflow.solver.backend import BACKENDS
-    if backend not in BACKENDS:   # before the run and its outputs
-        raise UserError(f"--backend: must be one of {', '.join(sorted(BACKENDS))}, got {backend!r}")
+    if backend not in BACKENDS and backend != "auto":   # before the run and its outputs
+        raise UserError(f"--backend: must be one of {', '.join(sorted(BACKENDS))} or auto, got {backend!r}")
     steps = positive_int_option("--steps", args.steps) if args.steps is not None else scene.steps
     if args.steps is not None:   # the command line's steps: the same bounds as the scene's
         check_work(scene.config.nx, scene.config.ny, steps, "--steps", "--steps")
@@ -83,6 +84,7 @@ def main(args) -> int:
         check_output(args.record, "--record", inputs=[args.scene], others=[args.out], force=args.force)
     warn_outside_stable_region(scene, args.scene)
 
+    backend = resolve_backend(backend, scene.config)
     solver = make_solver(backend, scene.config)
     recorder = None
     if args.record:

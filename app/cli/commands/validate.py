@@ -22,7 +22,7 @@ def add_arguments(parser):
                         help="cells per diameter (a multiple of 10 for the Schaefer-Turek cases, whose channel "
                              "is 4.1 diameters high; channel width for poiseuille, grid size for taylor-green); "
                              "default: each case's own")
-    parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
+    parser.add_argument("--backend", default="numpy", metavar="numpy|cpu|gl", help="solver backend (default: numpy)")
     parser.add_argument("--json", default=None, metavar="PATH", help="also write the results as JSON")
     parser.add_argument("--force", action="store_true", help="replace --json if it exists")
     parser.add_argument("--quick", action="store_true", help="small grids and short runs (the test-suite versions)")

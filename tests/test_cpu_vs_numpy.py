@@ -1,0 +1,175 @@
+"""The compiled cpu backend against the numpy reference, same scene, N steps.
+
+Both implement docs/algorithm.md; the cpu backend's kernel computes in float64 from float32
+storage where numpy computes in float32, so fields must agree to float32 rounding (1e-5
+relative) and every force model to 1e-4 relative: the tolerances of the gl backend's test
+(tests/test_gl_vs_numpy.py). Relative = max |cpu - numpy| / max |numpy| over the grid: of f, of
+rho - 1, of each velocity component against the top speed. With float64 storage both must
+agree far closer (1e-10).
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from feelflow.shapes import Cylinder, FlatPlate
+from feelflow.solver.backend import create_solver
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.forces import MODELS
+
+FIELD_TOL = {"float32": 1e-5, "float64": 1e-10}
+FORCE_TOL = {"float32": 1e-4, "float64": 1e-9}
+STEPS = 60
+
+
+def _rel(a, b):
+    """max |a - b| / max |b| (the absolute difference where b is identically zero)."""
+    diff, scale = float(np.abs(a - b).max()), float(np.abs(b).max())
+    return diff / scale if scale > 0 else diff
+
+
+def _run_pair(cfg, steps=STEPS, motion=None, models=()):
+    solvers = [create_solver(b, cfg) for b in ("numpy", "cpu")]
+    forces = [[], []]
+    for s in solvers:
+        if models:
+            s.enable_force_models(models)
+    for k in range(steps):
+        for j, s in enumerate(solvers):
+            if motion is not None:
+                motion(s, k)
+            s.step(1)
+            forces[j].append(s.forces())
+    return solvers, forces
+
+
+def _check_fields(solvers):
+    tol = FIELD_TOL[solvers[0].config.dtype]
+    ref, cpu = (s.macroscopic() for s in solvers)
+    rho = _rel(cpu[0] - 1, ref[0] - 1)
+    speed = float(np.hypot(ref[1], ref[2]).max())
+    u = max(float(np.abs(cpu[1] - ref[1]).max()), float(np.abs(cpu[2] - ref[2]).max())) / speed
+    f = _rel(solvers[1].distributions(), solvers[0].distributions())
+    print(f"\n  fields: rho-1 {rho:.1e}, u {u:.1e}, f {f:.1e}", end="")
+    assert rho < tol and u < tol and f < tol
+
+
+def _check_forces(forces, models, dtype="float32"):
+    for name in models:
+        ref = np.array([f[name] for f in forces[0]])
+        cpu = np.array([f[name] for f in forces[1]])
+        assert np.abs(ref).max() > 0, name  # the comparison must compare something
+        err = _rel(cpu, ref)
+        print(f"\n  force {name}: {err:.1e}", end="")
+        assert err < FORCE_TOL[dtype], name
+
+
+@pytest.mark.parametrize("collision", ["bgk", "trt"])
+def test_periodic_box_with_body_force(collision):
+    cfg = FlowConfig(nx=47, ny=32, dtype="float32", collision=collision, x_boundary="periodic",
+                     y_boundary="periodic", body_force=(1e-5, -2e-6), initial_velocity=(0.03, 0.01))
+    solvers, _ = _run_pair(cfg)
+    rng = np.random.default_rng(3)  # then a disturbed state, so that streaming matters
+    from feelflow.solver.lattice import equilibrium
+    f = equilibrium(1 + 1e-3 * rng.standard_normal((32, 47)), 0.02 * rng.standard_normal((32, 47)),
+                    0.02 * rng.standard_normal((32, 47)))
+    for s in solvers:
+        s.set_distributions(f)
+        s.step(STEPS)
+    _check_fields(solvers)
+
+
+@pytest.mark.parametrize("y_boundary", ["no_slip", "free_slip", "periodic"])
+@pytest.mark.parametrize("collision", ["bgk", "trt"])
+def test_tunnel_walls_inlet_outlet_sponge(y_boundary, collision):
+    cfg = FlowConfig(nx=61, ny=32, dtype="float32", collision=collision, y_boundary=y_boundary,
+                     inflow_profile="parabolic" if y_boundary == "no_slip" else "uniform",
+                     inflow_ramp_steps=20, sponge_cells=8)
+    solvers, _ = _run_pair(cfg)
+    _check_fields(solvers)
+
+
+def test_periodic_channel_free_slip_walls():
+    cfg = FlowConfig(nx=48, ny=32, dtype="float32", x_boundary="periodic", y_boundary="free_slip",
+                     initial_velocity=(0.03, 0.02))
+    solvers, _ = _run_pair(cfg)
+    _check_fields(solvers)
+
+
+@pytest.mark.parametrize("dtype", ["float32", "float64"])
+@pytest.mark.parametrize("collision", ["bgk", "trt"])
+def test_moving_rotating_cylinder_every_force_model(collision, dtype):
+    """Moved every step (cover/uncover refill, impulses), moving-wall term with rotation."""
+    cfg = FlowConfig(nx=63, ny=32, dtype=dtype, collision=collision, inflow_ramp_steps=20)
+
+    def move(s, k):
+        s.set_body(Cylinder(8.3, x=20.4 + 0.05 * k, y=15.7 + 0.02 * k), velocity=(0.05, 0.02), omega=0.002)
+
+    solvers, forces = _run_pair(cfg, motion=move, models=list(MODELS))
+    _check_fields(solvers)
+    _check_forces(forces, MODELS, dtype)
+
+
+def test_body_at_the_periodic_seam():
+    """A body touching the periodic seam: its links' nodes pull across it (the boundary-node
+    pass's own periodic neighbours)."""
+    cfg = FlowConfig(nx=48, ny=32, dtype="float32", x_boundary="periodic", y_boundary="periodic",
+                     initial_velocity=(0.03, 0.0))
+
+    def place(s, k):
+        if k == 0:
+            s.set_body(Cylinder(8.0, x=4.3, y=16.2), velocity=(0.01, 0.0))
+
+    solvers, forces = _run_pair(cfg, motion=place, models=["momentum_exchange"])
+    _check_fields(solvers)
+    _check_forces(forces, ["momentum_exchange"])
+
+
+def test_thin_plate_and_body_removed():
+    """A plate thinner than a cell (cut links between fluid nodes), then no body at all: the
+    boundary-node list shrinks back to the domain's edges."""
+    cfg = FlowConfig(nx=64, ny=32, dtype="float32", inflow_ramp_steps=20)
+
+    def place(s, k):
+        if k == 0:
+            s.set_body(FlatPlate(10.0, 0.4, x=24.3, y=16.2, angle=1.2))
+        if k == 40:
+            s.set_body(None)
+
+    solvers, forces = _run_pair(cfg, motion=place, models=["momentum_exchange"])
+    _check_fields(solvers)
+    _check_forces([f[:40] for f in forces], ["momentum_exchange"])
+
+
+@pytest.mark.parametrize("collision", ["bgk", "trt"])
+def test_incompressible_absorbing_sponge_moving_cylinder(collision):
+    """He & Luo's equilibrium, the sponge's absorbing layer and a cylinder moved every step."""
+    cfg = FlowConfig(nx=64, ny=32, dtype="float32", collision=collision, inflow_profile="parabolic",
+                     inflow_ramp_steps=20, sponge_cells=12, sponge_absorb=0.3, equilibrium="incompressible")
+
+    def move(s, k):
+        s.set_body(Cylinder(8.3, x=20.4 + 0.05 * k, y=15.7 + 0.02 * k), velocity=(0.05, 0.02), omega=0.002)
+
+    solvers, forces = _run_pair(cfg, motion=move, models=list(MODELS))
+    _check_fields(solvers)
+    _check_forces(forces, MODELS)
+
+
+def test_compressible_absorbing_sponge():
+    cfg = FlowConfig(nx=61, ny=32, dtype="float32", collision="trt", inflow_profile="parabolic",
+                     inflow_ramp_steps=20, sponge_cells=12, sponge_absorb=0.3)
+    solvers, _ = _run_pair(cfg)
+    _check_fields(solvers)
+
+
+def test_divergence_is_reported():
+    """A state that is not finite raises SolverDiverged, as numpy's does."""
+    from feelflow.solver.backend import SolverDiverged
+
+    cfg = FlowConfig(nx=32, ny=16, dtype="float32", x_boundary="periodic", y_boundary="periodic")
+    s = create_solver("cpu", cfg)
+    f = s.distributions()
+    f[1, 5, 7] = np.nan
+    s.set_distributions(f)
+    with pytest.raises(SolverDiverged):
+        s.step(1)
