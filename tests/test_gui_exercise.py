@@ -37,7 +37,7 @@ def test_edit_violate_fix_score_and_list_the_attempt(window, qtbot, tmp_path, mo
     qtbot.waitUntil(lambda: "All constraints met" in panel.constraints.text(), timeout=5000)
 
     # violate: too tall
-    assert window.edit_polygon(TALL)
+    assert window.bodies.edit_polygon(TALL)
     qtbot.waitUntil(lambda: "Not ready" in panel.constraints.text(), timeout=5000)
     assert "frontal height" in panel.constraints.text() and "10.00 cells" in panel.constraints.text()
     assert window.viewport.body_edge is not None
@@ -45,7 +45,7 @@ def test_edit_violate_fix_score_and_list_the_attempt(window, qtbot, tmp_path, mo
     assert not ex.score() and "frontal height" in warnings[-1]
 
     # fix it
-    assert window.edit_polygon(ARROW)
+    assert window.bodies.edit_polygon(ARROW)
     qtbot.waitUntil(lambda: "All constraints met" in panel.constraints.text(), timeout=5000)
     assert window.viewport.body_edge is None and panel.score_button.isEnabled()
 
@@ -68,7 +68,7 @@ def test_edit_violate_fix_score_and_list_the_attempt(window, qtbot, tmp_path, mo
     assert row.score == result.score and row.cd == result.cd and row.cl == result.cl
 
     # edit again, then load the attempt back into the editor
-    assert window.edit_polygon(SQUARE)
+    assert window.bodies.edit_polygon(SQUARE)
     panel.attempts.setCurrentRow(0)
     qtbot.mouseClick(panel.load_button, Qt.LeftButton)
     assert [tuple(v) for v in window.sim.polygon] == ARROW

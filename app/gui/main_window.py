@@ -38,6 +38,7 @@ from feelflow.app.gui.force_plot import ForcePlot  # noqa: E402
 from feelflow.app.gui.side_panel import SidePanel  # noqa: E402
 from feelflow.app.gui.display_modes import DISPLAY_MODES  # noqa: E402
 from feelflow.app.gui.viewport import MOUSE_HINT, Viewport  # noqa: E402
+from feelflow.app.gui.window.backend import BackendController  # noqa: E402
 from feelflow.app.gui.window.bodies import BodyController  # noqa: E402
 from feelflow.app.gui.window.exports import ExportController  # noqa: E402
 from feelflow.app.gui.window.flow import FlowController  # noqa: E402
@@ -88,6 +89,7 @@ class MainWindow(QMainWindow):
         self.flow = FlowController(self)
         self.exports = ExportController(self)
         self.lessons = LessonController(self)
+        self.backends = BackendController(self, backend)   # "auto": measured once the context exists
         self.exercises = ExerciseController(self)   # the Exercises menu and panel
         self.actions = build_menus(self)
 
@@ -159,6 +161,7 @@ class MainWindow(QMainWindow):
     def _on_context(self, ctx):
         from feelflow.solver.backend import BackendError
 
+        self.backend = self.backends.resolve(ctx)
         try:
             self._create_simulation(ctx)
         except (BackendError, RuntimeError) as exc:
@@ -183,8 +186,8 @@ class MainWindow(QMainWindow):
         self.plot.sim = self.sim
         self.viewport.mode = self.loop.display_mode
         self.panel.show_params(self.sim.params, self.loop.display_mode)
-        self.status["renderer"].setText(f"{self.viewport.renderer().split(' (')[0]}, {self.backend} solver")
-        self.status["renderer"].setToolTip(self.viewport.renderer())
+        self.status["renderer"].setText(self.backends.status_text(self.viewport.renderer().split(' (')[0], self.backend))
+        self.status["renderer"].setToolTip(f"{self.viewport.renderer()}; {self.backends.description}")
         self.loop.upload_field()
         self.inputs.refresh_devices()
         self.flow.say_guard()

@@ -23,8 +23,10 @@ DEFAULT_BACKEND = "gl"
 def add_arguments(parser):
     parser.add_argument("session", nargs="?", default=None, metavar="SESSION",
                         help="a recorded session file (.ffsession) to replay in the window once it has started")
-    parser.add_argument("--backend", choices=("gl", "numpy"), default=None,
-                        help=f"solver backend (default {DEFAULT_BACKEND}; numpy uploads the field every frame)")
+    parser.add_argument("--backend", choices=("auto", "cpu", "gl", "numpy"), default=None,
+                        help="solver backend (default: the Run > Solver backend menu's choice, at first "
+                             "'auto': the fastest here, measured on the window's grid and remembered; "
+                             f"--selftest: {DEFAULT_BACKEND})")
     parser.add_argument("--fresh", action="store_true", help="ignore remembered settings")
     parser.add_argument("--exercise", default=None, metavar="FILE",
                         help="open this exercise file (exercises/*.toml) once the window runs")
@@ -95,6 +97,10 @@ def main(args) -> int:
                              QSettings.IniFormat)
     else:
         settings = QSettings()
+    from feelflow.app.gui.window.backend import requested_backend
+
+    if not selftest:   # the self-test checks the shader path unless --backend says otherwise
+        backend = requested_backend(getattr(args, "backend", None), settings)
     window = MainWindow(backend=backend, settings=settings)
     if session is not None:
         replay_when_ready(window, session)

@@ -75,6 +75,8 @@ def build_menus(w: "MainWindow") -> Actions:
     pause = add_action(w, r, "Pause / run", w.loop.toggle_pause, "Space", checkable=True)
     add_action(w, r, "Reset flow", w.flow.reset, "R")
     add_action(w, r, "Stop device force / replay", w.inputs.escape, "Esc")
+    r.addSeparator()
+    w.backends.build_menu(r)   # Solver backend: Automatic / cpu / gl / numpy
     v = bar.addMenu("&View")
     add_action(w, v, "Full screen", lambda _=False: w.showNormal() if w.isFullScreen() else w.showFullScreen(), "F11")
     v.addSeparator()
