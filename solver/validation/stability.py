@@ -57,6 +57,8 @@ SPONGE_CELLS = 32
 SPONGE_ABSORB = 0.1
 SCENES = ("plate45", "cylinder_impulsive", "cylinder_shaken", "wedge_upstream")
 COLLISIONS = ("bgk", "trt")
+#: every operator a single point can run (`main`); the scan keeps COLLISIONS
+ALL_COLLISIONS = ("bgk", "trt", "rr")
 VISCOSITIES = (0.002, 0.003, 0.004, 0.006, 0.008, 0.012, 0.018, 0.027, 0.04)
 SPEEDS = (0.02, 0.035, 0.05, 0.07, 0.09)
 SIZE_CHECK = (10, 40)
@@ -93,10 +95,10 @@ class Point:
                 "max_u": None if not math.isfinite(self.max_u) else round(self.max_u, 5)}
 
 
-def scene_config(scene: str, collision: str, speed: float, nu: float, grid=GRID) -> FlowConfig:
+def scene_config(scene: str, collision: str, speed: float, nu: float, grid=GRID, smagorinsky: float = 0.0) -> FlowConfig:
     nx, ny = grid
     start = (0.0, 0.0) if scene == "cylinder_impulsive" else (speed, 0.0)
-    return FlowConfig(nx=nx, ny=ny, nu=nu, collision=collision, dtype="float32", x_boundary="tunnel",
+    return FlowConfig(nx=nx, ny=ny, nu=nu, collision=collision, smagorinsky=smagorinsky, dtype="float32", x_boundary="tunnel",
                       y_boundary="no_slip", inflow_speed=speed, inflow_ramp_steps=0, initial_velocity=start,
                       sponge_cells=min(SPONGE_CELLS, nx // 4), sponge_absorb=SPONGE_ABSORB).validate()
 
@@ -122,10 +124,11 @@ def _max_speed(solver) -> float:
 
 def run_point(make_solver: SolverFactory, scene: str, collision: str, speed: float, nu: float,
               size: int = DEFAULT_RESOLUTION, watch: Stopwatch | None = None,
-              convective_times: float = CONVECTIVE_TIMES, grid=GRID, u_bound: float = U_BOUND) -> Point:
+              convective_times: float = CONVECTIVE_TIMES, grid=GRID, u_bound: float = U_BOUND,
+              smagorinsky: float = 0.0) -> Point:
     """Run one point; its state is stable, diverged (SolverDiverged) or unbounded (max |u| above
     `u_bound`; pass math.inf to count only the solver's own divergence check)."""
-    config = scene_config(scene, collision, speed, nu, grid)
+    config = scene_config(scene, collision, speed, nu, grid, smagorinsky)
     body = scene_body(scene, size, grid)
     watch = watch or Stopwatch()
     steps = int(math.ceil(convective_times * size / speed))
@@ -319,8 +322,10 @@ def format_details(result: CaseResult) -> str:
 
 def main(argv=None) -> int:
     """`python -m feelflow.solver.validation.stability --u 0.09 --nu 0.002 --collision bgk --convective-times 30`:
-    the four hard cases at one point for longer than the scan (numpy), one line each."""
+    the four hard cases at one point for longer than the scan, one line each (JSON with --json)."""
     import argparse
+    import json
+    import time
     import warnings
 
     from feelflow.solver.backend import create_solver
@@ -329,19 +334,35 @@ def main(argv=None) -> int:
     parser.add_argument("--u", type=float, required=True, help="wind speed (cells per step)")
     parser.add_argument("--nu", type=float, default=None, help="viscosity (default: --k gives it)")
     parser.add_argument("--k", type=float, default=None, help="instead of --nu: nu = U sqrt(d) / K")
-    parser.add_argument("--collision", default="trt", choices=COLLISIONS)
-    parser.add_argument("--size", type=int, default=DEFAULT_RESOLUTION)
+    parser.add_argument("--collision", default="trt", choices=ALL_COLLISIONS)
+    parser.add_argument("--smagorinsky", type=float, default=0.0, help="Smagorinsky constant (collision rr)")
+    parser.add_argument("--size", type=int, nargs="+", default=[DEFAULT_RESOLUTION], help="body size(s) in cells")
+    parser.add_argument("--scene", nargs="+", default=list(SCENES), choices=SCENES)
     parser.add_argument("--convective-times", type=float, default=CONVECTIVE_TIMES)
+    parser.add_argument("--backend", default="numpy", help="numpy or gl (EGL standalone context)")
     args = parser.parse_args(argv)
     if (args.nu is None) == (args.k is None):
         parser.error("give --nu or --k")
-    nu = args.nu if args.nu is not None else args.u * math.sqrt(args.size) / args.k
+    kwargs = {}
+    if args.backend == "gl":   # the CLI's way (DESIGN rule 2): an EGL standalone context
+        import moderngl
+
+        kwargs["ctx"] = moderngl.create_context(standalone=True, backend="egl", require=330)
+
+    def make_solver(config):
+        return create_solver(args.backend, config, **kwargs)
+
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore", RuntimeWarning)
-        for scene in SCENES:
-            p = run_point(lambda c: create_solver("numpy", c), scene, args.collision, args.u, nu, args.size,
-                          convective_times=args.convective_times)
-            print(p.to_dict(), flush=True)
+        for size in args.size:
+            nu = args.nu if args.nu is not None else args.u * math.sqrt(size) / args.k
+            for scene in args.scene:
+                start = time.perf_counter()
+                p = run_point(make_solver, scene, args.collision, args.u, nu, size,
+                              convective_times=args.convective_times, smagorinsky=args.smagorinsky)
+                row = {**p.to_dict(), "smagorinsky": args.smagorinsky, "backend": args.backend,
+                       "convective_times": args.convective_times, "seconds": round(time.perf_counter() - start, 1)}
+                print(json.dumps(row), flush=True)
     return 0
 
 
