@@ -65,56 +65,66 @@ class RegularisedCollider:
         return total
 
     def _block(self, f, target) -> float:
-        g = f.astype(np.float64)
-        drho = g.sum(axis=0)
-        rho = np.full_like(drho, RHO0) if self.incompressible else drho + RHO0
-        cx, cy = C[:, 0].astype(np.float64), C[:, 1].astype(np.float64)
-        jx = np.tensordot(cx, g, axes=1)
-        jy = np.tensordot(cy, g, axes=1)
+        """The moments of n come from those of f: sum f^eq = deq, sum c f^eq = rho u,
+        sum c c f^eq = deq / 3 I + rho u u (the second-order equilibrium on D2Q9)."""
+        f0, f1, f2, f3, f4, f5, f6, f7, f8 = f
+        drho = f0 + f1 + f2 + f3 + f4 + f5 + f6 + f7 + f8
+        rho = RHO0 if self.incompressible else drho + RHO0
+        sx = f1 + f5 + f8       # c_x = +1
+        wx = f3 + f6 + f7       # c_x = -1
+        jx = sx - wx
+        jy = (f2 + f5 + f6) - (f4 + f7 + f8)
+        exx = sx + wx           # sum c_x^2 f
+        eyy = f2 + f4 + f5 + f6 + f7 + f8
+        exy = (f5 + f7) - (f6 + f8)
         Fx, Fy = self.force
-        if self.has_force:
-            jx += 0.5 * Fx
-            jy += 0.5 * Fy
-        ux, uy = jx / rho, jy / rho
+        ux = (jx + 0.5 * Fx) / rho
+        uy = (jy + 0.5 * Fy) / rho
         deq = drho
         if self.keep is not None:   # absorbing layer (solver/sponge.py): as Collider
-            deq = drho * self.keep
-            ux = self.keep * ux + (1.0 - self.keep) * target
-            uy = self.keep * uy
-        usq = 1.5 * (ux * ux + uy * uy)
-        feq = np.empty_like(g)
-        for i in range(9):
-            cu = 3.0 * (cx[i] * ux + cy[i] * uy)
-            feq[i] = W[i] * (deq + rho * (cu + 0.5 * cu * cu - usq))
-        n = g - feq
-        a0 = n.sum(axis=0)
-        a1x = np.tensordot(cx, n, axes=1)
-        a1y = np.tensordot(cy, n, axes=1)
-        pxx = np.tensordot(cx * cx, n, axes=1)
-        pyy = np.tensordot(cy * cy, n, axes=1)
-        pxy = np.tensordot(cx * cy, n, axes=1)
+            keep = self.keep.astype(f.dtype)
+            deq = drho * keep
+            ux = keep * ux + (1.0 - keep) * target.astype(f.dtype)
+            uy = keep * uy
+        a0 = drho - deq
+        a1x = jx - rho * ux
+        a1y = jy - rho * uy
+        pxx = exx - deq / 3.0 - rho * ux * ux
+        pyy = eyy - deq / 3.0 - rho * uy * uy
+        pxy = exy - rho * ux * uy
         axx = pxx - a0 / 3.0
         ayy = pyy - a0 / 3.0
         axxy = 2.0 * ux * pxy + uy * axx
         axyy = 2.0 * uy * pxy + ux * ayy
         if self.smag:
             stress = np.sqrt(pxx * pxx + pyy * pyy + 2.0 * pxy * pxy)
-            tau = 0.5 * (self.tau0 + np.sqrt(self.tau0 * self.tau0 + self.smag * stress / (drho + RHO0)))
-            omega = 1.0 / tau
+            tau0 = self.tau0 if np.isscalar(self.tau0) else self.tau0.astype(f.dtype)
+            omega = 1.0 / (0.5 * (tau0 + np.sqrt(tau0 * tau0 + self.smag * stress / (drho + RHO0))))
         else:
-            omega = self.omega
+            omega = self.omega if np.isscalar(self.omega) else self.omega.astype(f.dtype)
         keep_neq = 1.0 - omega
+        usq = 1.5 * (ux * ux + uy * uy)
         if self.has_force:
             uF = ux * Fx + uy * Fy
             src = 1.0 - 0.5 * omega
+        # the direction-independent parts: w_i [deq - rho usq + (1 - omega)(a0 - 3/2 (a_xx + a_yy))] / w_i
+        base = deq - rho * usq
+        reg0 = a0 - 1.5 * (axx + ayy)
         for i in range(9):
-            hxx, hyy, hxy = cx[i] ** 2 - 1.0 / 3.0, cy[i] ** 2 - 1.0 / 3.0, cx[i] * cy[i]
-            hxxy, hxyy = cx[i] ** 2 * cy[i] - cy[i] / 3.0, cx[i] * cy[i] ** 2 - cx[i] / 3.0
-            reg = (a0 + 3.0 * (cx[i] * a1x + cy[i] * a1y)
-                   + 4.5 * (hxx * axx + hyy * ayy + 2.0 * hxy * pxy) + 13.5 * (hxxy * axxy + hxyy * axyy))
-            out = feq[i] + keep_neq * (W[i] * reg)
+            cx, cy = float(C[i, 0]), float(C[i, 1])
+            cu = 3.0 * (cx * ux + cy * uy) if (cx or cy) else None
+            feq = base if cu is None else base + rho * (cu + 0.5 * cu * cu)
+            reg = reg0
+            if cx:
+                reg = reg + 3.0 * cx * a1x + 4.5 * axx + 13.5 * (cy * cy - 1.0 / 3.0) * cx * axyy
+            if cy:
+                reg = reg + 3.0 * cy * a1y + 4.5 * ayy + 13.5 * (cx * cx - 1.0 / 3.0) * cy * axxy
+            if cx and cy:
+                reg = reg + 9.0 * cx * cy * pxy
+            out = W[i] * (feq + keep_neq * reg)
             if self.has_force:
-                cF = cx[i] * Fx + cy[i] * Fy
-                out += src * (W[i] * (9.0 * (cx[i] * ux + cy[i] * uy) * cF - 3.0 * uF + 3.0 * cF))
+                cF = cx * Fx + cy * Fy
+                cul = 0.0 if cu is None else cu
+                out = out + src * (W[i] * (3.0 * cul * cF - 3.0 * uF + 3.0 * cF))
             f[i] = out
         return float(drho.sum())
