@@ -62,6 +62,14 @@ ALL_COLLISIONS = ("bgk", "trt", "rr")
 VISCOSITIES = (0.002, 0.003, 0.004, 0.006, 0.008, 0.012, 0.018, 0.027, 0.04)
 SPEEDS = (0.02, 0.035, 0.05, 0.07, 0.09)
 SIZE_CHECK = (10, 40)
+#: the high-Reynolds hold (`hold_scan`): the operator the chooser adds beyond TRT's region, at the
+#: window's wind and the top wind, to lower viscosities, every hard case, d = 10, 20, 40, for
+#: HOLD_CONVECTIVE_TIMES d / U (solver/operator_choice.py, docs/science/collision-operators.md)
+HOLD_COLLISION = "rr"
+HOLD_SPEEDS = (0.05, 0.09)
+HOLD_RE_CELL = (50.0, 75.0, 100.0)
+HOLD_SIZES = (10, 20, 40)
+HOLD_CONVECTIVE_TIMES = 30.0
 CONVECTIVE_TIMES = 6.0
 U_BOUND = 0.35          # 0.6 c_s: far beyond any physical speed here (wind + body <= 0.19); a runaway
 CHECK_EVERY = 100        # steps between the max |u| checks
@@ -208,6 +216,23 @@ def scan(make_solver: SolverFactory, scenes=SCENES, collisions=COLLISIONS, speed
     return points
 
 
+def hold_scan(make_solver: SolverFactory, watch: Stopwatch | None = None, progress=None,
+              collision: str = HOLD_COLLISION, speeds=HOLD_SPEEDS, re_cells=HOLD_RE_CELL,
+              sizes=HOLD_SIZES) -> list[Point]:
+    """Every hard case at each (U, Re_cell = U / nu, d) for HOLD_CONVECTIVE_TIMES d / U."""
+    points = []
+    for size in sizes:
+        for scene in SCENES:
+            for speed in speeds:
+                for re_cell in re_cells:
+                    p = run_point(make_solver, scene, collision, speed, speed / re_cell, size, watch,
+                                  convective_times=HOLD_CONVECTIVE_TIMES)
+                    points.append(p)
+                    if progress:
+                        progress(p)
+    return points
+
+
 def limits(points) -> dict:
     """Per (scene, collision, size): the lowest Re_cell = U / nu at which a run failed, the
     highest Re_cell below which every run was stable, and per speed the bracket of nu."""
@@ -247,6 +272,7 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
         for d in SIZE_CHECK:   # does the limit move with the body size? (Re_cell or Re_D)
             points += scan(make_solver, scenes=(worst,), collisions=("trt",), size=d, watch=watch,
                            progress=progress)
+        points += hold_scan(make_solver, watch=watch, progress=progress)
     result = CaseResult(NAME, backend, size)
     guarded = []
     for key, lim in limits(points).items():
@@ -256,6 +282,9 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
     for collision in sorted({p.collision for p in points}):   # the constant K of solver/stability_limit.py
         result.quantities[f"k_measured_{collision}"] = min(
             lim["re_cell_stable"] * math.sqrt(k[2]) for k, lim in limits(points).items() if k[1] == collision)
+    for collision in sorted({p.collision for p in points} & {HOLD_COLLISION}):   # STABLE_CELL_REYNOLDS
+        result.quantities[f"re_cell_measured_{collision}"] = min(
+            lim["re_cell_stable"] for k, lim in limits(points).items() if k[1] == collision)
     for p in points:   # every point the window would allow must have been stable
         if p.nu >= min_stable_viscosity(p.speed, p.collision, p.size) - 1e-12:
             guarded.append(p)
@@ -281,8 +310,9 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
 
 def quick_points():
     """(scene, collision, U, nu) for the default test suite: per hard case, the window's own
-    corner (the highest wind at the lowest viscosity the guard allows, TRT as in the window)
-    and the panel's extreme corner (U = 0.09, nu = 0.002), far outside the measured region."""
+    corner (the highest wind at the lowest viscosity the guard allows) for TRT and for the
+    high-Reynolds operator, and TRT at the panel's extreme corner (U = 0.09, nu = 0.002), far
+    outside TRT's measured region."""
     from feelflow.solver.stability_limit import min_stable_viscosity
 
     u = max(SPEEDS)
@@ -290,6 +320,7 @@ def quick_points():
     for scene in SCENES:
         out.append((scene, "trt", u, min_stable_viscosity(u, "trt", DEFAULT_RESOLUTION)))
         out.append((scene, "trt", u, min(VISCOSITIES)))
+        out.append((scene, HOLD_COLLISION, u, min_stable_viscosity(u, HOLD_COLLISION, DEFAULT_RESOLUTION)))
     return out
 
 
