@@ -121,3 +121,14 @@ def test_rr_holds_where_trt_runs_away(request):
         rr = stability.run_point(lambda c: make_solver("numpy", c, request), "cylinder_shaken", "rr", u, nu)
     assert not trt.stable, trt.to_dict()
     assert rr.stable and rr.max_u < stability.U_BOUND, rr.to_dict()
+
+
+def test_shedding_period_reads_the_period_of_a_sampled_sine():
+    """The Strouhal case's frequency reader (solver/validation/strouhal.py) on a known signal:
+    period 123.4 steps, sampled every 10, with an offset."""
+    from feelflow.solver.validation.strouhal import shedding_period
+
+    t = np.arange(0, 3000, 10.0)
+    periods = shedding_period(t, 0.3 + np.sin(2 * math.pi * t / 123.4 + 0.4))
+    assert len(periods) >= 20
+    assert float(np.mean(periods)) == pytest.approx(123.4, rel=1e-3)
