@@ -522,6 +522,10 @@ class Simulation:
     def mach(self) -> float:
         return units.mach(self.params.wind)
 
+    def operator_line(self) -> str:
+        """Which collision operator runs and why, in one line (the status bar's)."""
+        return self.operator_for().reason
+
     def field_rgba(self) -> np.ndarray:
         return field_rgba(self.solver)
 

@@ -285,5 +285,4 @@ class FrameLoop:
         w.status["fps"].setText(f"{r['fps']:.0f} fps")
         w.status["re"].setText(f"Re {model.reynolds():.0f}")
         w.status["ma"].setText(f"Ma {model.mach():.3f}")
-        operator = getattr(model, "operator_for", None)   # the collision operator and why (one line)
-        w.status["operator"].setText(operator().reason if operator is not None else "")
+        w.status["operator"].setText(model.operator_line())   # the collision operator and why
