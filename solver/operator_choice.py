@@ -5,7 +5,8 @@ The operators, cheapest first (costs per step: docs/science/collision-operators.
 (Ginzburg 2008), then recursive-regularised BGK (`rr`, solver/regularised.py). Both keep the
 validation results at the Mach numbers the tunnel allows (FlowConfig.mach_limit); what tells
 them apart is stability, measured on the hard cases (solver/stability_limit.py): TRT holds
-U sqrt(d) / nu <= margin x K, rr the cell Reynolds number U / nu <= margin x its measured limit.
+U sqrt(d) / nu <= margin x K, rr the cell Reynolds number U / nu <= margin x its measured limit,
+which falls with the body size and, above the wind it was measured at, with the Mach number.
 The rule: TRT where it holds, else rr; beyond rr's region the stability guard of the window
 (app/model/simulation.py stable_params) raises the viscosity to rr's limit.
 """
@@ -51,7 +52,7 @@ def choose(speed: float, nu: float, size: float, mach_limit: float = 0.17, named
             else:
                 reason = (f"{NAMES[collision]}: U/nu {re_cell:.1f} beyond TRT's stable "
                           f"{max_cell_reynolds('trt', size):.1f} at d {size:g}, within its "
-                          f"{max_cell_reynolds(collision, size):.0f}, Ma {mach:.2f}")
+                          f"{max_cell_reynolds(collision, size, speed):.0f}, Ma {mach:.2f}")
             return Choice(collision, 0.0, reason)
     return Choice(MOST_STABLE, 0.0, f"{NAMES[MOST_STABLE]}: U/nu {re_cell:.1f} beyond every operator's "
                                     f"stable limit at d {size:g} (the window raises the viscosity)")

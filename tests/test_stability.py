@@ -93,14 +93,16 @@ def test_quick_case_meets_its_checks(request):
 def test_presets_lie_inside_the_guarded_region():
     """Every lesson's scene, and every wind of a lesson's sweep, at the scene's viscosity."""
     from feelflow.app.model.bodies import params_for_shape
+    from feelflow.solver.operator_choice import choose
     from feelflow.app.model.presets import PRESETS
     from feelflow.app.model.scene import load_scene
 
     for key, lesson in PRESETS.items():
         scene = load_scene(lesson.path)
         cfg, size = scene.config, params_for_shape(scene.body)[1]
-        for u in (cfg.inflow_speed, *lesson.wind_sweep):
-            assert inside(u, cfg.nu, cfg.collision, size), (key, u, cfg.nu, cfg.collision, size)
+        for u in (cfg.inflow_speed, *lesson.wind_sweep):   # each wind gets its operator (operator_choice)
+            collision = choose(u, cfg.nu, size, named=scene.operator_named).collision
+            assert inside(u, cfg.nu, collision, size), (key, u, cfg.nu, collision, size)
 
 
 def test_guard_raises_the_viscosity_and_says_so():
@@ -159,7 +161,8 @@ def test_cli_run_warns_in_one_line_outside_the_region_and_still_runs(tmp_path):
     from test_cli_run import ROOT, SMALL
 
     u = 0.04
-    for nu, warns in ((u / measured_cell_reynolds("trt", 8) * 0.5, True), (0.05, False)):
+    # outside every operator's region (the scene names none: the chooser takes the most stable)
+    for nu, warns in ((u / measured_cell_reynolds("rr", 8) * 0.5, True), (0.05, False)):
         scene = tmp_path / f"scene_{nu:g}.toml"
         scene.write_text(SMALL.replace("nu = 0.05", f"nu = {nu!r}"))
         out = tmp_path / "forces.csv"
