@@ -32,6 +32,11 @@ sec. 4.5 and 10.7: the grid Reynolds number U dx / nu bounds the resolvable flow
 which grows without bound as tau+ -> 1/2 (tau- = 32 at nu = 0.002): the odd (flux) moments are
 barely relaxed there, and on this scan TRT fails where BGK does not.
 
+The full scan also runs the high-Reynolds hold (`hold_scan`): the recursive-regularised operator
+(solver/regularised.py) on every hard case at U = 0.05 and 0.09, U / nu = 50, 75, 100,
+d = 10, 20, 40, for 30 d / U each (docs/science/collision-operators.md); `python -m
+feelflow.solver.validation.stability --collision rr --backend gl ...` runs single points of it.
+
 `feelflow validate --case stability [--backend gl] [--json PATH]` runs the full scan;
 `--quick` runs `quick_points()` (as the default test suite does): one point per hard case inside the
 window's guarded region (must stay finite and bounded) and one far outside (must diverge).
