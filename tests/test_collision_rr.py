@@ -132,3 +132,17 @@ def test_shedding_period_reads_the_period_of_a_sampled_sine():
     periods = shedding_period(t, 0.3 + np.sin(2 * math.pi * t / 123.4 + 0.4))
     assert len(periods) >= 20
     assert float(np.mean(periods)) == pytest.approx(123.4, rel=1e-3)
+
+
+def test_the_chooser_takes_trt_where_it_holds_rr_beyond_and_keeps_a_named_one():
+    from feelflow.solver.operator_choice import choose
+    from feelflow.solver.stability_limit import inside
+
+    low = choose(0.05, 0.02, 20)                  # U / nu = 2.5: inside TRT's measured region
+    assert low.collision == "trt" and inside(0.05, 0.02, "trt", 20) and "cheapest" in low.reason
+    high = choose(0.05, 0.001, 20)                # U / nu = 50: beyond TRT's, inside rr's
+    assert high.collision == "rr" and not inside(0.05, 0.001, "trt", 20) and inside(0.05, 0.001, "rr", 20)
+    assert choose(0.05, 0.001, 20, named="trt").collision == "trt"   # a scene's own choice stays
+    assert choose(0.05, 0.0001, 20).collision == "rr"                  # beyond both: the most stable
+    for c in (low, high):
+        assert "\n" not in c.reason and c.reason.startswith(("TRT", "regularised BGK"))
