@@ -23,7 +23,8 @@
 //     model's link terms (as shaders/link_sums.glsl: S1 + S2, or S1) and adds them to the running
 //     total of the block's steps in the spare channels zw of texture G4 (sums_keep 0 on a
 //     block's first step restarts it); the backend reads them once per block.
-//   TRT, GUO_FORCE, SPONGE: collision operator, Guo body force, outlet sponge (per-column rates).
+//   TRT, GUO_FORCE, SPONGE: collision operator, Guo body force, outlet sponge (per-column rates);
+//   RR 1: recursive-regularised BGK with the Smagorinsky option instead (shaders/collide_rr.glsl).
 //   X_PERIODIC 0/1; Y_MODE 0 no_slip, 1 free_slip, 2 periodic; NX_ODD: nx is odd.
 // @LATTICE
 // @INCLUDE paired_layout.glsl
@@ -99,6 +100,10 @@ float feq_shifted(int i, float drho, float rho, vec2 u) {
     return W[i] * (drho + rho * (cu + 0.5 * cu * cu - usq));
 }
 
+#if RR
+// @INCLUDE collide_rr.glsl
+#endif
+
 void store_pair(float a[9], float b[9]) {
     out0 = vec4(a[0], a[1], b[0], b[3]);
     out1 = vec4(a[2], a[5], b[2], b[6]);
@@ -144,6 +149,10 @@ void collide(inout float f[9], ivec2 x) {
     float op = omega_plus;
     float om = omega_minus;
     float deq = drho;
+#endif
+#if RR
+    collide_rr(f, drho, deq, rho, ux, uy, op);
+    return;
 #endif
     float usq = ux * ux;
     usq += uy * uy;

@@ -11,7 +11,8 @@ from feelflow.solver.lattice import CS2, RHO0
 
 X_BOUNDARIES = ("tunnel", "periodic")
 Y_BOUNDARIES = ("no_slip", "free_slip", "periodic")
-COLLISIONS = ("bgk", "trt")
+#: bgk, trt, and "rr": recursive-regularised BGK (solver/regularised.py), the high-Reynolds operator
+COLLISIONS = ("bgk", "trt", "rr")
 #: the equilibrium's velocity terms: rho u (compressible, the seed's eq. 9) or RHO0 u with
 #: u = j / RHO0 (incompressible, He & Luo 1997, J. Stat. Phys. 88, 927)
 EQUILIBRIA = ("compressible", "incompressible")
@@ -38,6 +39,8 @@ class FlowConfig:
     nu: float = 0.02
     collision: str = "trt"
     trt_magic: float = 3.0 / 16.0
+    #: Smagorinsky constant C of the eddy viscosity (collision "rr" only; 0: none)
+    smagorinsky: float = 0.0
     equilibrium: str = "compressible"
     dtype: str = "float64"
     x_boundary: str = "tunnel"
@@ -85,6 +88,10 @@ class FlowConfig:
         need(self.tau < 10, "nu", f"too large (tau = {self.tau:.2f} > 10): lower the viscosity or raise the resolution")
         need(self.collision in COLLISIONS, "collision", f"must be one of {COLLISIONS}, got {self.collision!r}")
         need(self.equilibrium in EQUILIBRIA, "equilibrium", f"must be one of {EQUILIBRIA}, got {self.equilibrium!r}")
+        need(math.isfinite(self.smagorinsky) and 0.0 <= self.smagorinsky <= 0.5, "smagorinsky",
+             f"must be in 0..0.5, got {self.smagorinsky!r}")
+        need(self.smagorinsky == 0.0 or self.collision == "rr", "smagorinsky",
+             f"only the rr collision takes a Smagorinsky constant (collision is {self.collision!r})")
         need(0 < self.trt_magic < 10, "trt_magic", f"must be in (0, 10), got {self.trt_magic!r}")
         need(self.dtype in DTYPES, "dtype", f"must be one of {DTYPES}, got {self.dtype!r}")
         need(self.x_boundary in X_BOUNDARIES, "x_boundary", f"must be one of {X_BOUNDARIES}, got {self.x_boundary!r}")

@@ -34,6 +34,11 @@ class CpuSolver(NumpySolver):
 
         super().__init__(config)
         cfg = self.config
+        #: the recursive-regularised operator is not compiled: it runs numpy's reference step
+        #: (the same numbers, numpy's speed)
+        self._reference_step = cfg.collision == "rr"
+        if self._reference_step:
+            return
         nx, ny = cfg.nx, cfg.ny
         op, om = relaxation_rates(cfg)
         dt = self.dtype  # the kernels compute in the storage's precision, as numpy's Collider
@@ -89,6 +94,8 @@ class CpuSolver(NumpySolver):
         return self._redo
 
     def _step_once(self) -> None:
+        if self._reference_step:
+            return NumpySolver._step_once(self)
         g, out, pre = self.g, self._gin, self._pre
         t = self.time
         u_in = self._boundaries(g, pre, t)

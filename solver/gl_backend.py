@@ -2,7 +2,8 @@
 
 `GLSolver(config, ctx=moderngl_context)` implements `feelflow.solver.backend.Solver` with the
 same extra methods as the numpy reference (`add_force_model`, `body_window`) and the same
-physics: D2Q9 BGK or TRT collision (Ginzburg, Verhaeghe & d'Humieres 2008) with Guo forcing
+physics: D2Q9 BGK, TRT (Ginzburg, Verhaeghe & d'Humieres 2008) or recursive-regularised BGK
+(solver/regularised.py) collision with Guo forcing
 (Guo, Zheng & Shi 2002), walls, velocity inlet and pressure outlet, the outlet sponge
 (solver/sponge.py), and the moving body by interpolated bounce-back (Bouzidi, Firdaouss &
 Lallemand 2001). It never creates a GL context: the CLI and the tests hand it an EGL standalone
@@ -54,6 +55,7 @@ from feelflow.solver.gl_programs import begin_pass, create_program, set_uniforms
 from feelflow.solver.gl_regions import ALIGN, cover_triangle, regions
 from feelflow.solver.inflow import inlet_wall_profile, profile, ramp
 from feelflow.solver.lattice import Q, RHO0, equilibrium
+from feelflow.solver.regularised import smagorinsky_factor
 from feelflow.solver.relaxation import relaxation_rates
 from feelflow.solver.sponge import absorb_keep
 
@@ -78,6 +80,7 @@ class GLSolver(Solver):
         self.renderer = ctx.info.get("GL_RENDERER", "?")
         self._defines = {
             "TRT": cfg.collision == "trt",
+            "RR": cfg.collision == "rr",
             "INCOMPRESSIBLE": cfg.incompressible,
             "GUO_FORCE": any(c != 0.0 for c in cfg.body_force),
             "X_PERIODIC": cfg.x_boundary == "periodic",
@@ -97,7 +100,8 @@ class GLSolver(Solver):
             **dict(zip(G_NAMES, UNIT_G)), MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
             INFLOW=UNIT_INFLOW, OMEGA=UNIT_OMEGA, N=(nx, ny), grid_size=(tex_w, float(ny)),
             inv_n=(1.0 / tex_w, 1.0 / ny), body_force=tuple(float(v) for v in cfg.body_force),
-            omega_plus=float(np.ravel(op)[0]), omega_minus=float(np.ravel(om)[0]))  # column 0: no sponge
+            omega_plus=float(np.ravel(op)[0]), omega_minus=float(np.ravel(om)[0]),  # column 0: no sponge
+            smagorinsky=smagorinsky_factor(cfg.smagorinsky))
         self._objects = []  # GL objects to release
 
         def tex(size, components, dtype="f4", repeat=False):

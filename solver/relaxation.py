@@ -1,4 +1,4 @@
-"""Relaxation rates of the collision from the viscosity (BGK and TRT).
+"""Relaxation rates of the collision from the viscosity (BGK, TRT, and rr: one rate as BGK).
 
 tau = 3 nu + 1/2 (c_s^2 = 1/3); omega+ = 1 / tau. TRT (Ginzburg, Verhaeghe & d'Humieres,
 Commun. Comput. Phys. 3 (2008) 427): the odd rate omega- follows from the magic number

@@ -93,33 +93,46 @@ def test_quick_case_meets_its_checks(request):
 def test_presets_lie_inside_the_guarded_region():
     """Every lesson's scene, and every wind of a lesson's sweep, at the scene's viscosity."""
     from feelflow.app.model.bodies import params_for_shape
+    from feelflow.solver.operator_choice import choose
     from feelflow.app.model.presets import PRESETS
     from feelflow.app.model.scene import load_scene
 
     for key, lesson in PRESETS.items():
         scene = load_scene(lesson.path)
         cfg, size = scene.config, params_for_shape(scene.body)[1]
-        for u in (cfg.inflow_speed, *lesson.wind_sweep):
-            assert inside(u, cfg.nu, cfg.collision, size), (key, u, cfg.nu, cfg.collision, size)
+        for u in (cfg.inflow_speed, *lesson.wind_sweep):   # each wind gets its operator (operator_choice)
+            collision = choose(u, cfg.nu, size, named=scene.operator_named).collision
+            assert inside(u, cfg.nu, collision, size), (key, u, cfg.nu, collision, size)
 
 
 def test_guard_raises_the_viscosity_and_says_so():
-    from feelflow.app.model.simulation import Params, Simulation
+    """The window chooses its operator (solver/operator_choice.py), so its guard keeps the flow
+    inside the most stable operator's region; a scene that names TRT keeps TRT's region."""
+    from dataclasses import replace
 
-    sim = Simulation(Params(grid=(96, 48), size=10, wind=0.09, nu=0.002), backend="numpy")
+    from feelflow.app.model.simulation import Params, Simulation, default_base_config
+    from feelflow.solver.operator_choice import MOST_STABLE
+
+    sim = Simulation(Params(grid=(96, 48), size=10, wind=0.09, nu=0.0005), backend="numpy")
     assert sim.params.wind == 0.09   # the wind the student chose stays
-    assert inside(0.09, sim.params.nu, "trt", 10) and sim.config.nu == sim.params.nu
-    assert sim.params.nu < min_stable_viscosity(0.09, "trt", 10) + 1e-4   # raised to the limit, not beyond
+    assert inside(0.09, sim.params.nu, MOST_STABLE, 10) and sim.config.nu == sim.params.nu
+    assert sim.params.nu < min_stable_viscosity(0.09, MOST_STABLE, 10) + 1e-4   # raised to the limit, not beyond
     assert sim.guard_note.startswith(f"Viscosity raised to {sim.params.nu:.4f}")
+    assert sim.config.collision == MOST_STABLE   # beyond TRT's region
     sim.set_flow(nu=0.05)
-    assert sim.params.nu == 0.05 and sim.guard_note is None
-    sim.set_flow(nu=0.002)
-    assert sim.params.nu == pytest.approx(math.ceil(min_stable_viscosity(0.09, "trt", 10) * 1e4) / 1e4)
+    assert sim.params.nu == 0.05 and sim.guard_note is None and sim.config.collision == "trt"   # the cheapest
+    sim.set_flow(nu=0.0005)
+    assert sim.params.nu == pytest.approx(math.ceil(min_stable_viscosity(0.09, MOST_STABLE, 10) * 1e4) / 1e4)
     assert sim.guard_note is not None
-    nu = sim.params.nu
-    sim.set_shape(size=20)   # a larger body at the same wind needs a thicker fluid (Re_cell sqrt(d))
-    assert sim.params.nu > nu and inside(0.09, sim.params.nu, "trt", 20) and sim.config.nu == sim.params.nu
-    assert sim.guard_note is not None
+
+    named = Simulation(Params(grid=(96, 48), size=10, wind=0.09, nu=0.002), backend="numpy",
+                       base_config=replace(default_base_config((96, 48)), collision="trt"))
+    assert named.config.collision == "trt" and inside(0.09, named.params.nu, "trt", 10)
+    assert named.params.nu < min_stable_viscosity(0.09, "trt", 10) + 1e-4
+    nu = named.params.nu
+    named.set_shape(size=20)   # a larger body at the same wind needs a thicker fluid (Re_cell sqrt(d))
+    assert named.params.nu > nu and inside(0.09, named.params.nu, "trt", 20) and named.config.nu == named.params.nu
+    assert named.guard_note is not None
 
 
 def test_limit_falls_with_body_size_and_keeps_a_margin():
@@ -148,7 +161,8 @@ def test_cli_run_warns_in_one_line_outside_the_region_and_still_runs(tmp_path):
     from test_cli_run import ROOT, SMALL
 
     u = 0.04
-    for nu, warns in ((u / measured_cell_reynolds("trt", 8) * 0.5, True), (0.05, False)):
+    # outside every operator's region (the scene names none: the chooser takes the most stable)
+    for nu, warns in ((u / measured_cell_reynolds("rr", 8) * 0.5, True), (0.05, False)):
         scene = tmp_path / f"scene_{nu:g}.toml"
         scene.write_text(SMALL.replace("nu = 0.05", f"nu = {nu!r}"))
         out = tmp_path / f"forces_{nu:g}.csv"

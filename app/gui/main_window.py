@@ -77,7 +77,7 @@ class MainWindow(QMainWindow):
         self._dock("Controls", self.panel, Qt.RightDockWidgetArea)
         plot_dock = self._dock("Forces", self.plot, Qt.BottomDockWidgetArea)
         self.resizeDocks([plot_dock], [230], Qt.Vertical)
-        self.status = {k: QLabel() for k in ("steps", "mlups", "fps", "re", "ma", "renderer")}
+        self.status = {k: QLabel() for k in ("steps", "mlups", "fps", "re", "ma", "operator", "renderer")}
         for label in self.status.values():
             self.statusBar().addPermanentWidget(label)
 

@@ -118,7 +118,7 @@ class SidePanel(QScrollArea):
 
         # flow
         self.wind = QDoubleSpinBox(decimals=3, minimum=0.0, maximum=0.09, singleStep=0.005, suffix=" cells/step")
-        self.viscosity = QDoubleSpinBox(decimals=4, minimum=0.002, maximum=0.3, singleStep=0.002,
+        self.viscosity = QDoubleSpinBox(decimals=4, minimum=0.0005, maximum=0.3, singleStep=0.002,
                                         suffix=" cells\u00b2/step")
         self.reynolds = QLabel()
         self.mach = QLabel()

@@ -136,6 +136,13 @@ class ReplaySimulation:
     def mach(self) -> float:
         return units.mach(self.player.inflow_speed)
 
+    def operator_line(self) -> str:
+        """The recorded run's collision operator (the recording fixed it)."""
+        from feelflow.solver.operator_choice import NAMES
+
+        c = self.config.collision
+        return f"{NAMES.get(c, c)}: as recorded"
+
     def field_rgba(self):
         return field_rgba(self.solver)
 

@@ -21,6 +21,7 @@ from feelflow.solver.forces import MODELS
 #: FlowConfig field -> scene key (for messages from FlowConfig.validate)
 CONFIG_KEYS = {
     "nx": "grid.nx", "ny": "grid.ny", "nu": "flow.nu", "collision": "flow.collision",
+    "smagorinsky": "flow.smagorinsky",
     "trt_magic": "flow.trt_magic", "equilibrium": "flow.equilibrium", "dtype": "flow.dtype",
     "x_boundary": "flow.x_boundary",
     "y_boundary": "flow.walls", "inflow_speed": "flow.inflow_speed",
@@ -50,6 +51,8 @@ class Scene:
     backend: str
     reference_length: float  # frontal size of the body across the stream
     reference_speed: float   # inflow speed (or the fastest motion phase in fluid at rest)
+    operator_named: str | None = None   # flow.collision as the scene names it (None: chosen)
+    operator_reason: str = ""           # which operator runs and why (solver/operator_choice.py)
 
     @property
     def reynolds(self) -> float:
@@ -178,7 +181,8 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
     grid.done()
 
     flow = top.table("flow")
-    collision = flow.choice("collision", COLLISIONS, "trt")
+    named_operator = flow.choice("collision", COLLISIONS, None)   # None: solver/operator_choice.py picks
+    smagorinsky = flow.number("smagorinsky", 0.0, nonnegative=True)
     trt_magic = flow.number("trt_magic", 3.0 / 16.0, positive=True)
     equilibrium = flow.choice("equilibrium", EQUILIBRIA, "compressible")
     dtype = flow.choice("dtype", DTYPES, "float64")
@@ -228,6 +232,13 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
         nu = units.viscosity_for_reynolds(re_number, speed, length)
     elif nu is None:
         nu = 0.02
+    from feelflow.solver.operator_choice import choose
+
+    choice = choose(speed, nu, length, named=named_operator, smagorinsky=smagorinsky)
+    collision = choice.collision
+    if smagorinsky and collision != "rr":
+        reader.fail("flow.smagorinsky", f"only the rr collision takes a Smagorinsky constant "
+                                        f"(the scene runs {collision}); add flow.collision = \"rr\"")
 
     output = top.table("output")
     models = output.raw("forces", ["momentum_exchange"])
@@ -250,7 +261,8 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
 
     try:
         config = FlowConfig(
-            nx=nx, ny=ny, nu=nu, collision=collision, trt_magic=trt_magic, equilibrium=equilibrium,
+            nx=nx, ny=ny, nu=nu, collision=collision, smagorinsky=choice.smagorinsky, trt_magic=trt_magic,
+            equilibrium=equilibrium,
             dtype=dtype,
             x_boundary=x_boundary, y_boundary=walls, inflow_speed=inflow_speed,
             inflow_profile=inflow_profile, inflow_ramp_steps=ramp, body_force=body_force,
@@ -275,7 +287,8 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
 
     return Scene(source=source, config=config, body=body, motion=script, force_models=tuple(models),
                  output_interval=interval, steps=steps, backend=backend,
-                 reference_length=length, reference_speed=speed)
+                 reference_length=length, reference_speed=speed, operator_named=named_operator,
+                 operator_reason=choice.reason)
 
 
 #: shape parameters that are angles: radians in `shapes`, degrees in scene files

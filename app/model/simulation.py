@@ -17,6 +17,7 @@ from feelflow.solver.backend import create_solver
 from feelflow.solver.config import FlowConfig
 from feelflow.solver.inflow import ramp
 from feelflow.solver.motion import MotionRunner
+from feelflow.solver.operator_choice import MOST_STABLE, Choice, choose
 from feelflow.solver.stability_limit import inside, min_stable_viscosity
 
 #: grid presets offered in the side panel: label -> (nx, ny)
@@ -209,7 +210,9 @@ class Simulation:
         self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
         self.base_config = base_config or default_base_config(self.params.grid)
         self._wind_starts_everywhere = base_config is None   # default tunnel: no ramp, see below
-        self.params, self.guard_note = stable_params(self.params, self.base_config.collision)
+        # the collision operator: a given base configuration names it; else chosen per flow
+        self.operator_named = None if base_config is None else base_config.collision
+        self.params, self.guard_note = stable_params(self.params, self.guard_operator)
         self.sweep = None            # (wind speeds, steps each, first step): a wind-speed sweep
         self.sweep_slew_steps = self.SWEEP_SLEW_STEPS
         self.capped = False          # the Mach cap limited the body's speed in the last frame
@@ -217,13 +220,28 @@ class Simulation:
         self._build(keep_flow=False)
 
     # --- construction --------------------------------------------------------------------
+    @property
+    def guard_operator(self) -> str:
+        """The operator whose measured region the stability guard keeps the flow in: the named
+        one, else the most stable one the chooser can pick."""
+        return self.operator_named or MOST_STABLE
+
+    def operator_for(self, params: Params | None = None) -> Choice:
+        """The collision operator for `params` (solver/operator_choice.py) and why, in one line."""
+        p = params or self.params
+        base = self.base_config
+        return choose(p.wind, p.nu, p.size, base.mach_limit, named=self.operator_named,
+                      smagorinsky=base.smagorinsky)
+
     def flow_config(self, params: Params | None = None) -> FlowConfig:
-        """The base configuration (scene or default) with what the panel edits."""
+        """The base configuration (scene or default) with what the panel edits, and the operator."""
         p = params or self.params
         nx, ny = p.grid
         base = self.base_config
+        op = self.operator_for(p)
         extra = {"initial_velocity": (p.wind, 0.0)} if self._wind_starts_everywhere else {}
         return replace(base, nx=nx, ny=ny, nu=p.nu, inflow_speed=p.wind, y_boundary=p.wall,
+                       collision=op.collision, smagorinsky=op.smagorinsky,
                        sponge_cells=min(base.sponge_cells, nx // 4), **extra).validate()
 
     def _build(self, keep_flow: bool):
@@ -267,17 +285,20 @@ class Simulation:
         self.angle = self.angle_target = angle
         self._clamp_pose()
         self.solver.set_body(self.shape, self.vel, 0.0)
-        guarded, note = stable_params(self.params, self.base_config.collision)
+        guarded, note = stable_params(self.params, self.guard_operator)
         if note:   # a larger body needs a thicker fluid at this wind
             self.set_flow(nu=guarded.nu)
+        elif self.operator_for().collision != self.config.collision:   # the size changed the operator
+            self._build(keep_flow=True)
         self.guard_note = note
 
     def set_flow(self, wind=None, nu=None, wall=None):
         """Change inflow speed, viscosity or walls, keeping the flow as it is (raises ConfigError)."""
         params = replace(self.params, **{k: v for k, v in (("wind", wind), ("nu", nu), ("wall", wall)) if v is not None})
-        params, self.guard_note = stable_params(params, self.base_config.collision)
-        self.flow_config(params)  # validate first: a bad value leaves everything as it was
-        only_wind = (params.nu, params.wall) == (self.params.nu, self.params.wall)
+        params, self.guard_note = stable_params(params, self.guard_operator)
+        new = self.flow_config(params)  # validate first: a bad value leaves everything as it was
+        only_wind = ((params.nu, params.wall) == (self.params.nu, self.params.wall)
+                     and new.collision == self.config.collision)
         self.params = params
         if only_wind and hasattr(self.solver, "set_inflow_speed"):
             self.solver.set_inflow_speed(params.wind)   # live, no rebuild
@@ -361,11 +382,12 @@ class Simulation:
         cfg = scene.config
         models = [m for m in scene.force_models if m in FORCE_MODELS] or [self.params.force_model]
         self.base_config = cfg
+        self.operator_named = scene.operator_named
         self._wind_starts_everywhere = False
         self.params = replace(self.params, grid=(cfg.nx, cfg.ny), shape=kind, size=size or self.params.size,
                               angle_deg=math.degrees(scene.body.angle), wind=cfg.inflow_speed, nu=cfg.nu,
                               wall=cfg.y_boundary, force_model=models[0], compare_all=len(models) > 1)
-        self.params, self.guard_note = stable_params(self.params, cfg.collision)
+        self.params, self.guard_note = stable_params(self.params, self.guard_operator)
         self.polygon = verts
         self.runner = None
         self.sweep = None
@@ -499,6 +521,10 @@ class Simulation:
 
     def mach(self) -> float:
         return units.mach(self.params.wind)
+
+    def operator_line(self) -> str:
+        """Which collision operator runs and why, in one line (the status bar's)."""
+        return self.operator_for().reason
 
     def field_rgba(self) -> np.ndarray:
         return field_rgba(self.solver)

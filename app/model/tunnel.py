@@ -61,6 +61,10 @@ class TunnelModel(Protocol):
     def mach(self) -> float:
         ...
 
+    def operator_line(self) -> str:
+        """Which collision operator runs and why, in one line (solver/operator_choice.py)."""
+        ...
+
     def field_rgba(self) -> Any:
         """(ny, nx, 4) float32: rho, ux, uy, vorticity (the numpy path's field)."""
         ...

@@ -18,6 +18,7 @@ CASES: dict[str, str] = {
     "galilean": "feelflow.solver.validation.galilean",
     "mass": "feelflow.solver.validation.mass",
     "stability": "feelflow.solver.validation.stability",
+    "strouhal-re100": "feelflow.solver.validation.strouhal",
 }
 
 

@@ -47,6 +47,7 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
     block = sub * SAMPLES
     max_steps = int(max_convective_times * d / geo.u_mean)
     solver = geo.start(make_solver, refine=refine)
+    operator = solver.config.collision.upper()   # the case's TRT, or `feelflow validate --collision`
     watch = Stopwatch()
     converged = False
     try:
@@ -76,7 +77,7 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
     for quantity, rel in targets(d).items():
         result.checks.append(Check(f"{quantity}_rel_error", -rel, rel, SOURCE))
     result.checks.append(Check("converged", 1.0, 1.0, f"steady within {TOL:g} per {block} steps"))
-    result.notes = f"U_m = {geo.u_max} (Ma {geo.u_max * 3 ** 0.5:.3f}), TRT, {geo.nx} x {geo.ny}"
+    result.notes = f"U_m = {geo.u_max} (Ma {geo.u_max * 3 ** 0.5:.3f}), {operator}, {geo.nx} x {geo.ny}"
     if refine:
         result.quantities["cells_per_d_at_body"] = 2.0 * d
         result.notes += f", refined patch {geo.refined_patch()} at {2 * d} cells per diameter"

@@ -32,6 +32,11 @@ sec. 4.5 and 10.7: the grid Reynolds number U dx / nu bounds the resolvable flow
 which grows without bound as tau+ -> 1/2 (tau- = 32 at nu = 0.002): the odd (flux) moments are
 barely relaxed there, and on this scan TRT fails where BGK does not.
 
+The full scan also runs the high-Reynolds hold (`hold_scan`): the recursive-regularised operator
+(solver/regularised.py) on every hard case at U = 0.05 and 0.09, U / nu = 50, 75, 100,
+d = 10, 20, 40, for 30 d / U each (docs/science/collision-operators.md); `python -m
+feelflow.solver.validation.stability --collision rr --backend gl ...` runs single points of it.
+
 `feelflow validate --case stability [--backend gl] [--json PATH]` runs the full scan;
 `--quick` runs `quick_points()` (as the default test suite does): one point per hard case inside the
 window's guarded region (must stay finite and bounded) and one far outside (must diverge).
@@ -57,9 +62,19 @@ SPONGE_CELLS = 32
 SPONGE_ABSORB = 0.1
 SCENES = ("plate45", "cylinder_impulsive", "cylinder_shaken", "wedge_upstream")
 COLLISIONS = ("bgk", "trt")
+#: every operator a single point can run (`main`); the scan keeps COLLISIONS
+ALL_COLLISIONS = ("bgk", "trt", "rr")
 VISCOSITIES = (0.002, 0.003, 0.004, 0.006, 0.008, 0.012, 0.018, 0.027, 0.04)
 SPEEDS = (0.02, 0.035, 0.05, 0.07, 0.09)
 SIZE_CHECK = (10, 40)
+#: the high-Reynolds hold (`hold_scan`): the operator the chooser adds beyond TRT's region, at the
+#: window's wind and the top wind, to lower viscosities, every hard case, d = 10, 20, 40, for
+#: HOLD_CONVECTIVE_TIMES d / U (solver/operator_choice.py, docs/science/collision-operators.md)
+HOLD_COLLISION = "rr"
+HOLD_SPEEDS = (0.05, 0.09)
+HOLD_RE_CELL = (50.0, 75.0, 100.0)
+HOLD_SIZES = (10, 20, 40)
+HOLD_CONVECTIVE_TIMES = 30.0
 CONVECTIVE_TIMES = 6.0
 U_BOUND = 0.35          # 0.6 c_s: far beyond any physical speed here (wind + body <= 0.19); a runaway
 CHECK_EVERY = 100        # steps between the max |u| checks
@@ -93,10 +108,10 @@ class Point:
                 "max_u": None if not math.isfinite(self.max_u) else round(self.max_u, 5)}
 
 
-def scene_config(scene: str, collision: str, speed: float, nu: float, grid=GRID) -> FlowConfig:
+def scene_config(scene: str, collision: str, speed: float, nu: float, grid=GRID, smagorinsky: float = 0.0) -> FlowConfig:
     nx, ny = grid
     start = (0.0, 0.0) if scene == "cylinder_impulsive" else (speed, 0.0)
-    return FlowConfig(nx=nx, ny=ny, nu=nu, collision=collision, dtype="float32", x_boundary="tunnel",
+    return FlowConfig(nx=nx, ny=ny, nu=nu, collision=collision, smagorinsky=smagorinsky, dtype="float32", x_boundary="tunnel",
                       y_boundary="no_slip", inflow_speed=speed, inflow_ramp_steps=0, initial_velocity=start,
                       sponge_cells=min(SPONGE_CELLS, nx // 4), sponge_absorb=SPONGE_ABSORB).validate()
 
@@ -122,10 +137,11 @@ def _max_speed(solver) -> float:
 
 def run_point(make_solver: SolverFactory, scene: str, collision: str, speed: float, nu: float,
               size: int = DEFAULT_RESOLUTION, watch: Stopwatch | None = None,
-              convective_times: float = CONVECTIVE_TIMES, grid=GRID, u_bound: float = U_BOUND) -> Point:
+              convective_times: float = CONVECTIVE_TIMES, grid=GRID, u_bound: float = U_BOUND,
+              smagorinsky: float = 0.0) -> Point:
     """Run one point; its state is stable, diverged (SolverDiverged) or unbounded (max |u| above
     `u_bound`; pass math.inf to count only the solver's own divergence check)."""
-    config = scene_config(scene, collision, speed, nu, grid)
+    config = scene_config(scene, collision, speed, nu, grid, smagorinsky)
     body = scene_body(scene, size, grid)
     watch = watch or Stopwatch()
     steps = int(math.ceil(convective_times * size / speed))
@@ -205,6 +221,23 @@ def scan(make_solver: SolverFactory, scenes=SCENES, collisions=COLLISIONS, speed
     return points
 
 
+def hold_scan(make_solver: SolverFactory, watch: Stopwatch | None = None, progress=None,
+              collision: str = HOLD_COLLISION, speeds=HOLD_SPEEDS, re_cells=HOLD_RE_CELL,
+              sizes=HOLD_SIZES) -> list[Point]:
+    """Every hard case at each (U, Re_cell = U / nu, d) for HOLD_CONVECTIVE_TIMES d / U."""
+    points = []
+    for size in sizes:
+        for scene in SCENES:
+            for speed in speeds:
+                for re_cell in re_cells:
+                    p = run_point(make_solver, scene, collision, speed, speed / re_cell, size, watch,
+                                  convective_times=HOLD_CONVECTIVE_TIMES)
+                    points.append(p)
+                    if progress:
+                        progress(p)
+    return points
+
+
 def limits(points) -> dict:
     """Per (scene, collision, size): the lowest Re_cell = U / nu at which a run failed, the
     highest Re_cell below which every run was stable, and per speed the bracket of nu."""
@@ -244,6 +277,7 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
         for d in SIZE_CHECK:   # does the limit move with the body size? (Re_cell or Re_D)
             points += scan(make_solver, scenes=(worst,), collisions=("trt",), size=d, watch=watch,
                            progress=progress)
+        points += hold_scan(make_solver, watch=watch, progress=progress)
     result = CaseResult(NAME, backend, size)
     guarded = []
     for key, lim in limits(points).items():
@@ -253,6 +287,9 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
     for collision in sorted({p.collision for p in points}):   # the constant K of solver/stability_limit.py
         result.quantities[f"k_measured_{collision}"] = min(
             lim["re_cell_stable"] * math.sqrt(k[2]) for k, lim in limits(points).items() if k[1] == collision)
+    for collision in sorted({p.collision for p in points} & {HOLD_COLLISION}):   # STABLE_CELL_REYNOLDS
+        result.quantities[f"re_cell_measured_{collision}"] = min(
+            lim["re_cell_stable"] for k, lim in limits(points).items() if k[1] == collision)
     for p in points:   # every point the window would allow must have been stable
         if p.nu >= min_stable_viscosity(p.speed, p.collision, p.size) - 1e-12:
             guarded.append(p)
@@ -278,8 +315,9 @@ def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool =
 
 def quick_points():
     """(scene, collision, U, nu) for the default test suite: per hard case, the window's own
-    corner (the highest wind at the lowest viscosity the guard allows, TRT as in the window)
-    and the panel's extreme corner (U = 0.09, nu = 0.002), far outside the measured region."""
+    corner (the highest wind at the lowest viscosity the guard allows) for TRT and for the
+    high-Reynolds operator, and TRT at the panel's extreme corner (U = 0.09, nu = 0.002), far
+    outside TRT's measured region."""
     from feelflow.solver.stability_limit import min_stable_viscosity
 
     u = max(SPEEDS)
@@ -287,6 +325,7 @@ def quick_points():
     for scene in SCENES:
         out.append((scene, "trt", u, min_stable_viscosity(u, "trt", DEFAULT_RESOLUTION)))
         out.append((scene, "trt", u, min(VISCOSITIES)))
+        out.append((scene, HOLD_COLLISION, u, min_stable_viscosity(u, HOLD_COLLISION, DEFAULT_RESOLUTION)))
     return out
 
 
@@ -319,8 +358,10 @@ def format_details(result: CaseResult) -> str:
 
 def main(argv=None) -> int:
     """`python -m feelflow.solver.validation.stability --u 0.09 --nu 0.002 --collision bgk --convective-times 30`:
-    the four hard cases at one point for longer than the scan (numpy), one line each."""
+    the four hard cases at one point for longer than the scan, one line each (JSON with --json)."""
     import argparse
+    import json
+    import time
     import warnings
 
     from feelflow.solver.backend import create_solver
@@ -329,19 +370,35 @@ def main(argv=None) -> int:
     parser.add_argument("--u", type=float, required=True, help="wind speed (cells per step)")
     parser.add_argument("--nu", type=float, default=None, help="viscosity (default: --k gives it)")
     parser.add_argument("--k", type=float, default=None, help="instead of --nu: nu = U sqrt(d) / K")
-    parser.add_argument("--collision", default="trt", choices=COLLISIONS)
-    parser.add_argument("--size", type=int, default=DEFAULT_RESOLUTION)
+    parser.add_argument("--collision", default="trt", choices=ALL_COLLISIONS)
+    parser.add_argument("--smagorinsky", type=float, default=0.0, help="Smagorinsky constant (collision rr)")
+    parser.add_argument("--size", type=int, nargs="+", default=[DEFAULT_RESOLUTION], help="body size(s) in cells")
+    parser.add_argument("--scene", nargs="+", default=list(SCENES), choices=SCENES)
     parser.add_argument("--convective-times", type=float, default=CONVECTIVE_TIMES)
+    parser.add_argument("--backend", default="numpy", help="numpy or gl (EGL standalone context)")
     args = parser.parse_args(argv)
     if (args.nu is None) == (args.k is None):
         parser.error("give --nu or --k")
-    nu = args.nu if args.nu is not None else args.u * math.sqrt(args.size) / args.k
+    kwargs = {}
+    if args.backend == "gl":   # the CLI's way (DESIGN rule 2): an EGL standalone context
+        import moderngl
+
+        kwargs["ctx"] = moderngl.create_context(standalone=True, backend="egl", require=330)
+
+    def make_solver(config):
+        return create_solver(args.backend, config, **kwargs)
+
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore", RuntimeWarning)
-        for scene in SCENES:
-            p = run_point(lambda c: create_solver("numpy", c), scene, args.collision, args.u, nu, args.size,
-                          convective_times=args.convective_times)
-            print(p.to_dict(), flush=True)
+        for size in args.size:
+            nu = args.nu if args.nu is not None else args.u * math.sqrt(size) / args.k
+            for scene in args.scene:
+                start = time.perf_counter()
+                p = run_point(make_solver, scene, args.collision, args.u, nu, size,
+                              convective_times=args.convective_times, smagorinsky=args.smagorinsky)
+                row = {**p.to_dict(), "smagorinsky": args.smagorinsky, "backend": args.backend,
+                       "convective_times": args.convective_times, "seconds": round(time.perf_counter() - start, 1)}
+                print(json.dumps(row), flush=True)
     return 0
 
 

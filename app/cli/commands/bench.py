@@ -1,5 +1,6 @@
-"""`feelflow bench [solver|accuracy|haptics]`: speed of the solver backends, their speed against
-their error, or the haptic loop.
+"""`feelflow bench [solver|accuracy|haptics|operators]`: speed of the solver backends, their speed
+against their error, the haptic loop, or the cost per step of each collision operator
+(`app/bench/operator_cost.py`).
 
 The solver bench lives in `app/bench/solver_speed.py`, speed against error in
 `app/bench/accuracy.py`, the haptic one in `app/bench/haptic_loop.py`; this module only
@@ -12,7 +13,7 @@ import importlib
 from feelflow.app.bench.accuracy import AXES
 
 TARGETS = {"solver": "feelflow.app.bench.solver_speed", "accuracy": "feelflow.app.bench.accuracy",
-           "haptics": "feelflow.app.bench.haptic_loop"}
+           "haptics": "feelflow.app.bench.haptic_loop", "operators": "feelflow.app.bench.operator_cost"}
 
 
 def add_arguments(parser):
@@ -24,7 +25,7 @@ def add_arguments(parser):
                         help="haptics: the device to run the loop against (default: a simulator)")
     parser.add_argument("--seconds", type=float, default=None, help="how long to measure")
     parser.add_argument("--rounds", type=int, default=None,
-                        help="solver: alternating numpy / cpu / gl rounds per scene, medians reported (default 3; --quick 1)")
+                        help="solver, operators: alternating rounds (solver: numpy / cpu / gl) per scene, medians reported (default 3; --quick 1)")
     parser.add_argument("--grid", action="append", metavar="NXxNY",
                         help="solver: only this grid (repeatable; default 256x128, 512x256 and 1024x512)")
     parser.add_argument("--quick", action="store_true", help="solver, accuracy: fewer steps or points (smoke test)")

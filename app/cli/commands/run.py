@@ -141,7 +141,7 @@ def warn_outside_stable_region(scene, name) -> bool:
     speed = abs(scene.reference_speed)
     x0, y0, x1, y1 = scene.body.bounding_box()
     size = max(x1 - x0, y1 - y0)
-    limit = measured_cell_reynolds(cfg.collision, size)
+    limit = measured_cell_reynolds(cfg.collision, size, speed)
     if speed / cfg.nu <= limit:
         return False
     print(f"feelflow: warning: {name}: U / nu = {speed / cfg.nu:.3g} is above {limit:.3g}, the measured stable "

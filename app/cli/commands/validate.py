@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import platform
+from dataclasses import replace
 from pathlib import Path
 
 from feelflow.app.errors import UserError
@@ -23,6 +24,11 @@ def add_arguments(parser):
                              "is 4.1 diameters high; channel width for poiseuille, grid size for taylor-green); "
                              "default: each case's own")
     parser.add_argument("--backend", default="numpy", metavar="numpy|cpu|gl", help="solver backend (default: numpy)")
+    parser.add_argument("--collision", default=None, metavar="bgk|trt|rr",
+                        help="run the cases with this collision operator instead of their own (not the stability "
+                             "case, which names its operators)")
+    parser.add_argument("--smagorinsky", default=0.0, type=float, metavar="C",
+                        help="Smagorinsky constant with --collision rr (default 0: none)")
     parser.add_argument("--json", default=None, metavar="PATH", help="also write the results as JSON")
     parser.add_argument("--force", action="store_true", help="replace --json if it exists")
     parser.add_argument("--quick", action="store_true", help="small grids and short runs (the test-suite versions)")
@@ -112,6 +118,26 @@ def run_case(name: str, factory, resolution, quick: bool, backend: str, refine: 
     return result
 
 
+def operator_override(args) -> dict:
+    """{collision, smagorinsky} from --collision / --smagorinsky ({} when not given); UserError
+    naming the option when the pair is invalid."""
+    from feelflow.solver.config import COLLISIONS, ConfigError, FlowConfig
+
+    collision = getattr(args, "collision", None)
+    smagorinsky = float(getattr(args, "smagorinsky", 0.0) or 0.0)
+    if collision is None:
+        if smagorinsky:
+            raise UserError("--smagorinsky: needs --collision rr")
+        return {}
+    if collision not in COLLISIONS:
+        raise UserError(f"--collision: must be one of {', '.join(COLLISIONS)}, got {collision!r}")
+    try:
+        FlowConfig(nx=16, ny=16, collision=collision, smagorinsky=smagorinsky).validate()
+    except ConfigError as exc:
+        raise UserError(f"--{exc.key}: {str(exc).split(': ', 1)[1]}") from None
+    return {"collision": collision, "smagorinsky": smagorinsky}
+
+
 def main(args) -> int:
     from feelflow.app.cli.commands.run import positive_int_option
     from feelflow.app.headless import make_solver
@@ -145,19 +171,26 @@ def main(args) -> int:
 
         check_output(args.json, "--json", force=args.force)
 
+    operator = operator_override(args)
+
     def factory(config):
         return make_solver(args.backend, config)
+
+    def factory_with_operator(config):
+        return make_solver(args.backend, replace(config, **operator).validate())
 
     results = []
     for name in names:
         print(f"running {name} ...", flush=True)
-        result = run_case(name, factory, resolution, args.quick, args.backend, refine)
+        own = not operator or name == "stability"
+        result = run_case(name, factory if own else factory_with_operator, resolution, args.quick, args.backend, refine)
         results.append(result)
         print(f"  {name}: {'targets met' if result.passed else 'TARGETS NOT MET'} "
               f"({result.steps} steps, {result.wall_seconds:.1f} s stepping, {result.case_seconds:.1f} s in all)",
               flush=True)
     machine = machine_description()
-    print(f"\nFeelFlow validation, backend {args.backend}{', refined patch' if refine else ''}, on {machine}\n")
+    op = f", collision {operator['collision']} (Smagorinsky C {operator['smagorinsky']:g})" if operator else ""
+    print(f"\nFeelFlow validation, backend {args.backend}{', refined patch' if refine else ''}{op}, on {machine}\n")
     print(format_table(results))
     for r in results:   # a case may add its own tables (e.g. the stability map)
         details = getattr(case_module(r.name), "format_details", None)
@@ -168,5 +201,6 @@ def main(args) -> int:
           + (f"; not met: {', '.join(failed)}" if failed else ""))
     if args.json:
         write_json_atomic(Path(args.json), {"machine": machine, "backend": args.backend, "refine": refine,
+                                            "operator": operator or None,
                                             "cases": [r.to_dict() for r in results]})
     return 0 if not failed else 1

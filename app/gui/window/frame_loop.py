@@ -285,3 +285,4 @@ class FrameLoop:
         w.status["fps"].setText(f"{r['fps']:.0f} fps")
         w.status["re"].setText(f"Re {model.reynolds():.0f}")
         w.status["ma"].setText(f"Ma {model.mach():.3f}")
+        w.status["operator"].setText(model.operator_line())   # the collision operator and why
