@@ -2,16 +2,15 @@
 
 A serial port (/dev/ttyACM*, /dev/ttyUSB*) belongs to a group (`dialout` on Debian, Ubuntu and
 Fedora): its members may open it. A HID device (/dev/hidraw*) is root's alone unless a udev
-rule opens it up. `udev_rules()` writes FeelFlow's rule for every device it has a driver for
-(`python -m feelflow.haptics.permissions` prints it; `installer/install-desktop.sh --udev`
-installs it as RULES_FILE).
+rule opens it up: feelflow.haptics.udev writes FeelFlow's rule for every device it has a driver
+for (`python -m feelflow.haptics.udev` prints it; `installer/install-desktop.sh --udev` installs
+it as RULES_FILE).
 """
 from __future__ import annotations
 
 import errno
 import os
 import stat
-import sys
 
 RULES_FILE = "70-feelflow.rules"
 SERIAL_GROUP = "dialout"
@@ -57,24 +56,3 @@ def hid_fix(nodes: list[str]) -> str | None:
     if not denied:
         return None
     return f"no permission to use {', '.join(denied)}: {UDEV_FIX}"
-
-
-def udev_rules() -> str:
-    """The udev rule text for every device FeelFlow has a driver for (registry ids)."""
-    from feelflow.haptics.protocols import diyhid, spacemouse
-    from feelflow.haptics.registry import SERIAL_IDS
-
-    lines = ["# FeelFlow's haptic devices: the logged-in user (uaccess) and the dialout group may",
-             "# open them. Written by installer/install-desktop.sh --udev; --uninstall --udev removes it."]
-    hid = sorted(set(spacemouse.PRODUCTS) | {(diyhid.DEFAULT_VID, diyhid.DEFAULT_PID)})
-    for vid, pid in hid:
-        lines.append(f'KERNEL=="hidraw*", ATTRS{{idVendor}}=="{vid:04x}", ATTRS{{idProduct}}=="{pid:04x}", '
-                     'MODE="0660", TAG+="uaccess"')
-    for vid, pid in sorted(SERIAL_IDS):
-        lines.append(f'SUBSYSTEM=="tty", ATTRS{{idVendor}}=="{vid:04x}", ATTRS{{idProduct}}=="{pid:04x}", '
-                     f'MODE="0660", GROUP="{SERIAL_GROUP}", TAG+="uaccess"')
-    return "\n".join(lines) + "\n"
-
-
-if __name__ == "__main__":
-    sys.stdout.write(udev_rules())

@@ -13,7 +13,7 @@
 # Every file written is listed in a manifest (DATA/feelflow/installed-files.txt) with its checksum;
 # --uninstall removes exactly those that still hold what was written, and the folders install
 # created if they are empty (a bundle folder stays: delete it yourself).
-# --udev writes /etc/udev/rules.d/70-feelflow.rules (python -m feelflow.haptics.permissions):
+# --udev writes /etc/udev/rules.d/70-feelflow.rules (python -m feelflow.haptics.udev):
 # HID and serial haptic devices for the logged-in user; --udev --uninstall removes it.
 # update-desktop-database, update-mime-database and gtk-update-icon-cache run when present.
 set -euo pipefail
@@ -69,7 +69,7 @@ if [ "$udev" = 1 ]; then
     fi
   }
   [ -x "${python_m[0]}" ] || die "${python_m[0]} is missing: run installer/setup.sh first (or use a bundle)"
-  text="$("${python_m[@]}" -m feelflow.haptics.permissions)" || die "could not write the udev rule (see above)"
+  text="$("${python_m[@]}" -m feelflow.haptics.udev)" || die "could not write the udev rule (see above)"
   if [ "$uninstall" = 1 ]; then
     if [ ! -e "$rules" ]; then echo "$me: no udev rule to remove ($rules)"; exit 0; fi
     if [ "$(cat "$rules")" = "$text" ]; then

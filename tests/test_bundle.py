@@ -77,9 +77,9 @@ def test_run_record_and_open_the_session(bundle, tmp_path):
 def test_child_processes_run_from_the_bundle(bundle, tmp_path):
     """`feelflow -m MODULE`: the haptic loop's process and the serial simulator behind a pty
     both start as [sys.executable, "-m", ...], sys.executable being the bundle's program."""
-    from feelflow.haptics.permissions import udev_rules
+    from feelflow.haptics.udev import udev_rules
 
-    r = feelflow(bundle, tmp_path, "-m", "feelflow.haptics.permissions")
+    r = feelflow(bundle, tmp_path, "-m", "feelflow.haptics.udev")
     assert r.returncode == 0 and r.stdout == udev_rules(), r.stderr
     r = feelflow(bundle, tmp_path, "-m", "json.tool")
     assert r.returncode == 2 and "FeelFlow's own modules only" in r.stderr
@@ -122,7 +122,8 @@ def test_desktop_install_from_the_bundle_and_uninstall(bundle, tmp_path):
     assert r.returncode == 0, r.stderr
     assert list(home.iterdir()) == []
     # the udev rule, written by the bundle's own program
-    from feelflow.haptics.permissions import RULES_FILE, udev_rules
+    from feelflow.haptics.permissions import RULES_FILE
+    from feelflow.haptics.udev import udev_rules
 
     rules = tmp_path / "rules.d"
     rules.mkdir()

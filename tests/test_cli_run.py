@@ -88,7 +88,7 @@ def test_bad_steps_option(tmp_path, steps):
 
 def test_bad_backend_and_output_directory(tmp_path):
     scene = write(tmp_path, SMALL)
-    assert_one_line_error(feelflow("run", scene, "--backend", "cuda"), "--backend: must be one of gl, numpy")
+    assert_one_line_error(feelflow("run", scene, "--backend", "cuda"), "--backend: must be one of cpu, gl, numpy or auto")
     assert_one_line_error(feelflow("run", scene, "--out", tmp_path / "no" / "f.csv"), "--out: directory")
 
 

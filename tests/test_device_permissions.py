@@ -99,7 +99,7 @@ def test_hid_node_of_mode_000_names_the_udev_rule():
 
 
 def test_udev_rules_cover_every_device_with_a_driver():
-    from feelflow.haptics.permissions import udev_rules
+    from feelflow.haptics.udev import udev_rules
     from feelflow.haptics.protocols import diyhid, spacemouse
     from feelflow.haptics.registry import SERIAL_IDS, hid_driver_for
 

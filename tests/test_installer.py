@@ -255,7 +255,8 @@ def test_bundle_folder_without_a_program_is_one_line_and_exit_2(tmp_path):
 
 @needs_venv
 def test_udev_rule_install_and_uninstall(tmp_path):
-    from feelflow.haptics.permissions import RULES_FILE, udev_rules
+    from feelflow.haptics.permissions import RULES_FILE
+    from feelflow.haptics.udev import udev_rules
 
     rules_dir = tmp_path / "rules.d"
     rules_dir.mkdir()
@@ -272,7 +273,7 @@ def test_udev_rule_install_and_uninstall(tmp_path):
     (rules_dir / RULES_FILE).write_text(udev_rules() + "# local change\n")
     r = run_script(SCRIPT, tmp_path, "--udev", "--uninstall", FEELFLOW_UDEV_DIR=str(rules_dir))
     assert r.returncode == 0 and "kept" in r.stderr and (rules_dir / RULES_FILE).exists()
-    # from a bundle, the same rule (the program runs `feelflow -m feelflow.haptics.permissions`)
+    # from a bundle, the same rule (the program runs `feelflow -m feelflow.haptics.udev`)
     (rules_dir / RULES_FILE).unlink()
     stand_in_bundle(tmp_path / "bundle")
     r = run_script(tmp_path / "bundle" / "installer" / "install-desktop.sh", tmp_path, "--udev",

@@ -198,8 +198,8 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
         for key in ("sponge_strength", "sponge_absorb"):
             if flow.has(key) and x_boundary != "periodic":
                 reader.fail(f"flow.{key}", "has no effect without an absorbing layer (flow.sponge_cells > 0)")
-    if collision == "bgk" and flow.has("trt_magic"):
-        reader.fail("flow.trt_magic", "has no effect with flow.collision = \"bgk\" (it is TRT's parameter)")
+    if named_operator in ("bgk", "rr") and flow.has("trt_magic"):
+        reader.fail("flow.trt_magic", f"has no effect with flow.collision = \"{named_operator}\" (it is TRT's parameter)")
     inflow_speed = flow.number("inflow_speed", 0.05 if x_boundary == "tunnel" else 0.0, nonnegative=True)
     inflow_profile = flow.choice("inflow_profile", PROFILES, "uniform")
     ramp = flow.integer("inflow_ramp_steps", 1000, lo=0, hi=MAX_STEPS)
