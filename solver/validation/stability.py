@@ -380,7 +380,7 @@ def main(argv=None) -> int:
     if (args.nu is None) == (args.k is None):
         parser.error("give --nu or --k")
     kwargs = {}
-    if args.backend == "gl":   # the CLI's way (DESIGN rule 2): an EGL standalone context
+    if args.backend == "gl":   # the CLI's way (docs/developer/architecture.md, rule 2): an EGL standalone context
         import moderngl
 
         kwargs["ctx"] = moderngl.create_context(standalone=True, backend="egl", require=330)
