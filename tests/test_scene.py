@@ -102,7 +102,7 @@ BAD = [
     ({"output": {"forces": ["telepathy"]}}, "output.forces: unknown force model 'telepathy'"),
     ({"output": {"interval": 0}}, "output.interval: must be an integer >= 1, got 0"),
     ({"run": {"steps": "many"}}, "run.steps: must be an integer"),
-    ({"run": {"steps": 100, "backend": "cuda"}}, "run.backend: must be one of gl, numpy"),
+    ({"run": {"steps": 100, "backend": "cuda"}}, "run.backend: must be one of cpu, gl, numpy"),
     ({"run": None}, "run.steps: missing (required)"),
     ({"grid": None}, "grid: missing (required)"),
     ({"extras": {"a": 1}}, "extras: unknown key"),
