@@ -224,7 +224,8 @@ class Simulation:
         base = self.base_config
         extra = {"initial_velocity": (p.wind, 0.0)} if self._wind_starts_everywhere else {}
         return replace(base, nx=nx, ny=ny, nu=p.nu, inflow_speed=p.wind, y_boundary=p.wall,
-                       sponge_cells=min(base.sponge_cells, nx // 4), **extra).validate()
+                       sponge_cells=min(base.sponge_cells, nx // 4),
+                       inlet_sponge_cells=min(base.inlet_sponge_cells, nx // 8), **extra).validate()
 
     def _build(self, keep_flow: bool):
         config = self.flow_config()
