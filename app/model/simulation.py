@@ -39,6 +39,10 @@ FORCE_MODELS = {
 WALLS = {"no_slip": "Solid walls (no slip)", "free_slip": "Slippery walls (free slip)",
          "periodic": "No walls (periodic)"}
 
+#: columns of the inlet's absorbing layer in the window's tunnel (docs/science/quiet-tunnel.md)
+INLET_LAYER = 16
+
+
 def default_base_config(grid) -> FlowConfig:
     """What the panel does not edit: TRT, float32, an outlet sponge with its absorbing layer,
     and the wind blowing everywhere from the first step (initial velocity = inflow, no ramp).
@@ -47,9 +51,12 @@ def default_base_config(grid) -> FlowConfig:
     measured at 256 x 128); starting in uniform flow keeps the mean within +-4 % from the start.
     The absorbing layer (sponge_absorb, docs/science/algorithm.md step 3) lets that sound out: after a
     1000-step ramp at 256 x 128 the mean u swings by 0.3 % of U instead of 46 % (a test,
-    tests/test_solver_boundaries.py), so a change of wind settles at once."""
+    tests/test_solver_boundaries.py), so a change of wind settles at once. The inlet's layer
+    (inlet_sponge_cells) lets out the sound a moving or stopping body sends upstream
+    (docs/science/quiet-tunnel.md)."""
     nx, ny = grid
-    return FlowConfig(nx=nx, ny=ny, dtype="float32", inflow_ramp_steps=0, sponge_cells=32, sponge_absorb=0.1)
+    return FlowConfig(nx=nx, ny=ny, dtype="float32", inflow_ramp_steps=0, sponge_cells=32, sponge_absorb=0.1,
+                      inlet_sponge_cells=INLET_LAYER)
 
 
 #: distance (cells) the body's bounding box keeps from the domain edges
