@@ -46,6 +46,7 @@ class FlowConfig:
     sponge_strength: float = 10.0
     sponge_absorb: float = 0.0
     inlet_sponge_cells: int = 0
+    inlet_nonreflecting: float = 0.0
     initial_velocity: tuple[float, float] = (0.0, 0.0)
     mach_limit: float = 0.17
     extra: dict = field(default_factory=dict, compare=False)
@@ -102,6 +103,8 @@ class FlowConfig:
         need(self.inlet_sponge_cells + self.sponge_cells < self.nx // 2, "inlet_sponge_cells",
              f"the inlet and outlet layers ({self.inlet_sponge_cells} + {self.sponge_cells} columns) "
              f"must leave more than half of the {self.nx} columns free")
+        need(math.isfinite(self.inlet_nonreflecting) and 0.0 <= self.inlet_nonreflecting <= 0.1,
+             "inlet_nonreflecting", f"must be in 0..0.1, got {self.inlet_nonreflecting!r}")
         for key in ("body_force", "initial_velocity"):
             v = getattr(self, key)
             need(len(v) == 2 and all(math.isfinite(c) for c in v), key, "must be two finite numbers")

@@ -55,6 +55,7 @@ from feelflow.solver.gl_regions import ALIGN, cover_triangle, regions
 from feelflow.solver.inflow import inlet_wall_profile, profile, ramp
 from feelflow.solver.lattice import Q, RHO0, equilibrium
 from feelflow.solver.relaxation import relaxation_rates
+from feelflow.solver.quiet_inlet import CS_OVER_RHO0
 from feelflow.solver.sponge import absorb_keep, density_keep
 
 __all__ = ["BAND_WIDTH", "CHECK_EVERY", "GLSolver"]
@@ -83,6 +84,7 @@ class GLSolver(Solver):
             "X_PERIODIC": cfg.x_boundary == "periodic",
             "Y_MODE": _Y_MODE[cfg.y_boundary],
             "NX_ODD": nx % 2 == 1,
+            "QUIET_INLET": cfg.x_boundary == "tunnel" and cfg.inlet_nonreflecting > 0,
         }
         self._sponge = cfg.x_boundary == "tunnel" and (cfg.sponge_cells > 0 or absorb_keep(cfg) is not None)
         self._programs = {}
@@ -97,7 +99,9 @@ class GLSolver(Solver):
             **dict(zip(G_NAMES, UNIT_G)), MASK=UNIT_MASK, QA=UNIT_QA, QB=UNIT_QB,
             INFLOW=UNIT_INFLOW, OMEGA=UNIT_OMEGA, N=(nx, ny), grid_size=(tex_w, float(ny)),
             inv_n=(1.0 / tex_w, 1.0 / ny), body_force=tuple(float(v) for v in cfg.body_force),
-            omega_plus=float(np.ravel(op)[0]), omega_minus=float(np.ravel(om)[0]))  # column 0: no sponge
+            omega_plus=float(np.ravel(op)[0]), omega_minus=float(np.ravel(om)[0]),  # column 0: no sponge
+            **({"quiet_inlet": (float(cfg.inlet_nonreflecting), CS_OVER_RHO0)}
+               if cfg.x_boundary == "tunnel" and cfg.inlet_nonreflecting > 0 else {}))
         self._objects = []  # GL objects to release
 
         def tex(size, components, dtype="f4", repeat=False):
