@@ -36,8 +36,8 @@ uniform float omega_plus;      // 1 / tau
 uniform float omega_minus;     // TRT odd rate from the magic number
 uniform vec2 body_force;       // Guo force density F
 #if SPONGE
-uniform sampler2D OMEGA;       // (omega+, omega-, keep, keep_rho) of column ix in texel (ix, 0): the sponge
-                               // and the absorbing layers (numpy: relaxation_rates, absorb_keep, density_keep)
+uniform sampler2D OMEGA;       // (omega+, omega-, keep) of column ix in texel (ix, 0): the outlet sponge
+                               // and its absorbing layer (numpy: relaxation_rates, absorb_keep)
 #endif
 #if BODY
 uniform usampler2D MASK;       // per node: bit 0 solid; bit i (1..8) q[OPP[i], x] > 0; bit 8+i:
@@ -138,11 +138,11 @@ void collide(inout float f[9], ivec2 x) {
     float ux = jx / rho;
     float uy = jy / rho;
 #if SPONGE
-    vec4 rates = texelFetch(OMEGA, ivec2(x.x, 0), 0);
+    vec3 rates = texelFetch(OMEGA, ivec2(x.x, 0), 0).rgb;
     float op = rates.r;
     float om = rates.g;
-    // absorbing layers: equilibria of (RHO0 + keep_rho drho, keep u + (1 - keep) u_in(iy, t))
-    float deq = drho * rates.a;
+    // absorbing layer: equilibria of (RHO0 + keep drho, keep u + (1 - keep) u_in(iy, t))
+    float deq = drho * rates.b;
     ux *= rates.b;
     ux += (inflow_ramp * texelFetch(INFLOW, ivec2(x.y, 0), 0).r) * (1.0 - rates.b);
     uy *= rates.b;

@@ -31,14 +31,11 @@ class Collider:
     the equilibria use the density fluctuation drho * keep and the velocity
     keep u + (1 - keep) u_target, so each collision relaxes the node towards (RHO0, u_target) at
     omega+ (1 - keep); u_target = (target(iy), 0), `target` passed per call.
-    keep_rho: None (the density uses `keep`), or an (nx,) row for the density alone
-    (solver.sponge.density_keep: the inlet's layer relaxes the velocity only).
     incompressible: He & Luo's equilibrium (module docstring): rho -> RHO0 in the velocity terms.
     """
 
     def __init__(self, ny: int, nx: int, dtype, omega_p, omega_m, trt: bool, force=(0.0, 0.0),
-                 block_nodes: int = BLOCK_NODES, keep=None, incompressible: bool = False,
-                 keep_rho=None):
+                 block_nodes: int = BLOCK_NODES, keep=None, incompressible: bool = False):
         self.nx, self.ny = nx, ny
         self.rows = max(1, min(ny, block_nodes // nx))
         self.dtype = np.dtype(dtype)
@@ -64,7 +61,6 @@ class Collider:
         shape = (self.rows, nx)
         self.keep = None if keep is None else np.asarray(keep, dtype=dt)
         self.release = None if keep is None else np.asarray(1.0 - np.asarray(keep, np.float64), dtype=dt)
-        self.keep_rho = self.keep if keep_rho is None else np.asarray(keep_rho, dtype=dt)
         names = ("drho", "deq", "rho", "hrho", "ux", "uy", "q2", "cu", "sym", "anti", "t1", "t2", "uF")
         self._s = {n: np.empty(shape, dtype=dt) for n in names}
         if self.incompressible:
@@ -97,7 +93,7 @@ class Collider:
             deq = drho                 # the equilibria's density fluctuation
         else:
             deq = s["deq"]
-            mul(drho, self.keep_rho, out=deq)
+            mul(drho, self.keep, out=deq)
         sub(f1, f3, out=ux)
         ux += f5
         ux -= f6

@@ -45,7 +45,6 @@ class FlowConfig:
     sponge_cells: int = 0
     sponge_strength: float = 10.0
     sponge_absorb: float = 0.0
-    inlet_sponge_cells: int = 0
     inlet_nonreflecting: float = 0.0
     initial_velocity: tuple[float, float] = (0.0, 0.0)
     mach_limit: float = 0.17
@@ -98,11 +97,6 @@ class FlowConfig:
         need(self.sponge_strength >= 1, "sponge_strength", "must be >= 1")
         need(math.isfinite(self.sponge_absorb) and 0.0 <= self.sponge_absorb <= 0.5, "sponge_absorb",
              f"must be in 0..0.5, got {self.sponge_absorb!r}")
-        need(isinstance(self.inlet_sponge_cells, int) and 0 <= self.inlet_sponge_cells < self.nx // 4,
-             "inlet_sponge_cells", f"must be an integer in 0..{self.nx // 4 - 1}")
-        need(self.inlet_sponge_cells + self.sponge_cells < self.nx // 2, "inlet_sponge_cells",
-             f"the inlet and outlet layers ({self.inlet_sponge_cells} + {self.sponge_cells} columns) "
-             f"must leave more than half of the {self.nx} columns free")
         need(math.isfinite(self.inlet_nonreflecting) and 0.0 <= self.inlet_nonreflecting <= 0.1,
              "inlet_nonreflecting", f"must be in 0..0.1, got {self.inlet_nonreflecting!r}")
         for key in ("body_force", "initial_velocity"):

@@ -56,7 +56,7 @@ from feelflow.solver.inflow import inlet_wall_profile, profile, ramp
 from feelflow.solver.lattice import Q, RHO0, equilibrium
 from feelflow.solver.relaxation import relaxation_rates
 from feelflow.solver.quiet_inlet import CS_OVER_RHO0
-from feelflow.solver.sponge import absorb_keep, density_keep
+from feelflow.solver.sponge import absorb_keep
 
 __all__ = ["BAND_WIDTH", "CHECK_EVERY", "GLSolver"]
 
@@ -86,7 +86,7 @@ class GLSolver(Solver):
             "NX_ODD": nx % 2 == 1,
             "QUIET_INLET": cfg.x_boundary == "tunnel" and cfg.inlet_nonreflecting > 0,
         }
-        self._sponge = cfg.x_boundary == "tunnel" and (cfg.sponge_cells > 0 or absorb_keep(cfg) is not None)
+        self._sponge = cfg.x_boundary == "tunnel" and cfg.sponge_cells > 0
         self._programs = {}
         op, om = relaxation_rates(cfg)
         # texels: the lattice's ceil(nx / 2) columns, then (tunnels) the band area; an
@@ -123,11 +123,10 @@ class GLSolver(Solver):
         self._qa_tex.write(np.zeros((ny, nx, 4), "f4"))
         self._qb_tex.write(np.zeros((ny, nx, 4), "f4"))
         self._inflow_tex = tex((ny, 1), 4)  # row profile, rule c's three inlet links
-        self._omega_tex = tex((nx, 1), 4)
-        keep, keep_rho = absorb_keep(cfg), density_keep(cfg)
+        self._omega_tex = tex((nx, 1), 3)
+        keep = absorb_keep(cfg)
         rates = np.stack(np.broadcast_arrays(np.asarray(op, float) * np.ones(nx), np.asarray(om, float),
-                                             np.ones(nx) if keep is None else keep,
-                                             np.ones(nx) if keep_rho is None else keep_rho), -1)
+                                             np.ones(nx) if keep is None else keep), -1)
         self._omega_tex.write(rates.astype("f4").tobytes())
         self._inflow_key = None
         self._draws, self._draw_regions = [], None  # [(vertex array, scissor boxes)]
@@ -164,14 +163,9 @@ class GLSolver(Solver):
 
     def _regions(self, window):
         """solver/gl_regions.py `regions` for the body window (x0, y0, x1, y1) in nodes, or None."""
-        cfg = self.config
-        sponge_from = inlet_to = None
-        if self._sponge and cfg.sponge_cells > 0:
-            sponge_from = (self.nx - cfg.sponge_cells) // 2 // ALIGN * ALIGN
-        if self._sponge and cfg.inlet_sponge_cells > 0 and cfg.sponge_absorb > 0:
-            inlet_to = -(-(-(-cfg.inlet_sponge_cells // 2)) // ALIGN) * ALIGN  # texels, aligned up
+        sponge_from = (self.nx - self.config.sponge_cells) // 2 // ALIGN * ALIGN if self._sponge else None
         return regions(self._kx, self.ny, None if window is None else texel_box(window), sponge_from,
-                       self._wraps_free(), inlet_to)
+                       self._wraps_free())
 
     def _wraps_free(self) -> bool:
         """Both directions periodic, an even nx (whole texels), streamed through REPEAT

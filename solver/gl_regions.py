@@ -7,8 +7,7 @@ rectangles, each with the compile-time variant (BODY, EDGES, SPONGE) it needs:
 - the interior: plain streaming and collision (rule f of the algorithm), the fast path;
 - edge strips ALIGN texels wide: channel walls (half-way bounce-back or specular reflection),
   the velocity inlet, the pressure outlet and the periodic wrap;
-- the outlet sponge's and the inlet layer's columns: per-column relaxation rates and absorbing
-  layers (solver/sponge.py);
+- the outlet sponge's columns: per-column relaxation rates (solver/sponge.py);
 - the body window: Bouzidi, Firdaouss & Lallemand (2001) links with the moving-wall term, and
   the solid nodes.
 Rectangles are aligned to the 4x4 blocks (a partly covered block runs the whole shader). The
@@ -35,18 +34,17 @@ def _aligned(window, kx: int, ny: int):
 
 
 def regions(kx: int, ny: int, window=None, sponge_from: int | None = None,
-            wraps_free: bool = False, inlet_to: int | None = None) -> dict:
+            wraps_free: bool = False) -> dict:
     """{(body, edges, sponge): [rectangles (x0, y0, x1, y1)]} in texels of a grid `kx` texels
     wide and `ny` high.
 
     window: the body window's texel box, or None; sponge_from: the first texel column of the
     sponge (aligned down), or None without a sponge; wraps_free: both directions periodic and
-    the REPEAT samplers wrap exactly (an even nx), so the fast path needs no edge strips;
-    inlet_to: the texel column after the inlet's absorbing layer (aligned up), or None.
+    the REPEAT samplers wrap exactly (an even nx), so the fast path needs no edge strips.
     A grid too small for strips is drawn by one variant with every rule.
     """
     a = ALIGN
-    sp = int(sponge_from is not None or inlet_to is not None)
+    sp = int(sponge_from is not None)
     x1, y1 = (kx - 1) // a * a, (ny - 1) // a * a
     has_window = window is not None and window[0] < window[2] and window[1] < window[3]
     if x1 <= a or y1 <= a:
@@ -64,16 +62,12 @@ def regions(kx: int, ny: int, window=None, sponge_from: int | None = None,
         inside = w[0] >= a and w[1] >= a and w[2] <= x1 and w[3] <= y1
         parts[(1, 0, sp) if inside else (1, 1, sp)] = [w]
     if sp:  # the interior's sponge columns get the variant with per-column rates
-        lo = 0 if inlet_to is None else inlet_to
-        hi = kx if sponge_from is None else sponge_from
         plain, sponge = [], []
         for r in parts[(0, 0, 0)]:
-            if r[0] < min(lo, r[2]):
-                sponge.append((r[0], r[1], min(lo, r[2]), r[3]))
-            if max(r[0], lo) < min(r[2], hi):
-                plain.append((max(r[0], lo), r[1], min(r[2], hi), r[3]))
-            if r[2] > max(hi, r[0]):
-                sponge.append((max(r[0], hi), r[1], r[2], r[3]))
+            if r[0] < sponge_from:
+                plain.append((r[0], r[1], min(r[2], sponge_from), r[3]))
+            if r[2] > sponge_from:
+                sponge.append((max(r[0], sponge_from), r[1], r[2], r[3]))
         parts[(0, 0, 0)], parts[(0, 0, 1)] = plain, sponge
     return {k: v for k, v in parts.items() if v}
 

@@ -20,7 +20,7 @@ from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS, inlet_wa
 from feelflow.solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 from feelflow.solver.relaxation import relaxation_rates
 from feelflow.solver.quiet_inlet import wall_velocity_correction
-from feelflow.solver.sponge import absorb_keep, density_keep
+from feelflow.solver.sponge import absorb_keep
 
 #: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall
 MIRROR_Y = np.array([0, 1, 4, 3, 2, 8, 7, 6, 5])
@@ -53,8 +53,7 @@ class NumpySolver(Solver):
         self._w = W.astype(self.dtype)
         op, om = relaxation_rates(cfg)
         self._collide = Collider(ny, nx, self.dtype, op, om, cfg.collision == "trt", cfg.body_force,
-                                 keep=absorb_keep(cfg), incompressible=cfg.incompressible,
-                                 keep_rho=density_keep(cfg))
+                                 keep=absorb_keep(cfg), incompressible=cfg.incompressible)
         self._roll = []
         for i in range(Q):
             cx, cy = int(C[i, 0]), int(C[i, 1])

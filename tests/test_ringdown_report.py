@@ -14,18 +14,18 @@ ROOT = Path(__file__).resolve().parents[1]
 CLI = [sys.executable, "-c", "import sys; from feelflow.app.cli.main import main; sys.exit(main())"]
 
 
-def test_window_case_is_the_windows_tunnel_and_before_differs_only_by_the_inlet_layer():
+def test_window_case_is_the_windows_tunnel_and_before_differs_only_by_the_inlet():
     cfg, body, _ = window_case()
     assert (cfg.nx, cfg.ny) == (256, 128) and body.diameter == 20
-    assert cfg.inlet_sponge_cells == default_base_config((256, 128)).inlet_sponge_cells > 0
+    assert cfg.inlet_nonreflecting == default_base_config((256, 128)).inlet_nonreflecting > 0
     assert cfg.inflow_speed * body.diameter / cfg.nu == 40.0
-    assert set(WINDOW_BEFORE) == {"inlet_sponge_cells"}
+    assert WINDOW_BEFORE == {"inlet_nonreflecting": 0.0}
 
 
 def test_quick_window_run_reports_both_swings():
     r = run_window("numpy", before=False, quick=True)
     assert r["settled_drag"] > 0 and r["swing_after_stop"] > 0 and r["swing_before_move"] > 0
-    assert r["boundaries"] == "after" and r["inlet_layer"] > 0
+    assert r["boundaries"] == "after" and r["quiet_inlet"] > 0
 
 
 def test_report_ringdown_refuses_bad_input_in_one_line():

@@ -39,8 +39,8 @@ FORCE_MODELS = {
 WALLS = {"no_slip": "Solid walls (no slip)", "free_slip": "Slippery walls (free slip)",
          "periodic": "No walls (periodic)"}
 
-#: columns of the inlet's absorbing layer in the window's tunnel (docs/science/quiet-tunnel.md)
-INLET_LAYER = 16
+#: the quiet inlet's rate in the window's tunnel (FlowConfig.inlet_nonreflecting, solver/quiet_inlet.py)
+QUIET_INLET_RATE = 1e-3
 
 
 def default_base_config(grid) -> FlowConfig:
@@ -51,12 +51,12 @@ def default_base_config(grid) -> FlowConfig:
     measured at 256 x 128); starting in uniform flow keeps the mean within +-4 % from the start.
     The absorbing layer (sponge_absorb, docs/science/algorithm.md step 3) lets that sound out: after a
     1000-step ramp at 256 x 128 the mean u swings by 0.3 % of U instead of 46 % (a test,
-    tests/test_solver_boundaries.py), so a change of wind settles at once. The inlet's layer
-    (inlet_sponge_cells) lets out the sound a moving or stopping body sends upstream
+    tests/test_solver_boundaries.py), so a change of wind settles at once. The quiet inlet
+    (inlet_nonreflecting) lets out the sound a moving or stopping body sends upstream
     (docs/science/quiet-tunnel.md)."""
     nx, ny = grid
     return FlowConfig(nx=nx, ny=ny, dtype="float32", inflow_ramp_steps=0, sponge_cells=32, sponge_absorb=0.1,
-                      inlet_sponge_cells=INLET_LAYER)
+                      inlet_nonreflecting=QUIET_INLET_RATE)
 
 
 #: distance (cells) the body's bounding box keeps from the domain edges
@@ -231,8 +231,7 @@ class Simulation:
         base = self.base_config
         extra = {"initial_velocity": (p.wind, 0.0)} if self._wind_starts_everywhere else {}
         return replace(base, nx=nx, ny=ny, nu=p.nu, inflow_speed=p.wind, y_boundary=p.wall,
-                       sponge_cells=min(base.sponge_cells, nx // 4),
-                       inlet_sponge_cells=min(base.inlet_sponge_cells, nx // 8), **extra).validate()
+                       sponge_cells=min(base.sponge_cells, nx // 4), **extra).validate()
 
     def _build(self, keep_flow: bool):
         config = self.flow_config()

@@ -42,9 +42,9 @@ QUICK = (300, 20, 300, (100, 300), 200)
 QUICK_PHASE_STEPS = 60
 #: the seed protocol's scenes and their "before" boundaries (as the scenes were)
 SEED_DIAMETERS = ("d16", "d24", "d32")
-SEED_BEFORE = {"sponge_absorb": 0.0, "inlet_sponge_cells": 0}
-#: the window's "before": its outlet sponge and absorbing layer, no inlet layer
-WINDOW_BEFORE = {"inlet_sponge_cells": 0}
+SEED_BEFORE = {"sponge_absorb": 0.0, "inlet_nonreflecting": 0.0}
+#: the window's "before": its outlet sponge and absorbing layer, the bare velocity inlet
+WINDOW_BEFORE = {"inlet_nonreflecting": 0.0}
 
 
 def window_case(hold: int = HOLD_STEPS, move: int = MOVE_STEPS, after: int = AFTER_STEPS):
@@ -96,7 +96,7 @@ def run_window(backend: str, before: bool, quick: bool = False) -> dict:
     still = (t > hold - before_window) & (t <= hold)
     settled = float(drag[after].mean())
     return {"case": "window", "backend": backend, "boundaries": "before" if before else "after",
-            "grid": f"{cfg.nx}x{cfg.ny}", "inlet_layer": cfg.inlet_sponge_cells, "absorb": cfg.sponge_absorb,
+            "grid": f"{cfg.nx}x{cfg.ny}", "quiet_inlet": cfg.inlet_nonreflecting, "absorb": cfg.sponge_absorb,
             "wall_s": round(time.perf_counter() - start, 1), "settled_drag": settled,
             "swing_after_stop": float(drag[after].std() / abs(settled)),
             "swing_before_move": float(drag[still].std() / abs(settled))}
@@ -124,7 +124,7 @@ def run_seed(key: str, backend: str, before: bool, scenes_dir: Path, phase_steps
     tail = (t > a + (b - a) // 2) & (t <= b)
     mean = float(drag[tail].mean())
     return {"case": f"seed {key}", "backend": backend, "boundaries": "before" if before else "after",
-            "grid": f"{cfg.nx}x{cfg.ny}", "inlet_layer": cfg.inlet_sponge_cells, "absorb": cfg.sponge_absorb,
+            "grid": f"{cfg.nx}x{cfg.ny}", "quiet_inlet": cfg.inlet_nonreflecting, "absorb": cfg.sponge_absorb,
             "wall_s": round(time.perf_counter() - start, 1), "settled_drag": mean,
             "swing_after_stop": float(drag[tail].std() / abs(mean)), "swing_before_move": None,
             "phase_steps": int(b - a)}
@@ -132,12 +132,12 @@ def run_seed(key: str, backend: str, before: bool, scenes_dir: Path, phase_steps
 
 def format_table(runs: list[dict]) -> str:
     """Markdown: one row per run, before and after side by side in run order."""
-    lines = ["| case | backend | boundaries | grid | inlet layer (cells) | absorb | settled drag "
+    lines = ["| case | backend | boundaries | grid | quiet inlet rate | absorb | settled drag "
              "| swing after the stop / drag | swing before any move / drag | wall s |",
              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in runs:
         before_move = "-" if r["swing_before_move"] is None else f"{100 * r['swing_before_move']:.2f} %"
-        lines.append(f"| {r['case']} | {r['backend']} | {r['boundaries']} | {r['grid']} | {r['inlet_layer']} "
+        lines.append(f"| {r['case']} | {r['backend']} | {r['boundaries']} | {r['grid']} | {r['quiet_inlet']:g} "
                      f"| {r['absorb']:g} | {r['settled_drag']:.5g} | {100 * r['swing_after_stop']:.2f} % "
                      f"| {before_move} | {r['wall_s']:.0f} |")
     return "\n".join(lines)
