@@ -55,7 +55,7 @@ from feelflow.solver.gl_regions import ALIGN, cover_triangle, regions
 from feelflow.solver.inflow import inlet_wall_profile, profile, ramp
 from feelflow.solver.lattice import Q, RHO0, equilibrium
 from feelflow.solver.relaxation import relaxation_rates
-from feelflow.solver.quiet_inlet import CS_OVER_RHO0
+from feelflow.solver.quiet_inlet import CS_OVER_RHO0, quiet_terms
 from feelflow.solver.sponge import absorb_keep
 
 __all__ = ["BAND_WIDTH", "CHECK_EVERY", "GLSolver"]
@@ -271,9 +271,13 @@ class GLSolver(Solver):
         r = float(ramp(t, cfg.inflow_ramp_steps))
         if self._uniform_values.get("inflow_ramp") != r:  # constant once the ramp is over
             self._uniform_values["inflow_ramp"] = r  # also for programs compiled later
+            quiet = {}
+            if self._defines["QUIET_INLET"]:  # bare inlet, reference held, during the ramp
+                quiet["quiet_inlet"] = quiet_terms(cfg.inlet_nonreflecting, r)
+                self._uniform_values.update(quiet)
             for (key, _), prog in self._programs.items():
                 if key[1] or key[2]:  # edges (the inlet), sponge (the absorbing layer's target)
-                    set_uniforms(prog, inflow_ramp=r)
+                    set_uniforms(prog, inflow_ramp=r, **quiet)
 
     def _bind_sources(self, side):
         for unit, texture in zip(UNIT_G, self._g[side]):

@@ -19,7 +19,7 @@ from feelflow.solver.forces.base import BodyWindow
 from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS, inlet_wall_profile, outlet_incoming, profile, ramp
 from feelflow.solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 from feelflow.solver.relaxation import relaxation_rates
-from feelflow.solver.quiet_inlet import wall_velocity_correction
+from feelflow.solver.quiet_inlet import quiet_terms, wall_velocity_correction
 from feelflow.solver.sponge import absorb_keep
 
 #: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall
@@ -140,7 +140,8 @@ class NumpySolver(Solver):
             for k, i in enumerate(INLET_DIRECTIONS):
                 gin[i, :, 0] = g[OPP[i], :, 0] + (6.0 * W[i] * RHO0 * r) * self._inlet_wall_profile[k]
             if cfg.inlet_nonreflecting > 0:  # the quiet inlet (solver/quiet_inlet.py)
-                corr = wall_velocity_correction(g[:, :, 0].sum(axis=0), self._drho_ref, cfg.inlet_nonreflecting)
+                corr = wall_velocity_correction(g[:, :, 0].sum(axis=0), self._drho_ref,
+                                                *quiet_terms(cfg.inlet_nonreflecting, r))
                 for i in INLET_DIRECTIONS:
                     gin[i, :, 0] += (6.0 * W[i] * RHO0) * corr
         if cfg.y_boundary != "periodic":
