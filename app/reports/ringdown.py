@@ -1,7 +1,8 @@
 """`feelflow report ringdown`: how long the tunnel's sound rings in the force after a body moves.
 
-Two cases, each run with the boundaries it had before the inlet's absorbing layer ("before") and
-with the quiet tunnel's boundaries ("after", solver/sponge.py; docs/science/quiet-tunnel.md):
+Two kinds of case, each run with the boundaries it had before the quiet inlet ("before": a bare
+velocity inlet; the seed scenes also without the outlet's absorbing layer) and with the quiet
+tunnel's ("after", solver/quiet_inlet.py, solver/sponge.py; docs/science/quiet-tunnel.md):
 - window: the window's default tunnel (app/model/simulation.py default_base_config, 256 x 128,
   wind everywhere from the first step), a cylinder D = 20 at Re = 40 (steady) where the window
   puts a body, held still HOLD_STEPS, moved against the stream at MOVE_SPEED for MOVE_STEPS,
