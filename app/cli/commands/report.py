@@ -65,14 +65,7 @@ def main(args) -> int:
     out = Path(args.out)
     if not out.is_dir():
         raise UserError(f"--out: {args.out!r} is not a folder")
-    phase_steps = None
-    if args.phase_steps is not None:
-        try:
-            phase_steps = int(args.phase_steps)
-        except ValueError:
-            phase_steps = 0
-        if phase_steps < 1:
-            raise UserError(f"--phase-steps: must be a positive integer, got {args.phase_steps!r}")
+    phase_steps = phase_steps_option(args.phase_steps, 1)
     parts = PARTS
     keys = None  # protocol diameters
     if args.only is not None:
@@ -144,14 +137,7 @@ def ringdown(args) -> int:
         gl_context()   # one line on stderr, exit 2, when there is no EGL context
     elif args.backend != "numpy":
         raise UserError(f"--backend: must be numpy or gl, got {args.backend!r}")
-    phase_steps = None
-    if args.phase_steps is not None:
-        try:
-            phase_steps = int(args.phase_steps)
-        except ValueError:
-            phase_steps = 0
-        if phase_steps < 1000:
-            raise UserError(f"--phase-steps: must be an integer >= 1000, got {args.phase_steps!r}")
+    phase_steps = phase_steps_option(args.phase_steps, 1000)
     folder = Path(args.scenes)
     cases = _chosen(args.only, ["window", *SEED_DIAMETERS], "case")
     runs = []
@@ -192,3 +178,17 @@ def _print_runs(runs: list[dict], table: str, json_path: str | None) -> int:
     if json_path:
         save_text(json_path, json.dumps({"machine": machine(), "runs": runs}, indent=1) + "\n", "--json")
     return 0
+
+
+def phase_steps_option(text, minimum: int) -> int | None:
+    """--phase-steps as an integer of at least `minimum` (None when not given); UserError otherwise."""
+    if text is None:
+        return None
+    try:
+        steps = int(text)
+    except ValueError:
+        steps = minimum - 1
+    if steps < minimum:
+        what = "a positive integer" if minimum == 1 else f"an integer >= {minimum}"
+        raise UserError(f"--phase-steps: must be {what}, got {text!r}")
+    return steps
