@@ -1,5 +1,10 @@
 """Backend parametrisation for solver physics tests: numpy, the compiled cpu backend, and gl
-(EGL standalone) where it has landed."""
+(EGL standalone).
+
+The cpu backend's runs of these physics tests are in the `slow` tier (`pytest -m slow`): each
+compiles its own kernel variant with numba on a fresh machine (20 - 30 s apiece), which would
+push the default run past its 15 minutes. The default run still checks the cpu backend against
+numpy case by case (tests/test_cpu_vs_numpy.py) and through the backend choice."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -11,7 +16,7 @@ GL_LANDED = (Path(__file__).resolve().parents[1] / "solver" / "gl_backend.py").e
 #: use as @pytest.mark.parametrize("backend", BACKENDS)
 BACKENDS = [
     "numpy",
-    "cpu",
+    pytest.param("cpu", marks=pytest.mark.slow),
     pytest.param("gl", marks=[pytest.mark.gl,
                               pytest.mark.skipif(not GL_LANDED, reason="solver/gl_backend.py not landed yet")]),
 ]

@@ -42,7 +42,7 @@ interval = 20
 
 
 def feelflow(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "app", *map(str, args)], cwd=cwd or ROOT,
+    return subprocess.run([sys.executable, "-m", "feelflow.app", *map(str, args)], cwd=cwd or ROOT,
                           capture_output=True, text=True, timeout=300)
 
 

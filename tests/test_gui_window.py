@@ -290,7 +290,7 @@ def test_settings_are_remembered(qtbot, tmp_path):
 
 def test_without_a_display_one_line_and_exit_2():
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
-    r = subprocess.run([sys.executable, "-m", "app"], env=env, capture_output=True, text=True, timeout=60)
+    r = subprocess.run([sys.executable, "-m", "feelflow.app"], env=env, capture_output=True, text=True, timeout=60)
     assert r.returncode == 2
     assert len(r.stderr.strip().splitlines()) == 1 and "display" in r.stderr and "Traceback" not in r.stderr
 

@@ -9,7 +9,7 @@ from feelflow.haptics import BadDeviceURL, list_devices, open_device
 
 
 def run(*args):
-    return subprocess.run([sys.executable, "-m", "app", *args], capture_output=True, text=True, timeout=120)
+    return subprocess.run([sys.executable, "-m", "feelflow.app", *args], capture_output=True, text=True, timeout=120)
 
 
 def test_devices_json_lists_the_simulators():

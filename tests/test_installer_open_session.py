@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_a_missing_session_file_is_one_line_and_exit_2(tmp_path):
     missing = tmp_path / "gone.ffsession"
-    r = subprocess.run([sys.executable, "-m", "app", "gui", str(missing)], cwd=ROOT,
+    r = subprocess.run([sys.executable, "-m", "feelflow.app", "gui", str(missing)], cwd=ROOT,
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2
     assert r.stderr.strip() == f"feelflow: {missing}: no such session file"

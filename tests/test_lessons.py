@@ -89,6 +89,6 @@ def test_drag_speed_lesson_fits_the_steady_drag_law():
 
 
 def test_report_lessons_refuses_an_unknown_lesson_in_one_line():
-    r = subprocess.run([sys.executable, "-m", "app", "report", "lessons", "--only", "waves"],
+    r = subprocess.run([sys.executable, "-m", "feelflow.app", "report", "lessons", "--only", "waves"],
                        capture_output=True, text=True)
     assert r.returncode == 2 and "waves" in r.stderr and len(r.stderr.strip().splitlines()) == 1

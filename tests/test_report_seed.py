@@ -10,7 +10,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def feelflow(*args, cwd=ROOT):
-    return subprocess.run([sys.executable, "-m", "app", *args], cwd=cwd, capture_output=True, text=True, timeout=600)
+    return subprocess.run([sys.executable, "-m", "feelflow.app", *args], cwd=cwd, capture_output=True, text=True, timeout=600)
 
 
 def test_quick_report_writes_markdown_and_plots(tmp_path):

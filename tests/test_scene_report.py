@@ -35,6 +35,6 @@ def test_the_layer_calms_the_classroom_scene_after_its_ramp():
 
 
 def test_report_scenes_refuses_an_unknown_scene_in_one_line():
-    r = subprocess.run([sys.executable, "-m", "app", "report", "scenes", "--only", "tidal"],
+    r = subprocess.run([sys.executable, "-m", "feelflow.app", "report", "scenes", "--only", "tidal"],
                        capture_output=True, text=True, cwd=ROOT)
     assert r.returncode == 2 and "tidal" in r.stderr and len(r.stderr.strip().splitlines()) == 1

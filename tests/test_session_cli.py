@@ -17,7 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def feelflow(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "app", *map(str, args)], cwd=cwd or ROOT,
+    return subprocess.run([sys.executable, "-m", "feelflow.app", *map(str, args)], cwd=cwd or ROOT,
                           capture_output=True, text=True, timeout=120)
 
 

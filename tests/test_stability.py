@@ -166,7 +166,7 @@ def test_cli_run_warns_in_one_line_outside_the_region_and_still_runs(tmp_path):
         scene = tmp_path / f"scene_{nu:g}.toml"
         scene.write_text(SMALL.replace("nu = 0.05", f"nu = {nu!r}"))
         out = tmp_path / f"forces_{nu:g}.csv"
-        result = subprocess.run([sys.executable, "-m", "app", "run", str(scene), "--steps", "20", "--out", str(out)],
+        result = subprocess.run([sys.executable, "-m", "feelflow.app", "run", str(scene), "--steps", "20", "--out", str(out)],
                                 cwd=ROOT, capture_output=True, text=True, timeout=300)
         assert result.returncode == 0, result.stderr
         assert out.exists()
