@@ -188,3 +188,25 @@ def test_regularised_operator_runs_the_reference_step():
         Cylinder(x=20 + 0.1 * k, y=16.3, diameter=8), velocity=(0.1, 0.0)), models=("momentum_exchange",))
     assert np.array_equal(solvers[0].distributions(), solvers[1].distributions())
     assert forces[0] == forces[1]
+
+
+def test_a_second_process_loads_the_compiled_kernels_from_the_disk_cache():
+    """numba compiles a kernel variant in tens of seconds; with cache=True a later process (the
+    next start of the window, the next CLI run) must load it from the on-disk cache, not compile
+    it again (solver/cpu_kernels.py make_kernels says what breaks that)."""
+    import subprocess
+    import sys
+
+    code = ("from feelflow.solver.backend import create_solver\n"
+            "from feelflow.solver.config import FlowConfig\n"
+            "s = create_solver('cpu', FlowConfig(nx=48, ny=24, dtype='float32', collision='trt', "
+            "sponge_cells=8, sponge_absorb=0.1))\n"
+            "s.step(2)\n"
+            "k = (s._stream_collide, s._redo_kernel)\n"
+            "print(sum(d.stats.cache_hits.total() for d in k), sum(d.stats.cache_misses.total() for d in k))\n")
+    runs = [subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+            for _ in range(2)]
+    for r in runs:
+        assert r.returncode == 0, r.stderr
+    hits, misses = map(int, runs[1].stdout.split())
+    assert misses == 0 and hits >= 1, runs[1].stdout
