@@ -52,6 +52,7 @@ class FlowConfig:
     sponge_cells: int = 0
     sponge_strength: float = 10.0
     sponge_absorb: float = 0.0
+    inlet_nonreflecting: float = 0.0
     initial_velocity: tuple[float, float] = (0.0, 0.0)
     mach_limit: float = 0.17
     extra: dict = field(default_factory=dict, compare=False)
@@ -107,6 +108,8 @@ class FlowConfig:
         need(self.sponge_strength >= 1, "sponge_strength", "must be >= 1")
         need(math.isfinite(self.sponge_absorb) and 0.0 <= self.sponge_absorb <= 0.5, "sponge_absorb",
              f"must be in 0..0.5, got {self.sponge_absorb!r}")
+        need(math.isfinite(self.inlet_nonreflecting) and 0.0 <= self.inlet_nonreflecting <= 0.1,
+             "inlet_nonreflecting", f"must be in 0..0.1, got {self.inlet_nonreflecting!r}")
         for key in ("body_force", "initial_velocity"):
             v = getattr(self, key)
             need(len(v) == 2 and all(math.isfinite(c) for c in v), key, "must be two finite numbers")
