@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass, field
 
 from feelflow.solver.lattice import CS2, RHO0
+from feelflow.solver.quiet_inlet import shortest_ramp
 
 X_BOUNDARIES = ("tunnel", "periodic")
 Y_BOUNDARIES = ("no_slip", "free_slip", "periodic")
@@ -110,6 +111,12 @@ class FlowConfig:
              f"must be in 0..0.5, got {self.sponge_absorb!r}")
         need(math.isfinite(self.inlet_nonreflecting) and 0.0 <= self.inlet_nonreflecting <= 0.1,
              "inlet_nonreflecting", f"must be in 0..0.1, got {self.inlet_nonreflecting!r}")
+        if self.inlet_nonreflecting > 0 and self.x_boundary == "tunnel":
+            shortest = shortest_ramp(self.nx)
+            need(self.inflow_ramp_steps == 0 or self.inflow_ramp_steps >= shortest, "inlet_nonreflecting",
+                 f"the quiet inlet needs the wind everywhere from the start (inflow_ramp_steps = 0) or a ramp of "
+                 f"at least {shortest} steps at nx = {self.nx} (got {self.inflow_ramp_steps}): a shorter ramp's "
+                 f"sound would leave through it as a swing of the inflow")
         for key in ("body_force", "initial_velocity"):
             v = getattr(self, key)
             need(len(v) == 2 and all(math.isfinite(c) for c in v), key, "must be two finite numbers")
