@@ -141,23 +141,27 @@ def _pull(g, y, ym, yp, x, xm, xp):
             g[5, ym, xm], g[6, ym, xp], g[7, yp, xp], g[8, yp, xm])
 
 
+@numba.njit(inline="always", **_JIT)
+def _edge(g, out, y, ym, yp, x, op, om, keep, t, Fx, Fy, trt, incomp, has_keep, has_force, K):
+    """One node with periodic neighbours and its own column's rates; returns drho."""
+    nx = g.shape[2]
+    f = _pull(g, y, ym, yp, x, x - 1 if x > 0 else nx - 1, x + 1 if x < nx - 1 else 0)
+    r = _collide(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], op[x], om[x], keep[x], t,
+                 trt, incomp, has_keep, Fx, Fy, has_force, K)
+    _store(out, y, x, r)
+    return r[9]
+
+
 @functools.lru_cache(maxsize=None)
 def make_kernels(trt: bool, incomp: bool, has_keep: bool, has_force: bool, dtype: str = "float32"):
     """(stream_collide, redo_nodes) compiled for one collision variant and storage type: the
     flags and constants are constants of the compiled code, so the inner loop has no branches
-    (cached per variant). The rates, keep, target and force passed to them are of `dtype`."""
+    (cached per variant). The rates, keep, target and force passed to them are of `dtype`.
+    Their closures hold only these flags and constants, never another compiled function: numba's
+    on-disk cache keys a closure by its variables' pickled bytes, and a compiled function pickles
+    with an id that is new in every process, so such a closure would compile again at every start."""
     T = np.dtype(dtype).type
     K = (T(0.5), T(1.0), T(3.0), T(W0), T(W1), T(W5), T(R0))
-
-    @numba.njit(inline="always", **_JIT)
-    def _edge(g, out, y, ym, yp, x, op, om, keep, t, Fx, Fy):
-        """One node with periodic neighbours and its own column's rates; returns drho."""
-        nx = g.shape[2]
-        f = _pull(g, y, ym, yp, x, x - 1 if x > 0 else nx - 1, x + 1 if x < nx - 1 else 0)
-        r = _collide(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], op[x], om[x], keep[x], t,
-                     trt, incomp, has_keep, Fx, Fy, has_force, K)
-        _store(out, y, x, r)
-        return r[9]
 
     @numba.njit(parallel=True, **_JIT)
     def stream_collide(g, out, op, om, keep, target, xs, Fx, Fy):
@@ -189,9 +193,9 @@ def make_kernels(trt: bool, incomp: bool, has_keep: bool, has_force: bool, dtype
                 b[8, :n] = g[8, yp, x0 - 1:x1 - 1]
                 s += _chunk(b, o, n, op0, om0, t, trt, incomp, Fx, Fy, has_force, K)
                 out[:, y, x0:x1] = o[:, :n]
-            s += _edge(g, out, y, ym, yp, 0, op, om, keep, t, Fx, Fy)
+            s += _edge(g, out, y, ym, yp, 0, op, om, keep, t, Fx, Fy, trt, incomp, has_keep, has_force, K)
             for x in range(xs, nx):
-                s += _edge(g, out, y, ym, yp, x, op, om, keep, t, Fx, Fy)
+                s += _edge(g, out, y, ym, yp, x, op, om, keep, t, Fx, Fy, trt, incomp, has_keep, has_force, K)
             rows[y] = s
         return rows.sum()
 

@@ -18,6 +18,7 @@ def _numpy64(config):
 _numpy32 = bench_accuracy._factory("numpy", "float32", None)
 
 
+@pytest.mark.slow
 def test_error_falls_with_resolution_and_work_rises():
     """Against the reference values (benchmarks.md): from 10 to 20 cells per diameter the C_D
     error falls, and dp converges at better than first order (2.5 observed here); the finer run

@@ -74,6 +74,21 @@ def test_run_record_and_open_the_session(bundle, tmp_path):
     assert "100 steps on gl" in gl.stdout
 
 
+def test_the_compiled_cpu_backend_runs_frozen_and_keeps_its_compiled_kernels(bundle, tmp_path):
+    """numba inside the bundle: the kernels compile on the first run into the user's cache (the
+    bundle's own folder may be read-only) and the second run loads them: it writes nothing new."""
+    scene = tmp_path / "tunnel.toml"
+    shutil.copy(ROOT / "scenes" / "cylinder_tunnel.toml", scene)
+    compiled = []
+    for k in range(2):
+        r = feelflow(bundle, tmp_path, "run", scene, "--steps", "100", "--backend", "cpu", "--out", f"cpu{k}.csv")
+        assert r.returncode == 0, r.stdout + r.stderr
+        assert "100 steps on cpu" in r.stdout
+        compiled.append({(p.name, p.stat().st_mtime_ns) for p in tmp_path.rglob("*.nbc")})
+    assert compiled[0] and compiled[1] == compiled[0]
+    assert (tmp_path / "cpu0.csv").read_text() == (tmp_path / "cpu1.csv").read_text()
+
+
 def test_child_processes_run_from_the_bundle(bundle, tmp_path):
     """`feelflow -m MODULE`: the haptic loop's process and the serial simulator behind a pty
     both start as [sys.executable, "-m", ...], sys.executable being the bundle's program."""

@@ -20,6 +20,10 @@ from feelflow.solver.forces import MODELS
 FIELD_TOL = {"float32": 1e-5, "float64": 1e-10}
 FORCE_TOL = {"float32": 1e-4, "float64": 1e-9}
 STEPS = 60
+#: numba compiles one kernel per (operator, equilibrium, absorbing layer, body force, precision),
+#: about 30 s each on a fresh 2-core machine. The default run checks the variants the window runs
+#: (TRT, compressible, float32, with and without the absorbing layer); the others run with -m slow.
+SLOW = pytest.mark.slow
 
 
 def _rel(a, b):
@@ -64,7 +68,7 @@ def _check_forces(forces, models, dtype="float32"):
         assert err < FORCE_TOL[dtype], name
 
 
-@pytest.mark.parametrize("collision", ["bgk", "trt"])
+@pytest.mark.parametrize("collision", [pytest.param("bgk", marks=SLOW), pytest.param("trt", marks=SLOW)])
 def test_periodic_box_with_body_force(collision):
     cfg = FlowConfig(nx=47, ny=32, dtype="float32", collision=collision, x_boundary="periodic",
                      y_boundary="periodic", body_force=(1e-5, -2e-6), initial_velocity=(0.03, 0.01))
@@ -80,7 +84,7 @@ def test_periodic_box_with_body_force(collision):
 
 
 @pytest.mark.parametrize("y_boundary", ["no_slip", "free_slip", "periodic"])
-@pytest.mark.parametrize("collision", ["bgk", "trt"])
+@pytest.mark.parametrize("collision", [pytest.param("bgk", marks=SLOW), "trt"])
 def test_tunnel_walls_inlet_outlet_sponge(y_boundary, collision):
     cfg = FlowConfig(nx=61, ny=32, dtype="float32", collision=collision, y_boundary=y_boundary,
                      inflow_profile="parabolic" if y_boundary == "no_slip" else "uniform",
@@ -96,8 +100,8 @@ def test_periodic_channel_free_slip_walls():
     _check_fields(solvers)
 
 
-@pytest.mark.parametrize("dtype", ["float32", "float64"])
-@pytest.mark.parametrize("collision", ["bgk", "trt"])
+@pytest.mark.parametrize("dtype", ["float32", pytest.param("float64", marks=SLOW)])
+@pytest.mark.parametrize("collision", [pytest.param("bgk", marks=SLOW), "trt"])
 def test_moving_rotating_cylinder_every_force_model(collision, dtype):
     """Moved every step (cover/uncover refill, impulses), moving-wall term with rotation."""
     cfg = FlowConfig(nx=63, ny=32, dtype=dtype, collision=collision, inflow_ramp_steps=20)
@@ -141,7 +145,7 @@ def test_thin_plate_and_body_removed():
     _check_forces([f[:40] for f in forces], ["momentum_exchange"])
 
 
-@pytest.mark.parametrize("collision", ["bgk", "trt"])
+@pytest.mark.parametrize("collision", [pytest.param("bgk", marks=SLOW), pytest.param("trt", marks=SLOW)])
 def test_incompressible_absorbing_sponge_moving_cylinder(collision):
     """He & Luo's equilibrium, the sponge's absorbing layer and a cylinder moved every step."""
     cfg = FlowConfig(nx=64, ny=32, dtype="float32", collision=collision, inflow_profile="parabolic",
@@ -189,9 +193,31 @@ def test_regularised_operator_runs_the_reference_step():
 def test_quiet_inlet_matches_the_reference():
     """The quiet inlet lives in numpy's boundary rules, which the cpu backend shares: a tunnel
     with it, a sponge and a moving body agrees with numpy to float32 rounding."""
-    cfg = FlowConfig(nx=61, ny=32, dtype="float32", nu=0.01, inflow_speed=0.05, inflow_ramp_steps=10,
-                     inlet_nonreflecting=0.01, sponge_cells=8, sponge_absorb=0.1)
+    cfg = FlowConfig(nx=61, ny=32, dtype="float32", nu=0.01, inflow_speed=0.05, inflow_ramp_steps=0,
+                     initial_velocity=(0.05, 0.0), inlet_nonreflecting=0.01, sponge_cells=8, sponge_absorb=0.1)
     solvers, forces = _run_pair(cfg, steps=STEPS, motion=lambda s, k: s.set_body(
         Cylinder(x=20 + 0.1 * k, y=16.3, diameter=8), velocity=(0.1, 0.0)), models=("momentum_exchange",))
     _check_fields(solvers)
     _check_forces(forces, ("momentum_exchange",))
+
+
+def test_a_second_process_loads_the_compiled_kernels_from_the_disk_cache():
+    """numba compiles a kernel variant in tens of seconds; with cache=True a later process (the
+    next start of the window, the next CLI run) must load it from the on-disk cache, not compile
+    it again (solver/cpu_kernels.py make_kernels says what breaks that)."""
+    import subprocess
+    import sys
+
+    code = ("from feelflow.solver.backend import create_solver\n"
+            "from feelflow.solver.config import FlowConfig\n"
+            "s = create_solver('cpu', FlowConfig(nx=48, ny=24, dtype='float32', collision='trt', "
+            "sponge_cells=8, sponge_absorb=0.1))\n"
+            "s.step(2)\n"
+            "k = (s._stream_collide, s._redo_kernel)\n"
+            "print(sum(d.stats.cache_hits.total() for d in k), sum(d.stats.cache_misses.total() for d in k))\n")
+    runs = [subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+            for _ in range(2)]
+    for r in runs:
+        assert r.returncode == 0, r.stderr
+    hits, misses = map(int, runs[1].stdout.split())
+    assert misses == 0 and hits >= 1, runs[1].stdout

@@ -226,7 +226,7 @@ def test_quiet_inlet(nx, y_boundary, request):
     rule c's wall velocity corrected by the inlet node's density, its reference kept in G4.z of
     texel column 0 in GLSL; a body in the tunnel and an outlet sponge with its layer."""
     cfg = FlowConfig(nx=nx, ny=32, dtype="float32", collision="trt", inflow_profile="parabolic",
-                     y_boundary=y_boundary, inflow_ramp_steps=20, sponge_cells=12, sponge_absorb=0.3,
+                     y_boundary=y_boundary, inflow_ramp_steps=0, sponge_cells=12, sponge_absorb=0.3,
                      inlet_nonreflecting=0.05)
 
     def place(s, k):

@@ -118,6 +118,7 @@ def test_a_developed_channel_flow_crosses_the_patch():
     assert np.abs(uf[::2, ::2] - u0[y0:y1 + 1, x0:x1 + 1]).max() < tol
 
 
+@pytest.mark.slow
 def test_a_refined_patch_takes_2d1_towards_the_finer_lattice():
     """2D-1 at 10 cells per diameter: C_D is 0.53 % above the reference on the plain lattice
     (docs/science/data/accuracy-numpy.json), 0.13 % above at 20 cells and -0.04 % at 40. With the
