@@ -26,6 +26,8 @@
 //   TRT, GUO_FORCE, SPONGE: collision operator, Guo body force, outlet sponge (per-column rates);
 //   RR 1: recursive-regularised BGK with the Smagorinsky option instead (shaders/collide_rr.glsl).
 //   X_PERIODIC 0/1; Y_MODE 0 no_slip, 1 free_slip, 2 periodic; NX_ODD: nx is odd.
+//   QUIET_INLET: rule c's wall velocity passes outgoing sound (solver/quiet_inlet.py); its
+//     reference density lives in G4.z of texel column 0.
 // @LATTICE
 // @INCLUDE paired_layout.glsl
 
@@ -48,6 +50,10 @@ uniform sampler2D QB;          // q[5..8, x]
 #if EDGES || SPONGE
 uniform sampler2D INFLOW;      // texel (iy, 0): r profile(iy), gba rule c's links 1, 5, 8 (inflow.py)
 uniform float inflow_ramp;     // ramp(t): u_in(iy, t) = ramp(t) profile(iy)
+#if QUIET_INLET
+uniform vec2 quiet_inlet;      // (rate k, c_s / RHO0) of the quiet inlet (solver/quiet_inlet.py)
+float quiet_ref = 0.0;         // the inlet node's new drho_ref, stored in G4.z of texel column 0
+#endif
 #endif
 
 #if BODY && LINK_SUMS
@@ -235,6 +241,15 @@ void node_update(ivec2 x, inout float gin[9], float own[9], float west[9]) {
 #if EDGES
     // rule c's wall velocity per inlet link, at the link's midpoint (inlet_wall_profile)
     vec3 uin = X_PERIODIC == 0 ? inflow_ramp * texelFetch(INFLOW, ivec2(x.y, 0), 0).gba : vec3(0.0);
+#if QUIET_INLET
+    if (x.x == 0) {  // the quiet inlet: u_w += -c_s (drho - drho_ref) / RHO0 (solver/quiet_inlet.py)
+        float drho_in = 0.0;
+        for (int i = 0; i < Q; ++i) drho_in += own[i];
+        float ref = texelFetch(G4, ivec2(0, x.y), 0).z;
+        quiet_ref = ref + quiet_inlet.x * (drho_in - ref);
+        uin += vec3(-quiet_inlet.y * (drho_in - quiet_ref));
+    }
+#endif
     // outlet velocity u_b = u(x) + (u(x) - u(x - 1)) / 2 of the stored populations
     // (solver/inflow.py, outlet_incoming; Krueger et al. 2017, eq. 5.53)
     vec2 u_out = vec2(0.0);
@@ -320,5 +335,8 @@ void main() {
     // G4's zw (unused by the layout) carry the running total: Galilean-invariant S1 + S2, classic S1
     vec2 step_sums = LINK_SUMS == 1 ? link_sums.xy + link_sums.zw : link_sums.xy;
     out4.zw = sums_keep * texelFetch(G4, k, 0).zw + step_sums;
+#endif
+#if EDGES && QUIET_INLET
+    if (k.x == 0) out4.z = quiet_ref;
 #endif
 }

@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass, field
 
 from feelflow.solver.lattice import CS2, RHO0
+from feelflow.solver.quiet_inlet import shortest_ramp
 
 X_BOUNDARIES = ("tunnel", "periodic")
 Y_BOUNDARIES = ("no_slip", "free_slip", "periodic")
@@ -52,6 +53,7 @@ class FlowConfig:
     sponge_cells: int = 0
     sponge_strength: float = 10.0
     sponge_absorb: float = 0.0
+    inlet_nonreflecting: float = 0.0
     initial_velocity: tuple[float, float] = (0.0, 0.0)
     mach_limit: float = 0.17
     extra: dict = field(default_factory=dict, compare=False)
@@ -107,6 +109,14 @@ class FlowConfig:
         need(self.sponge_strength >= 1, "sponge_strength", "must be >= 1")
         need(math.isfinite(self.sponge_absorb) and 0.0 <= self.sponge_absorb <= 0.5, "sponge_absorb",
              f"must be in 0..0.5, got {self.sponge_absorb!r}")
+        need(math.isfinite(self.inlet_nonreflecting) and 0.0 <= self.inlet_nonreflecting <= 0.1,
+             "inlet_nonreflecting", f"must be in 0..0.1, got {self.inlet_nonreflecting!r}")
+        if self.inlet_nonreflecting > 0 and self.x_boundary == "tunnel":
+            shortest = shortest_ramp(self.nx)
+            need(self.inflow_ramp_steps == 0 or self.inflow_ramp_steps >= shortest, "inlet_nonreflecting",
+                 f"the quiet inlet needs the wind everywhere from the start (inflow_ramp_steps = 0) or a ramp of "
+                 f"at least {shortest} steps at nx = {self.nx} (got {self.inflow_ramp_steps}): a shorter ramp's "
+                 f"sound would leave through it as a swing of the inflow")
         for key in ("body_force", "initial_velocity"):
             v = getattr(self, key)
             need(len(v) == 2 and all(math.isfinite(c) for c in v), key, "must be two finite numbers")

@@ -57,6 +57,7 @@ from feelflow.solver.inflow import inlet_wall_profile, profile, ramp
 from feelflow.solver.lattice import Q, RHO0, equilibrium
 from feelflow.solver.regularised import smagorinsky_factor
 from feelflow.solver.relaxation import relaxation_rates
+from feelflow.solver.quiet_inlet import CS_OVER_RHO0, quiet_terms
 from feelflow.solver.sponge import absorb_keep
 
 __all__ = ["BAND_WIDTH", "CHECK_EVERY", "GLSolver"]
@@ -86,6 +87,7 @@ class GLSolver(Solver):
             "X_PERIODIC": cfg.x_boundary == "periodic",
             "Y_MODE": _Y_MODE[cfg.y_boundary],
             "NX_ODD": nx % 2 == 1,
+            "QUIET_INLET": cfg.x_boundary == "tunnel" and cfg.inlet_nonreflecting > 0,
         }
         self._sponge = cfg.x_boundary == "tunnel" and cfg.sponge_cells > 0
         self._programs = {}
@@ -101,7 +103,9 @@ class GLSolver(Solver):
             INFLOW=UNIT_INFLOW, OMEGA=UNIT_OMEGA, N=(nx, ny), grid_size=(tex_w, float(ny)),
             inv_n=(1.0 / tex_w, 1.0 / ny), body_force=tuple(float(v) for v in cfg.body_force),
             omega_plus=float(np.ravel(op)[0]), omega_minus=float(np.ravel(om)[0]),  # column 0: no sponge
-            smagorinsky=smagorinsky_factor(cfg.smagorinsky))
+            smagorinsky=smagorinsky_factor(cfg.smagorinsky),
+            **({"quiet_inlet": (float(cfg.inlet_nonreflecting), CS_OVER_RHO0)}
+               if cfg.x_boundary == "tunnel" and cfg.inlet_nonreflecting > 0 else {}))
         self._objects = []  # GL objects to release
 
         def tex(size, components, dtype="f4", repeat=False):
@@ -271,9 +275,13 @@ class GLSolver(Solver):
         r = float(ramp(t, cfg.inflow_ramp_steps))
         if self._uniform_values.get("inflow_ramp") != r:  # constant once the ramp is over
             self._uniform_values["inflow_ramp"] = r  # also for programs compiled later
+            quiet = {}
+            if self._defines["QUIET_INLET"]:  # bare inlet, reference held, during the ramp
+                quiet["quiet_inlet"] = quiet_terms(cfg.inlet_nonreflecting, r)
+                self._uniform_values.update(quiet)
             for (key, _), prog in self._programs.items():
                 if key[1] or key[2]:  # edges (the inlet), sponge (the absorbing layer's target)
-                    set_uniforms(prog, inflow_ramp=r)
+                    set_uniforms(prog, inflow_ramp=r, **quiet)
 
     def _bind_sources(self, side):
         for unit, texture in zip(UNIT_G, self._g[side]):

@@ -19,8 +19,9 @@ nine texels it needs, (k - 1 .. k + 1, y - 1 .. y + 1), are each fetched once
 `shaders/paired_layout.glsl` holds the same table for the shaders (a test compares them). An
 odd nx leaves node b of the last texel column unused (kept at zero, rest). G4's channels 2, 3
 hold no population: zero, except over the body window, where the step's pass keeps the running
-total of the momentum exchange's link sums (shaders/lbm_step.glsl, LINK_SUMS; `unpack`
-ignores them).
+total of the momentum exchange's link sums (shaders/lbm_step.glsl, LINK_SUMS), and channel 2 of
+texel column 0, which holds the quiet inlet's reference density (solver/quiet_inlet.py);
+`unpack` ignores them.
 """
 from __future__ import annotations
 

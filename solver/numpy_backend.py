@@ -20,6 +20,7 @@ from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS, inlet_wa
 from feelflow.solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 from feelflow.solver.regularised import RegularisedCollider
 from feelflow.solver.relaxation import relaxation_rates
+from feelflow.solver.quiet_inlet import quiet_terms, wall_velocity_correction
 from feelflow.solver.sponge import absorb_keep
 
 #: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall
@@ -49,6 +50,7 @@ class NumpySolver(Solver):
         feq = equilibrium(np.full((ny, nx), RHO0), np.full((ny, nx), float(ux0)), np.full((ny, nx), float(uy0)))
         self.g = shifted(feq).astype(self.dtype)
         self._gin = np.empty_like(self.g)
+        self._drho_ref = np.zeros(ny, dtype=self.dtype)  # the quiet inlet's reference (quiet_inlet.py)
         self._w = W.astype(self.dtype)
         op, om = relaxation_rates(cfg)
         if cfg.collision == "rr":
@@ -155,6 +157,11 @@ class NumpySolver(Solver):
             u_in = r * self._inflow_profile  # u_in(iy, t), as solver.inflow.inflow_velocity
             for k, i in enumerate(INLET_DIRECTIONS):
                 gin[i, :, 0] = g[OPP[i], :, 0] + (6.0 * W[i] * RHO0 * r) * self._inlet_wall_profile[k]
+            if cfg.inlet_nonreflecting > 0:  # the quiet inlet (solver/quiet_inlet.py)
+                corr = wall_velocity_correction(g[:, :, 0].sum(axis=0), self._drho_ref,
+                                                *quiet_terms(cfg.inlet_nonreflecting, r))
+                for i in INLET_DIRECTIONS:
+                    gin[i, :, 0] += (6.0 * W[i] * RHO0) * corr
         if cfg.y_boundary != "periodic":
             self._walls(g, gin)
         b = self.body
@@ -210,4 +217,5 @@ class NumpySolver(Solver):
         if f.shape != self.g.shape:
             raise ValueError(f"distributions must have shape {self.g.shape}, got {f.shape}")
         self.g[...] = shifted(f)
+        self._drho_ref = np.zeros(self.config.ny, dtype=self.dtype)  # the quiet inlet's reference
 

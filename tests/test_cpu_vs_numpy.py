@@ -190,6 +190,17 @@ def test_regularised_operator_runs_the_reference_step():
     assert forces[0] == forces[1]
 
 
+def test_quiet_inlet_matches_the_reference():
+    """The quiet inlet lives in numpy's boundary rules, which the cpu backend shares: a tunnel
+    with it, a sponge and a moving body agrees with numpy to float32 rounding."""
+    cfg = FlowConfig(nx=61, ny=32, dtype="float32", nu=0.01, inflow_speed=0.05, inflow_ramp_steps=0,
+                     initial_velocity=(0.05, 0.0), inlet_nonreflecting=0.01, sponge_cells=8, sponge_absorb=0.1)
+    solvers, forces = _run_pair(cfg, steps=STEPS, motion=lambda s, k: s.set_body(
+        Cylinder(x=20 + 0.1 * k, y=16.3, diameter=8), velocity=(0.1, 0.0)), models=("momentum_exchange",))
+    _check_fields(solvers)
+    _check_forces(forces, ("momentum_exchange",))
+
+
 def test_a_second_process_loads_the_compiled_kernels_from_the_disk_cache():
     """numba compiles a kernel variant in tens of seconds; with cache=True a later process (the
     next start of the window, the next CLI run) must load it from the on-disk cache, not compile

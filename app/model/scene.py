@@ -28,7 +28,7 @@ CONFIG_KEYS = {
     "inflow_profile": "flow.inflow_profile", "inflow_ramp_steps": "flow.inflow_ramp_steps",
     "body_force": "flow.body_force", "sponge_cells": "flow.sponge_cells",
     "sponge_strength": "flow.sponge_strength", "sponge_absorb": "flow.sponge_absorb",
-    "initial_velocity": "flow.initial_velocity",
+    "inlet_nonreflecting": "flow.inlet_nonreflecting", "initial_velocity": "flow.initial_velocity",
     "mach_limit": "flow.mach_limit",
 }
 #: the direction of the stream in a tunnel (the inlet is at x = -1/2)
@@ -206,6 +206,7 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
     sponge_cells = flow.integer("sponge_cells", 0, lo=0)
     sponge_strength = flow.number("sponge_strength", 10.0, positive=True)
     sponge_absorb = flow.number("sponge_absorb", 0.0, nonnegative=True)
+    inlet_nonreflecting = flow.number("inlet_nonreflecting", 0.0, nonnegative=True)
     mach_limit = flow.number("mach_limit", 0.17, positive=True)
     initial_velocity = flow.pair("initial_velocity", (0.0, 0.0))
     body_force = flow.pair("body_force", (0.0, 0.0))
@@ -267,7 +268,7 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
             x_boundary=x_boundary, y_boundary=walls, inflow_speed=inflow_speed,
             inflow_profile=inflow_profile, inflow_ramp_steps=ramp, body_force=body_force,
             sponge_cells=sponge_cells, sponge_strength=sponge_strength, sponge_absorb=sponge_absorb,
-            initial_velocity=initial_velocity, mach_limit=mach_limit,
+            inlet_nonreflecting=inlet_nonreflecting, initial_velocity=initial_velocity, mach_limit=mach_limit,
         ).validate()
     except ConfigError as exc:
         key = CONFIG_KEYS.get(exc.key, exc.key)

@@ -40,6 +40,10 @@ FORCE_MODELS = {
 WALLS = {"no_slip": "Solid walls (no slip)", "free_slip": "Slippery walls (free slip)",
          "periodic": "No walls (periodic)"}
 
+#: the quiet inlet's rate in the window's tunnel (FlowConfig.inlet_nonreflecting, solver/quiet_inlet.py)
+QUIET_INLET_RATE = 1e-3
+
+
 def default_base_config(grid) -> FlowConfig:
     """What the panel does not edit: TRT, float32, an outlet sponge with its absorbing layer,
     and the wind blowing everywhere from the first step (initial velocity = inflow, no ramp).
@@ -48,9 +52,12 @@ def default_base_config(grid) -> FlowConfig:
     measured at 256 x 128); starting in uniform flow keeps the mean within +-4 % from the start.
     The absorbing layer (sponge_absorb, docs/science/algorithm.md step 3) lets that sound out: after a
     1000-step ramp at 256 x 128 the mean u swings by 0.3 % of U instead of 46 % (a test,
-    tests/test_solver_boundaries.py), so a change of wind settles at once."""
+    tests/test_solver_boundaries.py), so a change of wind settles at once. The quiet inlet
+    (inlet_nonreflecting) lets out the sound a moving or stopping body sends upstream
+    (docs/science/quiet-tunnel.md)."""
     nx, ny = grid
-    return FlowConfig(nx=nx, ny=ny, dtype="float32", inflow_ramp_steps=0, sponge_cells=32, sponge_absorb=0.1)
+    return FlowConfig(nx=nx, ny=ny, dtype="float32", inflow_ramp_steps=0, sponge_cells=32, sponge_absorb=0.1,
+                      inlet_nonreflecting=QUIET_INLET_RATE)
 
 
 #: distance (cells) the body's bounding box keeps from the domain edges

@@ -22,9 +22,10 @@ TAIL_STEPS = 1000
 
 
 def plain_scene(scene):
-    """The scene without the absorbing layer, the wind everywhere from the first step."""
+    """The scene without the absorbing layer and the quiet inlet, the wind everywhere from the
+    first step."""
     cfg = scene.config
-    cfg = dataclasses.replace(cfg, sponge_absorb=0.0, inflow_ramp_steps=0,
+    cfg = dataclasses.replace(cfg, sponge_absorb=0.0, inlet_nonreflecting=0.0, inflow_ramp_steps=0,
                               initial_velocity=(cfg.inflow_speed, 0.0))
     return dataclasses.replace(scene, config=cfg)
 

@@ -5,8 +5,9 @@ quarter-wave sound mode swings it; Kam, Leung & Chew 2006 and Xu & Sagaut 2013 f
 absorbing layer that lets the sound out, docs/science/algorithm.md step 3), and the drag's scatter
 over the second half of the run.
 
-`compare=True` also runs each scene without the sponge's absorbing layer (`sponge_absorb = 0`),
-the old way of running them (docs/science/validation.md 'Calm tunnels'). Qt-free.
+`compare=True` also runs each scene without the sponge's absorbing layer (`sponge_absorb = 0`)
+and with the bare velocity inlet (`inlet_nonreflecting = 0`), the old way of running them
+(docs/science/validation.md 'Calm tunnels'). Qt-free.
 """
 from __future__ import annotations
 
@@ -34,7 +35,7 @@ def run_scene_calm(path, backend: str = "numpy", without_layer: bool = False, st
     scene = load_scene(path)
     cfg = scene.config
     if without_layer:
-        cfg = dataclasses.replace(cfg, sponge_absorb=0.0)
+        cfg = dataclasses.replace(cfg, sponge_absorb=0.0, inlet_nonreflecting=0.0)
     steps = int(steps or scene.steps)
     solver = make_solver(backend, cfg)
     t, mean_u, drag = [], [], []

@@ -2,7 +2,7 @@
 against wind speed U, per hard scene and collision operator, on the window's grid.
 
 Scenes (grid 192 x 96, the window's tunnel: velocity inlet, pressure outlet with its 32-cell
-sponge and the sponge's absorbing layer (as the window has), no-slip walls,
+sponge and its absorbing layer, the quiet inlet (as the window has), no-slip walls,
 float32; the body of size `d` at the window's start point (0.3 nx, ny/2)):
   plate45            - a flat plate d long and 0.5 cells thick (thinner than a cell) at 45 deg,
                        fixed, the wind blowing everywhere from the first step (the window's start);
@@ -60,6 +60,8 @@ GRID = (192, 96)
 SPONGE_CELLS = 32
 #: the absorbing layer of the window's sponge (app.simulation.default_base_config; a test keeps them equal)
 SPONGE_ABSORB = 0.1
+#: the window's quiet inlet (app.simulation.QUIET_INLET_RATE; a test keeps them equal)
+QUIET_INLET_RATE = 1e-3
 SCENES = ("plate45", "cylinder_impulsive", "cylinder_shaken", "wedge_upstream")
 COLLISIONS = ("bgk", "trt")
 #: every operator a single point can run (`main`); the scan keeps COLLISIONS
@@ -113,7 +115,8 @@ def scene_config(scene: str, collision: str, speed: float, nu: float, grid=GRID,
     start = (0.0, 0.0) if scene == "cylinder_impulsive" else (speed, 0.0)
     return FlowConfig(nx=nx, ny=ny, nu=nu, collision=collision, smagorinsky=smagorinsky, dtype="float32", x_boundary="tunnel",
                       y_boundary="no_slip", inflow_speed=speed, inflow_ramp_steps=0, initial_velocity=start,
-                      sponge_cells=min(SPONGE_CELLS, nx // 4), sponge_absorb=SPONGE_ABSORB).validate()
+                      sponge_cells=min(SPONGE_CELLS, nx // 4), sponge_absorb=SPONGE_ABSORB,
+                      inlet_nonreflecting=QUIET_INLET_RATE).validate()
 
 
 def scene_body(scene: str, size: float, grid=GRID):

@@ -4,6 +4,9 @@ docs/science/seed-report.md with PNG plots (the work is in app/reports/seed.py).
 lessons headless as the window does and print how steady their forces are (app/lesson_report.py).
 `feelflow report scenes [--only NAME,...] [--compare] [--json PATH]`: run the example scenes with an
 outlet sponge as `feelflow run` does and print how calm their tunnel is (app/scene_report.py).
+`feelflow report ringdown [--only window,d16,...] [--phase-steps N] [--json PATH]`: how long the
+tunnel's sound rings in the drag after a body stops, with the old boundaries and the quiet
+tunnel's, in one table (app/reports/ringdown.py).
 
 Parts (`--only`): protocol (or one diameter, protocol:d32), shapes, sweep, lift; each stores its
 series in OUT/seed-report/data-<part>.json (data-protocol-<d>.json per diameter), and the report
@@ -17,13 +20,14 @@ from pathlib import Path
 
 from feelflow.app.errors import UserError
 
-TARGETS = ("seed", "lessons", "scenes")
+TARGETS = ("seed", "lessons", "scenes", "ringdown")
 
 
 def add_arguments(parser):
     parser.add_argument("target", choices=TARGETS,
                         help="which report (seed: the thesis's experiments; lessons: the Presets menu's lessons; "
-                             "scenes: how calm the example scenes' tunnels are)")
+                             "scenes: how calm the example scenes' tunnels are; ringdown: how long sound rings in "
+                             "the drag after a stop, old and quiet boundaries)")
     parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
     parser.add_argument("--quick", action="store_true",
                         help="a few dozen steps per run: a smoke test of the whole chain, not physics")
@@ -32,7 +36,7 @@ def add_arguments(parser):
     parser.add_argument("--only", default=None, metavar="PART[,PART]",
                         help="run only these parts: protocol (or protocol:d16, :d24, :d32), shapes, sweep, "
                              "lift (default: all); for lessons, lesson keys (drag_speed, lift, ...); for "
-                             "scenes, scene names (default, plate, ...)")
+                             "scenes, scene names (default, plate, ...); for ringdown, window, d16, d24, d32")
     parser.add_argument("--compare", action="store_true",
                         help="lessons: also run each one plain (no absorbing layer, wind everywhere from the "
                              "first step, sudden wind changes); scenes: also without the absorbing layer")
@@ -54,6 +58,8 @@ def main(args) -> int:
         return lessons(args)
     if args.target == "scenes":
         return scene_calm(args)
+    if args.target == "ringdown":
+        return ringdown(args)
     from feelflow.app.reports.seed import PARTS, PROTOCOL, run_part, save_part, write_report
 
     out = Path(args.out)
@@ -119,6 +125,33 @@ def scene_calm(args) -> int:
                   f"on {args.backend}", file=sys.stderr, flush=True)
             runs.append(run_scene_calm(folder / f"{name}.toml", args.backend, without_layer=without,
                                        steps=40 if args.quick else None))
+    return _print_runs(runs, format_table(runs), args.json)
+
+
+def ringdown(args) -> int:
+    from feelflow.app.headless import gl_context
+    from feelflow.app.reports.ringdown import (QUICK_PHASE_STEPS, SEED_DIAMETERS, format_table, run_seed,
+                                                run_window)
+
+    if args.backend == "gl":
+        gl_context()   # one line on stderr, exit 2, when there is no EGL context
+    elif args.backend != "numpy":
+        raise UserError(f"--backend: must be numpy or gl, got {args.backend!r}")
+    phase_steps = phase_steps_option(args.phase_steps, 1000)
+    folder = Path(args.scenes)
+    cases = _chosen(args.only, ["window", *SEED_DIAMETERS], "case")
+    runs = []
+    for case in cases:
+        for before in (True, False):
+            print(f"feelflow report ringdown: {case} ({'before' if before else 'after'}) on {args.backend}",
+                  file=sys.stderr, flush=True)
+            if case == "window":
+                runs.append(run_window(args.backend, before, quick=args.quick))
+            else:
+                if not (folder / f"seed_protocol_{case}.toml").is_file():
+                    raise UserError(f"--scenes: {str(folder / f'seed_protocol_{case}.toml')!r} not found")
+                runs.append(run_seed(case, args.backend, before, folder,
+                                     QUICK_PHASE_STEPS if args.quick else phase_steps))
     return _print_runs(runs, format_table(runs), args.json)
 
 

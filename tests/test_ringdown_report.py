@@ -1,0 +1,35 @@
+"""`feelflow report ringdown` (app/reports/ringdown.py): the chain runs, before and after in one
+table, bad input refused in one line. The figures themselves are in docs/science/quiet-tunnel.md,
+measured by the full command; --quick runs a few hundred steps (a smoke test, not physics)."""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+from feelflow.app.model.simulation import default_base_config
+from feelflow.app.reports.ringdown import WINDOW_BEFORE, run_window, window_case
+
+ROOT = Path(__file__).resolve().parents[1]
+CLI = [sys.executable, "-c", "import sys; from feelflow.app.cli.main import main; sys.exit(main())"]
+
+
+def test_window_case_is_the_windows_tunnel_and_before_differs_only_by_the_inlet():
+    cfg, body, _ = window_case()
+    assert (cfg.nx, cfg.ny) == (256, 128) and body.diameter == 20
+    assert cfg.inlet_nonreflecting == default_base_config((256, 128)).inlet_nonreflecting > 0
+    assert cfg.inflow_speed * body.diameter / cfg.nu == 40.0
+    assert WINDOW_BEFORE == {"inlet_nonreflecting": 0.0}
+
+
+def test_quick_window_run_reports_both_swings():
+    r = run_window("numpy", before=False, quick=True)
+    assert r["settled_drag"] > 0 and r["swing_after_stop"] > 0 and r["swing_before_move"] > 0
+    assert r["boundaries"] == "after" and r["quiet_inlet"] > 0
+
+
+def test_report_ringdown_refuses_bad_input_in_one_line():
+    for extra in (["--only", "d40"], ["--phase-steps", "10"]):
+        r = subprocess.run([*CLI, "report", "ringdown", *extra], capture_output=True, text=True, cwd=ROOT)
+        assert r.returncode == 2, r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1 and extra[1] in r.stderr
