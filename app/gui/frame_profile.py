@@ -30,7 +30,7 @@ PARTS = {
     "check": "physical-range check",
     "field": "field for drawing",
     "loop": "frame loop, other",
-    "draw": "viewport GL draw",
+    "draw": "viewport GL draw, read-back",
     "overlay": "viewport overlay (QPainter)",
     "readouts": "panel readouts",
     "plot_data": "force plot refresh (pyqtgraph)",
@@ -105,7 +105,7 @@ class FrameProfile:
         self._wrap_slot(loop.slow_timer.timeout, loop.refresh_readouts, "readouts")
         self._wrap(loop, "upload_field", "field")
         self._wrap(loop, "refresh_readouts", "readouts")
-        self._wrap(vp, "_draw_field", "draw")
+        self._wrap(vp, "_field_image", "draw")
         self._wrap(vp.overlay, "paint", "overlay")
         self._wrap(plot, "refresh", "plot_data")
         self._wrap(plot.plot, "paintEvent", "plot_paint")
