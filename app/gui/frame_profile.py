@@ -99,7 +99,7 @@ class FrameProfile:
         self._wrap(backend, "step", "steps")
         for model in getattr(backend, "_models", {}).values():
             self._wrap(model, "compute", "forces")
-        self._wrap(session, "_check_physical", "check")
+        self._wrap(backend, "check_physical", "check")
         self._wrap(sim, "_move_body", "moves")
         self._wrap_slot(loop.timer.timeout, loop.tick, "loop")
         self._wrap_slot(loop.slow_timer.timeout, loop.refresh_readouts, "readouts")

@@ -26,6 +26,11 @@ MAX_STEPS_PER_FRAME = 200
 MIN_STEPS_PER_FRAME = 2   # the flow keeps moving even where drawing alone takes 1/30 s
 N_TRACERS = 900
 READOUT_MS = 500
+#: the live tunnel's physical-range check (SessionSolver.check_physical) runs once this many
+#: solver steps have passed, not after every frame: it reads the whole field back (on the gl
+#: backend a read-back of all populations), about 1.5 ms on a 2-core machine without a GPU;
+#: non-finite populations are still caught at every step by the backends themselves
+PHYSICAL_CHECK_STEPS = 64
 
 
 class FrameLoop:
@@ -51,6 +56,8 @@ class FrameLoop:
         self.slow_timer.timeout.connect(self.refresh_readouts)
 
     def start(self):
+        if self.w.sim is not None:
+            self.w.sim.solver.check_every = PHYSICAL_CHECK_STEPS
         self.timer.start()
         self.slow_timer.start()
 
