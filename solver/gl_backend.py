@@ -26,15 +26,17 @@ How it is organised (one module per part):
   replays the block from its start state with a check after every step, so
   `feelflow.solver.backend.SolverDiverged` names the exact step, as in the reference.
 
-API for the app (a QOpenGLWidget sharing this context):
-- `field_texture()` -> moderngl.Texture, nx x ny, RGBA32F = (rho, ux, uy, vorticity), computed
-  by a pass only when called (u as `Solver.macroscopic`; vorticity duy/dx - dux/dy by central
-  differences). NEAREST filtering; bind it with `.use(location=k)` in your own draw.
+API for the app (the window's viewport draws with this context):
+- `field_texture(vorticity=True)` -> moderngl.Texture, nx x ny, RGBA32F = (rho, ux, uy,
+  vorticity), computed by a pass only when called (u as `Solver.macroscopic`; vorticity
+  duy/dx - dux/dy by central differences, 0 with `vorticity=False`). NEAREST filtering; bind
+  it with `.use(location=k)` in your own draw.
 - `grid_size` -> (nx, ny); `renderer` -> the GL renderer string; `finish()` waits for the GPU.
 - Every pass sets the state it needs (solver/gl_programs.py `begin_pass`) and binds every
   texture unit it samples (units 0..10) right before drawing. Nothing is restored: after
-  `step()` or `field_texture()` the bound framebuffer is the solver's, so a paintGL must re-bind
-  its own (`ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`) and its textures.
+  `step()` or `field_texture()` the bound framebuffer is the solver's, so a draw must bind its
+  own framebuffer and its textures (in a QOpenGLWidget's paintGL:
+  `ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`).
 """
 from __future__ import annotations
 
@@ -502,12 +504,15 @@ class GLSolver(Solver):
     def grid_size(self):
         return self.nx, self.ny
 
-    def field_texture(self):
-        """(rho, ux, uy, vorticity) as an nx x ny RGBA32F texture, computed now by one pass."""
+    def field_texture(self, vorticity: bool = True):
+        """(rho, ux, uy, vorticity) as an nx x ny RGBA32F texture, computed now by one pass;
+        with `vorticity=False` the fourth component is 0 (the pass then reads one node per
+        texel instead of five: about a fifth of the cost)."""
         if self._field is None:
             self._field = self._field_pass("field.glsl", (self.nx, self.ny),
                                          {"INCOMPRESSIBLE": self._defines["INCOMPRESSIBLE"]})
         prog, tex, fbo, vao = self._field
+        prog["vorticity"].value = int(bool(vorticity))
         begin_pass(self.ctx, fbo, tex.size)
         for unit, texture in zip(UNIT_G, self._g[self._cur]):
             texture.use(location=unit)

@@ -96,6 +96,9 @@ class FrameLoop:
         if mode != "tracers":
             w.viewport.tracers = None
         w.panel.show_params(w.params_now(), mode)
+        if w.backend == "gl" and w.shown is not None:   # the field again: vorticity only where shown
+            w.make_current()
+            self.upload_field()
         w.viewport.update()
 
     # --- the field ----------------------------------------------------------------------------
@@ -105,8 +108,8 @@ class FrameLoop:
         model = w.shown
         if model is None:
             return None
-        if w.backend == "gl":
-            w.viewport.use_texture(model.solver.field_texture())
+        if w.backend == "gl":   # the vorticity (five nodes a texel) only where it is shown
+            w.viewport.use_texture(model.solver.field_texture(vorticity=self.display_mode == "vorticity"))
             return None
         rgba = model.field_rgba()
         w.viewport.makeCurrent()
