@@ -1,5 +1,7 @@
-"""The frame loop: each frame runs as many solver steps as keep the window at >= 30 fps
-(adaptive stepping: the cost of a step and of the rest of the frame, each smoothed), uploads
+"""The frame loop: each frame runs as many solver steps as fit its length (adaptive stepping:
+the cost of a step and of the rest of the frame, each smoothed; `FrameLoop.frame_seconds`:
+60 frames per second where drawing takes at most half a frame, down to 30 as it takes more,
+so that the solver keeps at least half of each frame), uploads
 the field, moves the tracers, sets the force arrows and redraws; twice a second the readouts
 follow. Pause, the display mode and the unstable-flow dialog live here too.
 
@@ -21,7 +23,11 @@ from feelflow.solver.backend import SolverDiverged
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
 
-TARGET_FRAME_S = 1.0 / 31.5    # aim just above 30 fps: every spare millisecond goes to the solver
+#: the frame's length: as short as 1/60 s (aim just above 60 fps), as long as keeps at least
+#: MIN_SOLVER_SHARE of it for the solver's steps, never longer than 1/30 s (just above 30 fps)
+FASTEST_FRAME_S = 1.0 / 61.5
+SLOWEST_FRAME_S = 1.0 / 31.5
+MIN_SOLVER_SHARE = 0.5
 MAX_STEPS_PER_FRAME = 200
 MIN_STEPS_PER_FRAME = 2   # the flow keeps moving even where drawing alone takes 1/30 s
 N_TRACERS = 900
@@ -195,7 +201,7 @@ class FrameLoop:
             other = max(0.0, (now - self._last_tick) - self._last_step_s)
             self.other_cost = 0.8 * self.other_cost + 0.2 * min(other, 0.2)
         self._last_tick, self._last_step_s = now, t1 - t0
-        budget = TARGET_FRAME_S - self.other_cost
+        budget = self.frame_seconds() - self.other_cost
         self.steps_per_frame = int(max(MIN_STEPS_PER_FRAME, min(MAX_STEPS_PER_FRAME, budget / max(self.step_cost, 1e-6))))
         rw = self._rate_window
         rw[1] += n
@@ -205,6 +211,14 @@ class FrameLoop:
             cfg = self.w.shown.config
             self.rates = {"steps_per_s": rw[1] / dt, "fps": rw[2] / dt, "mlups": rw[1] * cfg.nx * cfg.ny / dt / 1e6}
             self._rate_window = [now, 0, 0]
+
+    def frame_seconds(self) -> float:
+        """The frame length the steps per frame aim at: 1/60 s where the rest of the frame
+        (drawing, Qt) takes at most half of it, longer as the rest takes more, so that the
+        solver keeps half of each frame; never longer than 1/30 s: where the rest takes more
+        than half of that, the solver gets what is left (at least MIN_STEPS_PER_FRAME steps)."""
+        wanted = self.other_cost / (1.0 - MIN_SOLVER_SHARE)
+        return min(SLOWEST_FRAME_S, max(FASTEST_FRAME_S, wanted))
 
     def _free_stream_density(self, rgba) -> float:
         """Median density of the fluid: the reference of the pressure coefficient (the lattice's
