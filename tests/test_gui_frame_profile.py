@@ -1,5 +1,6 @@
 """`feelflow --selftest --frame-profile` (app/gui/frame_profile.py): the parts of a frame are timed
-on the running window, every part is reported, and detaching leaves the window as it was."""
+on the running window, every part is reported, and detaching leaves the window as it was; and
+the frame length the frame loop aims at (app/gui/window/frame_loop.py)."""
 from __future__ import annotations
 
 import os
@@ -44,3 +45,15 @@ def test_frame_profile_times_every_part_and_leaves_the_window_as_it_was(window, 
         assert not any(getattr(v, "__qualname__", "").startswith("FrameProfile") for v in vars(obj).values())
     frames = window.viewport.frames
     qtbot.waitUntil(lambda: window.viewport.frames > frames + 2, timeout=5000)
+
+
+def test_frames_aim_at_60_per_second_while_the_solver_keeps_half_of_each():
+    from types import SimpleNamespace
+
+    from feelflow.app.gui.window.frame_loop import FASTEST_FRAME_S, SLOWEST_FRAME_S, FrameLoop
+
+    def frame(other_ms):
+        return FrameLoop.frame_seconds(SimpleNamespace(other_cost=other_ms / 1e3))
+    assert frame(4.0) == FASTEST_FRAME_S == 1 / 61.5       # drawing takes a quarter: 60 fps
+    assert frame(10.0) == pytest.approx(0.020)              # half for the solver: 50 fps
+    assert frame(25.0) == SLOWEST_FRAME_S == 1 / 31.5      # never below 30 fps
