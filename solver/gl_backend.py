@@ -133,7 +133,7 @@ class GLSolver(Solver):
         self._inflow_key = None
         self._draws, self._draw_regions = [], None  # [(vertex array, scissor boxes)]
         self._vaos = {}  # (region key, link-sum mode) -> (vertex array, vbo), made on first use
-        self._field = None
+        self._field = {}  # with the vorticity or not -> (program, texture, framebuffer, vao)
         self._checks = CheckAtlas(ctx, self._kx, nx, ny)
         self._band = BandArea(ctx, self._kx, band_w, ny, self._tex_size)
         self._band_sums = None  # LinkSums: the link-sum pass (LINK_SUM_MODELS), made on first use
@@ -506,29 +506,36 @@ class GLSolver(Solver):
 
     def field_texture(self, vorticity: bool = True):
         """(rho, ux, uy, vorticity) as an nx x ny RGBA32F texture, computed now by one pass;
-        with `vorticity=False` the fourth component is 0 (the pass then reads one node per
-        texel instead of five: about a fifth of the cost)."""
-        if self._field is None:
-            self._field = self._field_pass("field.glsl", (self.nx, self.ny),
-                                         {"INCOMPRESSIBLE": self._defines["INCOMPRESSIBLE"]})
-        prog, tex, fbo, vao = self._field
-        prog["vorticity"].value = int(bool(vorticity))
+        with `vorticity=False` the fourth component is 0. Two programs (VORTICITY 1 or 0: a
+        uniform branch would not help, llvmpipe runs both sides) drawing into one texture; the
+        one without reads one node per texel, not five."""
+        key = bool(vorticity)
+        if key not in self._field:
+            target = next(iter(self._field.values()), None)
+            self._field[key] = self._field_pass(
+                "field.glsl", (self.nx, self.ny), {"INCOMPRESSIBLE": self._defines["INCOMPRESSIBLE"], "VORTICITY": key},
+                target=None if target is None else target[1:3])
+        prog, tex, fbo, vao = self._field[key]
         begin_pass(self.ctx, fbo, tex.size)
         for unit, texture in zip(UNIT_G, self._g[self._cur]):
             texture.use(location=unit)
         vao.render(moderngl.TRIANGLES)
         return tex
 
-
-    def _field_pass(self, fragment, size, defines=None):
-        """(program, texture, framebuffer, vao) of a one-rectangle pass into an RGBA32F target."""
+    def _field_pass(self, fragment, size, defines=None, target=None):
+        """(program, texture, framebuffer, vao) of a one-rectangle pass into an RGBA32F target:
+        a new one, or `target` = (texture, framebuffer) of another such pass."""
         prog = create_program(self.ctx, "rect_vertex.glsl", fragment, defines)
-        tex = self.ctx.texture(size, 4, dtype="f4")
-        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        fbo = self.ctx.framebuffer(color_attachments=[tex])
+        if target is None:
+            tex = self.ctx.texture(size, 4, dtype="f4")
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            fbo = self.ctx.framebuffer(color_attachments=[tex])
+            self._objects += [fbo, tex]
+        else:
+            tex, fbo = target
         vbo = self.ctx.buffer(triangles([(0, 0, *size)]).tobytes())
         vao = self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
-        self._objects += [vao, vbo, fbo, tex, prog]
+        self._objects += [vao, vbo, prog]
         set_uniforms(prog, **dict(zip(G_NAMES, UNIT_G)), N=(self.nx, self.ny),
                      grid_size=(float(size[0]), float(size[1])),
                      body_force=tuple(float(v) for v in self.config.body_force))
@@ -538,7 +545,7 @@ class GLSolver(Solver):
         for obj in [*(o for pair in self._vaos.values() for o in pair), *self._objects, *self._programs.values()]:
             obj.release()
         self._draws, self._vaos, self._objects, self._programs = [], {}, [], {}
-        self._field = None
+        self._field = {}
         self._checks.release()
         self._band.release()
         if self._band_sums is not None:
