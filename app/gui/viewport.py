@@ -7,7 +7,7 @@ polygon editor, the rotation handle (app/gui/turn_handle.py) and the wheel, each
 the window. The gl solver runs on the same context (`makeCurrent`).
 
 Why not a QOpenGLWidget: with one in the window, Qt composites the whole window through OpenGL
-on every frame; on a machine without a GPU (llvmpipe) that took about two thirds of each frame
+on every frame; on a machine without a GPU (llvmpipe) that took half or more of each frame
 (docs/science/performance.md, "The window"). Reading back the coloured field (a few MB a
 frame) costs far less, and on a GPU the frame already waits for the solver's own read-back.
 
@@ -198,8 +198,9 @@ class Viewport(QWidget):
             return
         field = self._field_image()
         if field is not None:
+            image, where = field
             painter.setRenderHint(QPainter.SmoothPixmapTransform)
-            painter.drawImage(*reversed(field))
+            painter.drawImage(where, image)
         self.overlay.paint(painter)
         painter.end()
         self.frames += 1
