@@ -39,10 +39,18 @@ class SessionSolver:
 
     `set_viscosity`, `reset` and `rebuild` build a new backend with `factory(config)`
     (default: the same backend by name, handing on the wrapped solver's `.ctx` if it has one).
+
+    The flow's physical range (`check_physical`) is checked after each `step` call (each force
+    row), or, with `check_every` = N > 1, only once at least N solver steps have run since the
+    last check (the window: the check reads the whole field back). Non-finite populations are
+    caught by the backends themselves at every step either way.
     """
 
-    def __init__(self, solver, recorder: SessionRecorder | None = None, *, factory=None, body=None):
+    def __init__(self, solver, recorder: SessionRecorder | None = None, *, factory=None, body=None,
+                 check_every: int = 1):
         self._solver = solver
+        self.check_every = max(1, int(check_every))
+        self._checked_at = None      # solver time of the last physical-range check
         self.recorder = recorder
         self._factory = factory or _same_backend_factory(solver)
         self.flow_config = solver.config  # the configuration asked for (reset returns to it)
@@ -130,7 +138,7 @@ class SessionSolver:
         body = self._body_row()
         try:
             self._solver.step(n)
-            self._check_physical()
+            self.check_physical()
         except SolverDiverged as exc:
             done = max(1, min(n, exc.step - start))
             self._record_row(done, {m: (math.nan, math.nan) for m in self.models}, body)
@@ -163,7 +171,7 @@ class SessionSolver:
         if part["done"] < row_steps:
             return False
         try:
-            self._check_physical()
+            self.check_physical()
         except SolverDiverged:
             self._part = None
             self._record_row(row_steps, {m: (math.nan, math.nan) for m in self.models}, part["body"])
@@ -173,11 +181,14 @@ class SessionSolver:
                          part["body"])
         return True
 
-    def _check_physical(self) -> None:
-        """SolverDiverged when the flow left the physical range (solver.backend.Solver.check_physical)."""
-        check = getattr(self._solver, "check_physical", None)
-        if check is not None:
-            check()
+    def check_physical(self) -> None:
+        """SolverDiverged when the flow left the physical range (solver.backend.Solver.check_physical);
+        nothing when fewer than `check_every` solver steps have run since the last check."""
+        t = self._solver.time
+        if self._checked_at is not None and 0 <= t - self._checked_at < self.check_every:
+            return
+        self._solver.check_physical()
+        self._checked_at = t
 
     @property
     def partial_steps(self) -> int:
