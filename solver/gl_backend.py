@@ -59,7 +59,7 @@ from feelflow.solver.inflow import inlet_wall_profile, profile, ramp
 from feelflow.solver.lattice import Q, RHO0, equilibrium
 from feelflow.solver.regularised import smagorinsky_factor
 from feelflow.solver.relaxation import relaxation_rates
-from feelflow.solver.quiet_inlet import CS_OVER_RHO0, quiet_terms
+from feelflow.solver.quiet_inlet import CS_OVER_RHO0, checked_reference, quiet_terms
 from feelflow.solver.sponge import absorb_keep
 
 __all__ = ["BAND_WIDTH", "CHECK_EVERY", "GLSolver"]
@@ -507,6 +507,23 @@ class GLSolver(Solver):
         if f.shape != (Q, self.ny, self.nx):
             raise ValueError(f"distributions must have shape {(Q, self.ny, self.nx)}, got {f.shape}")
         self._write_shifted(shifted(f).astype("f4"))
+
+    def inlet_reference(self) -> np.ndarray | None:
+        """Channel z of texture G4's texel column 0 (solver/gl_layout.py), current side."""
+        if not self.has_quiet_inlet:
+            return None
+        return self._g4_column()[:, 2].astype(np.float64)
+
+    def set_inlet_reference(self, row) -> None:
+        row = checked_reference(self, row)
+        column = self._g4_column()
+        column[:, 2] = row
+        self._g[self._cur][4].write(column.tobytes(), viewport=(0, 0, 1, self.ny))
+
+    def _g4_column(self) -> np.ndarray:
+        """Texel column 0 of texture G4, current side: (ny, 4) float32, a copy."""
+        raw = self._fbo[self._cur].read(viewport=(0, 0, 1, self.ny), components=4, attachment=4, dtype="f4")
+        return np.frombuffer(raw, dtype="f4").reshape(self.ny, 4).copy()
 
     @property
     def grid_size(self):

@@ -87,6 +87,7 @@ class SessionSolver:
                      "velocity": list(self.velocity), "omega": self.omega,
                      "force_models": list(self.models), "inflow_speed": self.inflow_speed}
         rec.state = np.ascontiguousarray(self._solver.distributions(), dtype=np.float64)
+        rec.inlet_reference = self._solver.inlet_reference()
         self.recorder = rec
         self.clock = 0
         return rec
@@ -218,7 +219,7 @@ class SessionSolver:
             self.recorder.record_parameter("nu", float(nu))
         self.flow_config = config
         old = self._solver
-        new = carry_flow(self._factory, config, old.distributions(), old.time, self.shape)
+        new = carry_flow(self._factory, config, old.distributions(), old.time, self.shape, old.inlet_reference())
         self._reapply(new)
         old.close()
 
@@ -243,6 +244,9 @@ class SessionSolver:
         new = self._factory(config)
         if keep_flow and (config.nx, config.ny) == (old.config.nx, old.config.ny):
             new.set_distributions(old.distributions())
+            reference = old.inlet_reference()
+            if reference is not None and new.has_quiet_inlet:
+                new.set_inlet_reference(reference)
             new.time = old.time
         self.flow_config = config
         self.shape, self.velocity, self.omega, self.models, self.inflow_speed = None, (0.0, 0.0), 0.0, (), None
@@ -280,14 +284,17 @@ def _same_backend_factory(solver):
     return factory
 
 
-def carry_flow(factory, config, f, time, shape):
+def carry_flow(factory, config, f, time, shape, inlet_reference=None):
     """A new backend for `config` holding populations `f` at `time`, with `shape` (if any)
     placed at rest *before* the populations arrive: a fresh lattice started at rest books no
-    cover impulse, and the caller's own placement afterwards covers no new node."""
+    cover impulse, and the caller's own placement afterwards covers no new node. The quiet
+    inlet's reference (Solver.inlet_reference) is carried too where both flows have one."""
     new = factory(dataclasses.replace(config, initial_velocity=(0.0, 0.0)))
     if shape is not None:
         new.set_body(shape, velocity=(0.0, 0.0), omega=0.0)
     new.set_distributions(f)
+    if inlet_reference is not None and new.has_quiet_inlet:
+        new.set_inlet_reference(inlet_reference)
     new.time = int(time)
     return new
 
