@@ -75,9 +75,10 @@ def markdown(parts: dict, res: dict, plots_dir: str) -> str:
             "pushes the slow fluid of its own wake until that wake has diffused (time scale D^2/nu, longer than a "
             "phase), so even the exact force is not yet zero there: compare each model with the reference. "
             "F(against)/F(stopped) = 2^n, n the drag exponent at this Re (n = 2 only for constant C_D).\n")
-        add("At U = 0.01 the drag is small next to the force swings of the tunnel's acoustic modes, rung by every "
-            "impulsive start and stop of the body: the column *swing* is the standard deviation of F_x (100-step "
-            "means) over the last half of the second stopped phase. Differences smaller than it are noise. "
+        add("Every impulsive start and stop of the body rings the tunnel's acoustic modes; the scenes let that sound "
+            "out at both ends (the outlet's absorbing layer and the quiet inlet, docs/science/quiet-tunnel.md), and "
+            "the column *swing* is what is left: the standard deviation of F_x (100-step means) over the last half "
+            "of the second stopped phase (the summary below gives it over the stopped drag). Differences smaller than it are noise. "
             "The clean Galilean check is `pytest tests/test_force_models_flow.py -s` (the same protocol in two "
             "frames in a periodic box, no tunnel acoustics; docs/science/force-models.md has its numbers). The classic form "
             "differs from the reference only by -u_w sum (f_out - f_in) over the body links and by the cover/uncover "
