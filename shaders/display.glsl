@@ -9,6 +9,7 @@ uniform int mode;           // 0 speed, 1 vorticity, 2 pressure, 3 tracers (spee
 uniform float scale;        // lattice value -> shown value (e.g. 1/U for speed / wind speed)
 uniform vec2 range;         // shown values at the bottom and the top of the colour bar
 uniform float rho_ref;      // free-stream density: pressure is shown relative to it
+uniform int bgra;           // 1: blue, green, red, alpha (a QImage of Format_RGB32 on little-endian)
 
 in vec2 uv;
 out vec4 colour;
@@ -31,5 +32,8 @@ void main() {
     colour = vec4(texture(lut, vec2(s, 0.5)).rgb, 1.0);
     if (mode == 3) {
         colour.rgb = mix(vec3(0.96), colour.rgb, 0.3);
+    }
+    if (bgra == 1) {
+        colour = colour.bgra;
     }
 }

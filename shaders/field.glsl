@@ -1,7 +1,8 @@
 #version 330 core
 // The field the viewport draws: (rho, ux, uy, vorticity) per node from the stored populations
 // (moments of f*, as Solver.macroscopic, Guo's F/2 removed; vorticity duy/dx - dux/dy by central differences,
-// one-sided at the domain edges). Runs only when the app asks for it.
+// one-sided at the domain edges; only with VORTICITY 1: it reads five nodes, not one). Runs
+// only when the app asks for it.
 // @LATTICE
 // @INCLUDE paired_layout.glsl
 
@@ -29,6 +30,7 @@ vec3 moments(ivec2 p) {  // (rho, ux, uy) at node p
 void main() {
     ivec2 x = ivec2(gl_FragCoord.xy);
     vec3 m = moments(x);
+#if VORTICITY
     ivec2 xe = ivec2(min(x.x + 1, N.x - 1), x.y);
     ivec2 xw = ivec2(max(x.x - 1, 0), x.y);
     ivec2 xn = ivec2(x.x, min(x.y + 1, N.y - 1));
@@ -36,4 +38,7 @@ void main() {
     float duy_dx = (moments(xe).z - moments(xw).z) / float(xe.x - xw.x);
     float dux_dy = (moments(xn).y - moments(xs).y) / float(xn.y - xs.y);
     field = vec4(m, duy_dx - dux_dy);
+#else
+    field = vec4(m, 0.0);   // VORTICITY 0: one node's moments, not five
+#endif
 }

@@ -149,7 +149,23 @@ class Solver(ABC):
 
     @abstractmethod
     def set_distributions(self, f: np.ndarray) -> None:
-        """Replace the state with full populations f (9, ny, nx)."""
+        """Replace the state with full populations f (9, ny, nx); the quiet inlet's reference
+        restarts at 0 (set it afterwards with set_inlet_reference)."""
+
+    @property
+    def has_quiet_inlet(self) -> bool:
+        """Whether the flow's state holds the quiet inlet's reference (solver/quiet_inlet.py)."""
+        return self.config.x_boundary == "tunnel" and self.config.inlet_nonreflecting > 0
+
+    def inlet_reference(self) -> np.ndarray | None:
+        """The quiet inlet's per-row reference density fluctuation (ny,) float64, part of the
+        flow's state beside the populations (sessions and carried flows keep it); None without
+        a quiet inlet."""
+        return None
+
+    def set_inlet_reference(self, row) -> None:
+        """Set the quiet inlet's reference (ny,) (after set_distributions, which restarts it)."""
+        raise ValueError(f"the {self.name} backend holds no quiet inlet reference")
 
     def macroscopic(self):
         """(rho, ux, uy), each (ny, nx) float64, from the stored post-collision populations,

@@ -26,15 +26,17 @@ How it is organised (one module per part):
   replays the block from its start state with a check after every step, so
   `feelflow.solver.backend.SolverDiverged` names the exact step, as in the reference.
 
-API for the app (a QOpenGLWidget sharing this context):
-- `field_texture()` -> moderngl.Texture, nx x ny, RGBA32F = (rho, ux, uy, vorticity), computed
-  by a pass only when called (u as `Solver.macroscopic`; vorticity duy/dx - dux/dy by central
-  differences). NEAREST filtering; bind it with `.use(location=k)` in your own draw.
+API for the app (the window's viewport draws with this context):
+- `field_texture(vorticity=True)` -> moderngl.Texture, nx x ny, RGBA32F = (rho, ux, uy,
+  vorticity), computed by a pass only when called (u as `Solver.macroscopic`; vorticity
+  duy/dx - dux/dy by central differences, 0 with `vorticity=False`). NEAREST filtering; bind
+  it with `.use(location=k)` in your own draw.
 - `grid_size` -> (nx, ny); `renderer` -> the GL renderer string; `finish()` waits for the GPU.
 - Every pass sets the state it needs (solver/gl_programs.py `begin_pass`) and binds every
   texture unit it samples (units 0..10) right before drawing. Nothing is restored: after
-  `step()` or `field_texture()` the bound framebuffer is the solver's, so a paintGL must re-bind
-  its own (`ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`) and its textures.
+  `step()` or `field_texture()` the bound framebuffer is the solver's, so a draw must bind its
+  own framebuffer and its textures (in a QOpenGLWidget's paintGL:
+  `ctx.detect_framebuffer(self.defaultFramebufferObject()).use()`).
 """
 from __future__ import annotations
 
@@ -57,7 +59,7 @@ from feelflow.solver.inflow import inlet_wall_profile, profile, ramp
 from feelflow.solver.lattice import Q, RHO0, equilibrium
 from feelflow.solver.regularised import smagorinsky_factor
 from feelflow.solver.relaxation import relaxation_rates
-from feelflow.solver.quiet_inlet import CS_OVER_RHO0, quiet_terms
+from feelflow.solver.quiet_inlet import CS_OVER_RHO0, checked_reference, quiet_terms
 from feelflow.solver.sponge import absorb_keep
 
 __all__ = ["BAND_WIDTH", "CHECK_EVERY", "GLSolver"]
@@ -135,7 +137,7 @@ class GLSolver(Solver):
         self._inflow_key = None
         self._draws, self._draw_regions = [], None  # [(vertex array, scissor boxes)]
         self._vaos = {}  # (region key, link-sum mode) -> (vertex array, vbo), made on first use
-        self._field = None
+        self._field = {}  # with the vorticity or not -> (program, texture, framebuffer, vao)
         self._checks = CheckAtlas(ctx, self._kx, nx, ny)
         self._band = BandArea(ctx, self._kx, band_w, ny, self._tex_size)
         self._band_sums = None  # LinkSums: the link-sum pass (LINK_SUM_MODELS), made on first use
@@ -506,32 +508,59 @@ class GLSolver(Solver):
             raise ValueError(f"distributions must have shape {(Q, self.ny, self.nx)}, got {f.shape}")
         self._write_shifted(shifted(f).astype("f4"))
 
+    def inlet_reference(self) -> np.ndarray | None:
+        """Channel z of texture G4's texel column 0 (solver/gl_layout.py), current side."""
+        if not self.has_quiet_inlet:
+            return None
+        return self._g4_column()[:, 2].astype(np.float64)
+
+    def set_inlet_reference(self, row) -> None:
+        row = checked_reference(self, row)
+        column = self._g4_column()
+        column[:, 2] = row
+        self._g[self._cur][4].write(column.tobytes(), viewport=(0, 0, 1, self.ny))
+
+    def _g4_column(self) -> np.ndarray:
+        """Texel column 0 of texture G4, current side: (ny, 4) float32, a copy."""
+        raw = self._fbo[self._cur].read(viewport=(0, 0, 1, self.ny), components=4, attachment=4, dtype="f4")
+        return np.frombuffer(raw, dtype="f4").reshape(self.ny, 4).copy()
+
     @property
     def grid_size(self):
         return self.nx, self.ny
 
-    def field_texture(self):
-        """(rho, ux, uy, vorticity) as an nx x ny RGBA32F texture, computed now by one pass."""
-        if self._field is None:
-            self._field = self._field_pass("field.glsl", (self.nx, self.ny),
-                                         {"INCOMPRESSIBLE": self._defines["INCOMPRESSIBLE"]})
-        prog, tex, fbo, vao = self._field
+    def field_texture(self, vorticity: bool = True):
+        """(rho, ux, uy, vorticity) as an nx x ny RGBA32F texture, computed now by one pass;
+        with `vorticity=False` the fourth component is 0. Two programs (VORTICITY 1 or 0: a
+        uniform branch would not help, llvmpipe runs both sides) drawing into one texture; the
+        one without reads one node per texel, not five."""
+        key = bool(vorticity)
+        if key not in self._field:
+            target = next(iter(self._field.values()), None)
+            self._field[key] = self._field_pass(
+                "field.glsl", (self.nx, self.ny), {"INCOMPRESSIBLE": self._defines["INCOMPRESSIBLE"], "VORTICITY": key},
+                target=None if target is None else target[1:3])
+        prog, tex, fbo, vao = self._field[key]
         begin_pass(self.ctx, fbo, tex.size)
         for unit, texture in zip(UNIT_G, self._g[self._cur]):
             texture.use(location=unit)
         vao.render(moderngl.TRIANGLES)
         return tex
 
-
-    def _field_pass(self, fragment, size, defines=None):
-        """(program, texture, framebuffer, vao) of a one-rectangle pass into an RGBA32F target."""
+    def _field_pass(self, fragment, size, defines=None, target=None):
+        """(program, texture, framebuffer, vao) of a one-rectangle pass into an RGBA32F target:
+        a new one, or `target` = (texture, framebuffer) of another such pass."""
         prog = create_program(self.ctx, "rect_vertex.glsl", fragment, defines)
-        tex = self.ctx.texture(size, 4, dtype="f4")
-        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        fbo = self.ctx.framebuffer(color_attachments=[tex])
+        if target is None:
+            tex = self.ctx.texture(size, 4, dtype="f4")
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            fbo = self.ctx.framebuffer(color_attachments=[tex])
+            self._objects += [fbo, tex]
+        else:
+            tex, fbo = target
         vbo = self.ctx.buffer(triangles([(0, 0, *size)]).tobytes())
         vao = self.ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
-        self._objects += [vao, vbo, fbo, tex, prog]
+        self._objects += [vao, vbo, prog]
         set_uniforms(prog, **dict(zip(G_NAMES, UNIT_G)), N=(self.nx, self.ny),
                      grid_size=(float(size[0]), float(size[1])),
                      body_force=tuple(float(v) for v in self.config.body_force))
@@ -541,7 +570,7 @@ class GLSolver(Solver):
         for obj in [*(o for pair in self._vaos.values() for o in pair), *self._objects, *self._programs.values()]:
             obj.release()
         self._draws, self._vaos, self._objects, self._programs = [], {}, [], {}
-        self._field = None
+        self._field = {}
         self._checks.release()
         self._band.release()
         if self._band_sums is not None:

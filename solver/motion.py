@@ -138,7 +138,5 @@ class MotionRunner:
             add(self.solver.forces(), k)
             self.t += k
             remaining -= k
-        check = getattr(self.solver, "check_physical", None)
-        if check is not None:   # SolverDiverged when the flow left the physical range
-            check()
+        self.solver.check_physical()   # SolverDiverged when the flow left the physical range
         return {name: (acc[0] / n, acc[1] / n) for name, acc in total.items()}

@@ -20,7 +20,7 @@ from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS, inlet_wa
 from feelflow.solver.lattice import C, OPP, Q, RHO0, W, equilibrium
 from feelflow.solver.regularised import RegularisedCollider
 from feelflow.solver.relaxation import relaxation_rates
-from feelflow.solver.quiet_inlet import quiet_terms, wall_velocity_correction
+from feelflow.solver.quiet_inlet import checked_reference, quiet_terms, wall_velocity_correction
 from feelflow.solver.sponge import absorb_keep
 
 #: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall
@@ -218,4 +218,11 @@ class NumpySolver(Solver):
             raise ValueError(f"distributions must have shape {self.g.shape}, got {f.shape}")
         self.g[...] = shifted(f)
         self._drho_ref = np.zeros(self.config.ny, dtype=self.dtype)  # the quiet inlet's reference
+
+    def inlet_reference(self) -> np.ndarray | None:
+        return self._drho_ref.astype(np.float64) if self.has_quiet_inlet else None
+
+    def set_inlet_reference(self, row) -> None:
+        row = checked_reference(self, row)
+        self._drho_ref = row.astype(self.dtype)
 

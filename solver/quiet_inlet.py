@@ -57,3 +57,14 @@ def wall_velocity_correction(drho: np.ndarray, drho_ref: np.ndarray, rate: float
     link of the row (module docstring). drho: the inlet column's density fluctuation, (ny,)."""
     drho_ref += rate * (drho - drho_ref)
     return (-coefficient) * (drho - drho_ref)
+
+
+def checked_reference(solver, row) -> np.ndarray:
+    """`row` as a finite (ny,) float64 reference for `solver` (a Solver with the quiet inlet:
+    Solver.set_inlet_reference), else ValueError naming what is wrong."""
+    if not solver.has_quiet_inlet:
+        raise ValueError("this flow has no quiet inlet (inlet_nonreflecting = 0): no reference to set")
+    row = np.asarray(row, dtype=np.float64)
+    if row.shape != (solver.config.ny,) or not np.isfinite(row).all():
+        raise ValueError(f"the quiet inlet's reference must be {solver.config.ny} finite numbers, got shape {row.shape}")
+    return row

@@ -43,6 +43,9 @@ def test_field_texture_holds_moments_and_vorticity(equilibrium, request):
     # vorticity: central differences inside, one-sided at the domain edges (np.gradient)
     vort = np.gradient(uy, axis=1, edge_order=1) - np.gradient(ux, axis=0, edge_order=1)
     assert np.allclose(field[..., 3], vort, rtol=0, atol=1e-5)
+    # without the vorticity (the window's other display modes): the same moments, a zero fourth
+    plain = np.frombuffer(s.field_texture(vorticity=False).read(), dtype="f4").reshape(24, 40, 4)
+    assert np.array_equal(plain[..., :3], field[..., :3]) and not plain[..., 3].any()
 
 
 def test_steps_ignore_the_host_gl_state(gl_context, request):

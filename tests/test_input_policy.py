@@ -278,3 +278,33 @@ def test_check_physical_flags_speed_and_density_on_a_finite_field():
         s.time += 1
         with pytest.raises(SolverDiverged, match="far"):
             s.check_physical()
+
+
+def test_a_session_solver_checking_every_n_steps_still_catches_a_flow_out_of_range():
+    """The window checks the range once every PHYSICAL_CHECK_STEPS steps (SessionSolver.check_every);
+    the default checks after every step call."""
+    from feelflow.app.sessions import SessionSolver
+    from feelflow.solver.backend import SolverDiverged, create_solver
+    from feelflow.solver.config import FlowConfig
+    from feelflow.solver.lattice import C, W
+
+    backend = create_solver("numpy", FlowConfig(nx=16, ny=8, x_boundary="periodic", y_boundary="periodic",
+                                                inflow_speed=0.0))
+    checked, check = [], backend.check_physical
+    backend.check_physical = lambda: (checked.append(backend.time), check())[1]
+    ss = SessionSolver(backend)
+    ss.step(1)
+    ss.step(2)
+    ss.check_physical()   # nothing new since the last check
+    assert checked == [1, 3]
+    ss.check_every = 8
+    for _ in range(20):
+        ss.step(1)
+    assert checked == [1, 3, 11, 19]
+    u = 0.6   # a uniform stream far above the Mach limit: finite, it stays so in a periodic box
+    cu = 3 * (C[:, 0] * u)
+    backend.set_distributions((W * (1 + cu + 0.5 * cu ** 2 - 1.5 * u * u))[:, None, None] * np.ones((9, 8, 16)))
+    with pytest.raises(SolverDiverged, match="far"):
+        for _ in range(8):
+            ss.step(1)
+    assert backend.time == 27 and checked[-1] == 27

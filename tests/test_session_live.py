@@ -12,9 +12,14 @@ from session_scenes import MODELS, small_config, start_body
 from feelflow.solver.backend import create_solver
 
 
-@pytest.mark.parametrize("dtype", ["float32", "float64"])
-def test_recording_started_mid_flow_replays(tmp_path, dtype):
+@pytest.mark.parametrize("dtype, quiet", [("float32", False), ("float64", False), ("float32", True)])
+def test_recording_started_mid_flow_replays(tmp_path, dtype, quiet):
+    """quiet: the quiet inlet's reference (solver/quiet_inlet.py) is part of the flow's state;
+    the session keeps it with the populations, and a rebuild carries it."""
     cfg = small_config(dtype=dtype)
+    if quiet:
+        cfg = dataclasses.replace(cfg, inlet_nonreflecting=0.01, inflow_ramp_steps=0,
+                                  initial_velocity=(cfg.inflow_speed, 0.0))
     ss = SessionSolver(create_solver("numpy", cfg), body=start_body())
     ss.enable_force_models(MODELS)
     x = 20.0
@@ -35,6 +40,7 @@ def test_recording_started_mid_flow_replays(tmp_path, dtype):
     rec.save(path)
     s = load_session(path)
     assert s.start["time"] == 30 and s.state.shape == (9, 32, 64)
+    assert (s.inlet_reference is not None and np.abs(s.inlet_reference).max() > 0) == quiet
     assert [p["name"] for p in s.parameters].count("rebuild") == 1
     result = replay(s)
     assert result.max_force > 1e-3

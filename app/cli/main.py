@@ -39,6 +39,8 @@ def build_parser() -> argparse.ArgumentParser:
                         help="open the real window, exercise it and exit 0 only if everything worked")
     parser.add_argument("--screenshot", metavar="PATH", help="with --selftest: save a screenshot")
     parser.add_argument("--seconds", type=float, default=8.0, help="with --selftest: how long to run")
+    parser.add_argument("--frame-profile", action="store_true",
+                        help="with --selftest: also print where a frame's time goes (solver, drawing, plot, Qt)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, help_ in COMMANDS.items():
         p = sub.add_parser(name, help=help_, description=help_)

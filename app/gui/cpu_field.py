@@ -72,10 +72,10 @@ class CpuCanvas(QWidget):
     """A raster widget that paints what the viewport's GL would have.
 
     Over the viewport (`stand_in=False`: Qt has an OpenGL context, below 3.3) it is the
-    viewport's child, transparent to the mouse. Where Qt has no OpenGL at all a QOpenGLWidget
-    in the window keeps the whole window from reaching the screen, so the canvas takes the
-    viewport's place (`stand_in=True`): the viewport leaves the window, hidden, keeps the
-    canvas' size, and gets the canvas' mouse, wheel and key events."""
+    viewport's child, transparent to the mouse. Where Qt has no OpenGL at all the canvas takes
+    the viewport's place (`stand_in=True`, before the window shows, so that the viewport never
+    tries to make a context): the viewport leaves the window, hidden, keeps the canvas' size,
+    and gets the canvas' mouse, wheel and key events."""
 
     FORWARD = {QEvent.MouseButtonPress, QEvent.MouseButtonRelease, QEvent.MouseMove, QEvent.MouseButtonDblClick,
                QEvent.Wheel, QEvent.Leave, QEvent.Enter, QEvent.HoverMove, QEvent.KeyPress, QEvent.KeyRelease}

@@ -1,7 +1,8 @@
 """`feelflow --selftest`: open the real window, run the default scene, drag the body with
 synthetic mouse events, switch shape and force model, save a screenshot, print frames per
 second and solver steps per second; exit 0 only if everything worked (non-blank field, body
-moved, plot has data). `feelflow --selftest gui SESSION` measures the window's replay of SESSION
+moved, plot has data); with `--frame-profile`, where the measured frames' time went
+(app/gui/frame_profile.py). `feelflow --selftest gui SESSION` measures the window's replay of SESSION
 instead: frames per second and session steps per second while it replays."""
 from __future__ import annotations
 
@@ -62,9 +63,14 @@ class SelfTest:
     """Drives the window from a timer; `exit_code` is set when the application quits."""
 
     def __init__(self, window, seconds: float = 8.0, screenshot: str | None = None, out=sys.stdout,
-                 replay: bool = False):
+                 replay: bool = False, frame_profile: bool = False):
         self.window, self.seconds, self.screenshot, self.out = window, max(4.0, seconds), screenshot, out
         self.replay = replay   # the window replays a session (feelflow --selftest gui SESSION): measure that
+        self.profile = None    # a FrameProfile over the measured frames (--frame-profile), or None
+        if frame_profile and not replay:
+            from feelflow.app.gui.frame_profile import FrameProfile
+
+            self.profile = FrameProfile()
         self.exit_code = 1
         self.failures = []
         self.results = {}
@@ -102,9 +108,13 @@ class SelfTest:
         yield from self._wait(1.0)                      # warm-up: shader compile, adaptive stepping
         sim = w.sim
         measure = 0.45 * self.seconds
+        if self.profile is not None:
+            self.profile.attach(w)
         s0, f0, t0 = sim.solver.time, w.viewport.frames, time.perf_counter()
         yield from self._wait(measure)
         dt = time.perf_counter() - t0
+        if self.profile is not None:
+            self.profile.detach()
         steps, frames = sim.solver.time - s0, w.viewport.frames - f0
         nodes = sim.config.nx * sim.config.ny
         self.results.update(grid=f"{sim.config.nx}x{sim.config.ny}", fps=frames / dt, steps_per_s=steps / dt,
@@ -179,6 +189,9 @@ class SelfTest:
                   f"({r['mlups']:.1f} MLUPS, {r['steps_per_frame']:.1f} steps/frame)", file=self.out)
             print(f"selftest: frame budget: {r['step_ms']:.2f} ms per solver step, "
                   f"{r['rest_of_frame_ms']:.1f} ms per frame for everything else (drawing, Qt)", file=self.out)
+        if self.profile is not None and self.profile.frames:
+            for line in self.profile.report(self.window.viewport.renderer(), self.window.backend, r.get("grid", "?")):
+                print(line, file=self.out)
         for split, fps, steps_s, per_frame in r.get("replay", []):
             print(f"selftest: replay, {'long rows in parts' if split else 'rows whole'}: {fps:.1f} frames/s, "
                   f"{steps_s:.0f} session steps/s ({per_frame:.1f} steps/frame)", file=self.out)

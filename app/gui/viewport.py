@@ -1,26 +1,33 @@
-"""The wind tunnel view: a QOpenGLWidget whose moderngl context colours the flow field
-(shaders/display*.glsl, colormaps from pyqtgraph), with the overlay (app/gui/overlay.py: body,
-force arrows, tracers, colour bar, notes, the polygon editor's handles and the rotation handle)
-painted on top with QPainter; and the mouse: dragging the body, the polygon editor, the
-rotation handle (app/gui/turn_handle.py) and the wheel, each a signal to the window.
+"""The wind tunnel view: a plain (raster) widget with an OpenGL context of its own on an
+offscreen surface. Its moderngl context colours the flow field (shaders/display*.glsl,
+colormaps from pyqtgraph) into a framebuffer that is read back and drawn with QPainter, with
+the overlay (app/gui/overlay.py: body, force arrows, tracers, colour bar, notes, the polygon
+editor's handles and the rotation handle) painted on top; and the mouse: dragging the body, the
+polygon editor, the rotation handle (app/gui/turn_handle.py) and the wheel, each a signal to
+the window. The gl solver runs on the same context (`makeCurrent`).
 
-GL pitfalls handled here: detect_framebuffer in every paintGL, enable_only(NOTHING) before any
-pass, every texture bound before every draw.
+Why not a QOpenGLWidget: with one in the window, Qt composites the whole window through OpenGL
+on every frame; on a machine without a GPU (llvmpipe) that took half or more of each frame
+(docs/science/performance.md, "The window"). Reading back the coloured field (a few MB a
+frame) costs far less, and on a GPU the frame already waits for the solver's own read-back.
+
+GL rules kept here: enable_only(NOTHING) before any pass, every texture bound before every draw.
 """
 from __future__ import annotations
 
 import math
+import sys
 
 import moderngl
 import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import QEvent, QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QPainter, QPolygonF
-from PySide6.QtOpenGLWidgets import QOpenGLWidget
-from PySide6.QtWidgets import QToolTip
+from PySide6.QtGui import QImage, QOffscreenSurface, QOpenGLContext, QPainter, QPolygonF
+from PySide6.QtWidgets import QToolTip, QWidget
 
 from feelflow import SHADER_DIR
 from feelflow.app.gui import turn_handle
+from feelflow.app.gui.cpu_field import BACKGROUND
 from feelflow.app.gui.first_start import required_gl
 from feelflow.app.gui.display_modes import COLOUR_BAR_MARGIN, DISPLAY_MODES
 from feelflow.app.gui.overlay import Overlay
@@ -28,6 +35,7 @@ from feelflow.app.model.tunnel import TunnelModel
 from feelflow.solver import units
 from feelflow.solver.lattice import glsl_constants
 
+LITTLE_ENDIAN = sys.byteorder == "little"
 WHEEL_DEG_PER_NOTCH = 2.0  # one notch of the mouse wheel (120 eighths of a degree) turns the body this far
 MOUSE_HINT = ("Drag the body to move it; drag its round handle or turn the mouse wheel to rotate it "
               "(hold Shift for 15\u00b0 steps).")
@@ -39,7 +47,7 @@ def load_shader(name: str) -> str:
     return (SHADER_DIR / name).read_text().replace("// @LATTICE", glsl_constants())
 
 
-class Viewport(QOpenGLWidget):
+class Viewport(QWidget):
     """Shows `sim`, a `TunnelModel` (the live tunnel or a replay, set by the window once the
     context exists). It never changes the model: the mouse's requests leave as signals
     (`bodyPulled`, `turnRequested`, `wheelTurned`, `polygonEdited`) for the window's
@@ -77,6 +85,12 @@ class Viewport(QOpenGLWidget):
         self._turn = None              # the handle's drag in progress (turn_handle.Turn)
         self._hover = None             # "handle", "body" or "near" (the handle shows), or None
         self.overlay = Overlay(self)
+        self._gl = self._surface = None   # the QOpenGLContext and its offscreen surface
+        self._gl_tried = False
+        self._image_fbo = None         # where display.glsl colours the field for the paint event
+        self._pixels = None
+        self._outline_cache = None     # (shape, lattice rectangle, QPolygonF) of body_outline_points
+        self.setAttribute(Qt.WA_OpaquePaintEvent)   # paintEvent fills every pixel
         self.setMinimumSize(480, 260)
         self.setMouseTracking(True)    # the handle appears when the pointer comes near the body
         self.setFocusPolicy(Qt.StrongFocus)
@@ -84,8 +98,26 @@ class Viewport(QOpenGLWidget):
     # --- GL ---------------------------------------------------------------------------------
     contextFailed = Signal(str)     # no usable OpenGL 3.3: one line for the user
 
+    def showEvent(self, ev):
+        super().showEvent(ev)
+        if not self._gl_tried:      # the context once, when the window first shows
+            self._gl_tried = True
+            self.initializeGL()
+
     def initializeGL(self):
+        """An OpenGL context of its own on an offscreen surface (the default surface format,
+        app/cli/commands/gui.py), and the moderngl context on it; contextFailed where there is
+        none of OpenGL 3.3."""
+        gl = QOpenGLContext(self)
+        surface = QOffscreenSurface(None, self)
         try:
+            if not gl.create():
+                raise RuntimeError("Qt could not create an OpenGL context")
+            surface.setFormat(gl.format())
+            surface.create()
+            if not gl.makeCurrent(surface):
+                raise RuntimeError("Qt could not make its OpenGL context current")
+            self._gl, self._surface = gl, surface
             self.ctx = moderngl.create_context(require=required_gl())
         except Exception as exc:   # moderngl.Error and friends: say so, never a traceback
             self.ctx = None        # the window then draws on the CPU (app/gui/cpu_field.py)
@@ -93,11 +125,15 @@ class Viewport(QOpenGLWidget):
             return
         self._init_programs()
 
+    def makeCurrent(self):
+        """The viewport's GL context current (the gl solver draws with it too)."""
+        if self._gl is not None:
+            self._gl.makeCurrent(self._surface)
+
     def _init_programs(self):
         self.program = self.ctx.program(vertex_shader=load_shader("display_vertex.glsl"),
                                         fragment_shader=load_shader("display.glsl"))
         self.vao = self.ctx.vertex_array(self.program, [])
-        self._align_texture = self.ctx.texture((1, 1), 4, dtype="f1")
         self._sampler = self.ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False)
         self._lut = None
         self._lut_name = None
@@ -154,38 +190,52 @@ class Viewport(QOpenGLWidget):
         nx, ny = self.sim.config.nx, self.sim.config.ny
         return QPointF(r.left() + (x + 0.5) / nx * r.width(), r.bottom() - (y + 0.5) / ny * r.height())
 
-    def paintGL(self):
-        if self.ctx is None:       # no OpenGL 3.3: a cpu_field.CpuCanvas paints over the viewport
-            return
+    def paintEvent(self, _ev):
         painter = QPainter(self)
-        painter.beginNativePainting()   # Qt's GL state is saved; moderngl draws the field
-        try:
-            self._draw_field()
-        finally:
-            # moderngl leaves GL_UNPACK_ALIGNMENT at 1 after the solver's uploads; Qt's glyph
-            # cache assumes the default 4 (garbled text otherwise): a 1-texel write restores it
-            self._align_texture.write(b"\0\0\0\0", alignment=4)
-            painter.endNativePainting()
+        painter.fillRect(self.rect(), BACKGROUND)
+        if self.ctx is None:       # not yet shown, or no OpenGL 3.3: a cpu_field.CpuCanvas paints over it
+            painter.end()
+            return
+        field = self._field_image()
+        if field is not None:
+            image, where = field
+            painter.setRenderHint(QPainter.SmoothPixmapTransform)
+            painter.drawImage(where, image)
         self.overlay.paint(painter)
         painter.end()
         self.frames += 1
 
-    def _draw_field(self):
-        ctx = self.ctx
-        ctx.enable_only(moderngl.NOTHING)
-        fbo = ctx.detect_framebuffer(self.defaultFramebufferObject())
-        fbo.use()
-        dpr = self.devicePixelRatioF()
-        full = (0, 0, int(self.width() * dpr), int(self.height() * dpr))
-        ctx.viewport = full
-        ctx.clear(0.16, 0.17, 0.19, 1.0)
+    def grabFramebuffer(self) -> QImage:
+        """What the viewport shows (the field and its overlay), for screenshots."""
+        return self.grab().toImage()
+
+    def _field_image(self):
+        """(image, where): the field coloured by display.glsl into a QImage (top row first), at
+        the lattice's own size or the lattice rectangle's size in device pixels, whichever is
+        smaller, read back; `where` is the rectangle (logical pixels) to draw it in. The window
+        stays a plain raster window, which Qt updates by copying the changed pixels only (a GL
+        widget makes Qt composite the whole window on every frame), and a picture no larger
+        than the lattice is cheap to colour and read back on a machine without a GPU: QPainter
+        scales it up, smoothly. None before there is a field."""
         if self.sim is None or self.field_texture is None:
-            return
+            return None
+        ctx = self.ctx
+        dpr = self.devicePixelRatioF()
+        r = self.lattice_rect()
+        nx, ny = self.sim.config.nx, self.sim.config.ny
+        size = (max(1, min(nx, int(round(r.width() * dpr)))), max(1, min(ny, int(round(r.height() * dpr)))))
+        self.makeCurrent()
+        ctx.enable_only(moderngl.NOTHING)
+        if self._image_fbo is None or self._image_fbo.size != size:
+            if self._image_fbo is not None:
+                self._image_fbo.color_attachments[0].release()
+                self._image_fbo.release()
+            self._image_fbo = ctx.framebuffer(color_attachments=[ctx.texture(size, 4, dtype="f1")])
+            self._pixels = bytearray(size[0] * size[1] * 4)
+        self._image_fbo.use()
+        ctx.viewport = (0, 0, *size)
         mode = DISPLAY_MODES[self.mode]
         self._ensure_lut(mode.colormap)
-        r = self.lattice_rect()
-        ctx.viewport = (int(round(r.left() * dpr)), int(round((self.height() - r.bottom()) * dpr)),
-                        int(round(r.width() * dpr)), int(round(r.height() * dpr)))
         self.field_texture.use(0)
         self._sampler.use(0)          # smooth, without changing the solver's own texture
         self._lut.filter = (moderngl.LINEAR, moderngl.LINEAR)
@@ -196,8 +246,12 @@ class Viewport(QOpenGLWidget):
         self.program["scale"] = self.display_scale()
         self.program["range"] = mode.range
         self.program["rho_ref"] = self.rho_ref
+        self.program["flip_y"] = 1.0  # the image's first row is the lattice's top
+        self.program["bgra"] = int(LITTLE_ENDIAN)   # B, G, R, A bytes are QImage.Format_RGB32 there
         self.vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
-        ctx.viewport = full
+        self._image_fbo.read_into(self._pixels, components=4, alignment=1)
+        fmt = QImage.Format_RGB32 if LITTLE_ENDIAN else QImage.Format_RGBA8888   # RGB32: QPainter's fastest
+        return QImage(self._pixels, size[0], size[1], 4 * size[0], fmt), r
 
     def display_scale(self) -> float:
         """Lattice value -> the colour bar's unit (reference speed: the wind, or half the cap)."""
@@ -212,13 +266,23 @@ class Viewport(QOpenGLWidget):
 
     # --- geometry the overlay and the mouse share -----------------------------------------------
     def body_outline_points(self, outline=None):
-        """The outline in widget pixels: `to_widget` with the lattice rectangle computed once,
-        not once per point (this runs in every paint)."""
-        pts = self.sim.shape.outline() if outline is None else outline
+        """The outline in widget pixels, computed with numpy; the body's own (`outline` None) is
+        kept until the body or the lattice rectangle changes (this runs in every paint)."""
+        shape = self.sim.shape
         r = self.lattice_rect()
         nx, ny = self.sim.config.nx, self.sim.config.ny
-        left, bottom, w, h = r.left(), r.bottom(), r.width(), r.height()
-        return QPolygonF([QPointF(left + (x + 0.5) / nx * w, bottom - (y + 0.5) / ny * h) for x, y in pts])
+        key = (r.left(), r.bottom(), r.width(), r.height(), nx, ny)
+        if outline is None and self._outline_cache is not None and self._outline_cache[0] is shape \
+                and self._outline_cache[1] == key:
+            return self._outline_cache[2]
+        pts = np.asarray(shape.outline() if outline is None else outline, float).reshape(-1, 2)
+        left, bottom, w, h = key[:4]
+        xs = (left + (pts[:, 0] + 0.5) * (w / nx)).tolist()
+        ys = (bottom - (pts[:, 1] + 0.5) * (h / ny)).tolist()
+        polygon = QPolygonF([QPointF(x, y) for x, y in zip(xs, ys)])
+        if outline is None:
+            self._outline_cache = (shape, key, polygon)
+        return polygon
 
     def outlet_zone_x(self):
         """Widget x where the outlet zone begins, None without one. In the zone (the sponge's last

@@ -50,8 +50,9 @@ def load_scene_with(path: Path, *, phase_steps=None, steps=None, inflow_speed=No
         data.setdefault("flow", {})["inflow_speed"] = inflow_speed
     if interval is not None:
         data.setdefault("output", {})["interval"] = interval
-    if ramp is not None:
-        data.setdefault("flow", {})["inflow_ramp_steps"] = min(ramp, data.get("flow", {}).get("inflow_ramp_steps", ramp))
+    if ramp is not None:   # a shortened ramp; with the quiet inlet, which refuses short ramps, none
+        flow = data.setdefault("flow", {})
+        flow["inflow_ramp_steps"] = 0 if flow.get("inlet_nonreflecting", 0) else min(ramp, flow.get("inflow_ramp_steps", ramp))
     return scene_from_dict(data, str(path))
 
 

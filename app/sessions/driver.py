@@ -39,10 +39,18 @@ class SessionSolver:
 
     `set_viscosity`, `reset` and `rebuild` build a new backend with `factory(config)`
     (default: the same backend by name, handing on the wrapped solver's `.ctx` if it has one).
+
+    The flow's physical range (`check_physical`) is checked after each `step` call (each force
+    row), or, with `check_every` = N > 1, only once at least N solver steps have run since the
+    last check (the window: the check reads the whole field back). Non-finite populations are
+    caught by the backends themselves at every step either way.
     """
 
-    def __init__(self, solver, recorder: SessionRecorder | None = None, *, factory=None, body=None):
+    def __init__(self, solver, recorder: SessionRecorder | None = None, *, factory=None, body=None,
+                 check_every: int = 1):
         self._solver = solver
+        self.check_every = max(1, int(check_every))
+        self._checked_at = None      # solver time of the last physical-range check
         self.recorder = recorder
         self._factory = factory or _same_backend_factory(solver)
         self.flow_config = solver.config  # the configuration asked for (reset returns to it)
@@ -79,6 +87,7 @@ class SessionSolver:
                      "velocity": list(self.velocity), "omega": self.omega,
                      "force_models": list(self.models), "inflow_speed": self.inflow_speed}
         rec.state = np.ascontiguousarray(self._solver.distributions(), dtype=np.float64)
+        rec.inlet_reference = self._solver.inlet_reference()
         self.recorder = rec
         self.clock = 0
         return rec
@@ -130,7 +139,7 @@ class SessionSolver:
         body = self._body_row()
         try:
             self._solver.step(n)
-            self._check_physical()
+            self.check_physical()
         except SolverDiverged as exc:
             done = max(1, min(n, exc.step - start))
             self._record_row(done, {m: (math.nan, math.nan) for m in self.models}, body)
@@ -163,7 +172,7 @@ class SessionSolver:
         if part["done"] < row_steps:
             return False
         try:
-            self._check_physical()
+            self.check_physical()
         except SolverDiverged:
             self._part = None
             self._record_row(row_steps, {m: (math.nan, math.nan) for m in self.models}, part["body"])
@@ -173,11 +182,14 @@ class SessionSolver:
                          part["body"])
         return True
 
-    def _check_physical(self) -> None:
-        """SolverDiverged when the flow left the physical range (solver.backend.Solver.check_physical)."""
-        check = getattr(self._solver, "check_physical", None)
-        if check is not None:
-            check()
+    def check_physical(self) -> None:
+        """SolverDiverged when the flow left the physical range (solver.backend.Solver.check_physical);
+        nothing when fewer than `check_every` solver steps have run since the last check."""
+        t = self._solver.time
+        if self._checked_at is not None and 0 <= t - self._checked_at < self.check_every:
+            return
+        self._solver.check_physical()
+        self._checked_at = t
 
     @property
     def partial_steps(self) -> int:
@@ -207,7 +219,7 @@ class SessionSolver:
             self.recorder.record_parameter("nu", float(nu))
         self.flow_config = config
         old = self._solver
-        new = carry_flow(self._factory, config, old.distributions(), old.time, self.shape)
+        new = carry_flow(self._factory, config, old.distributions(), old.time, self.shape, old.inlet_reference())
         self._reapply(new)
         old.close()
 
@@ -232,6 +244,9 @@ class SessionSolver:
         new = self._factory(config)
         if keep_flow and (config.nx, config.ny) == (old.config.nx, old.config.ny):
             new.set_distributions(old.distributions())
+            reference = old.inlet_reference()
+            if reference is not None and new.has_quiet_inlet:
+                new.set_inlet_reference(reference)
             new.time = old.time
         self.flow_config = config
         self.shape, self.velocity, self.omega, self.models, self.inflow_speed = None, (0.0, 0.0), 0.0, (), None
@@ -269,14 +284,17 @@ def _same_backend_factory(solver):
     return factory
 
 
-def carry_flow(factory, config, f, time, shape):
+def carry_flow(factory, config, f, time, shape, inlet_reference=None):
     """A new backend for `config` holding populations `f` at `time`, with `shape` (if any)
     placed at rest *before* the populations arrive: a fresh lattice started at rest books no
-    cover impulse, and the caller's own placement afterwards covers no new node."""
+    cover impulse, and the caller's own placement afterwards covers no new node. The quiet
+    inlet's reference (Solver.inlet_reference) is carried too where both flows have one."""
     new = factory(dataclasses.replace(config, initial_velocity=(0.0, 0.0)))
     if shape is not None:
         new.set_body(shape, velocity=(0.0, 0.0), omega=0.0)
     new.set_distributions(f)
+    if inlet_reference is not None and new.has_quiet_inlet:
+        new.set_inlet_reference(inlet_reference)
     new.time = int(time)
     return new
 

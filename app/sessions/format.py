@@ -49,6 +49,9 @@ INPUT_ARRAYS = {"seq": ("int64", ()), "step": ("int64", ()), "pose": ("float64",
 FORCE_ARRAYS = {"seq": ("int64", ()), "step": ("int64", ()), "n": ("int64", ()),
                 "body": ("float64", (4,)), "values": ("float64", None)}
 STATE_ARRAYS = {"f": ("float64", None)}
+#: state.npz's optional array: the quiet inlet's reference (ny,) float64 (solver/quiet_inlet.py),
+#: present when the flow had one; without it the replay would drift from the recording
+INLET_REFERENCE = "inlet_reference"
 #: a commanded body or inflow speed beyond this (one cell per step) is not a lattice velocity
 MAX_LATTICE_SPEED = 1.0
 
@@ -147,6 +150,7 @@ class Session:
     models: tuple[str, ...]
     start: dict | None = None        # manifest "start": recording began on a running flow
     state: np.ndarray | None = None  # then its populations f (9, ny, nx), from state.npz
+    inlet_reference: np.ndarray | None = None  # and the quiet inlet's reference (ny,), if it has one
     source: str = field(default="session", compare=False)
 
     @property
@@ -230,7 +234,10 @@ def session_bytes(session: Session) -> bytes:
         zf.writestr(INPUTS, _npz_bytes(session.inputs))
         zf.writestr(FORCES, _npz_bytes(session.forces))
         if session.state is not None:
-            zf.writestr(STATE, _npz_bytes({"f": session.state}))
+            arrays = {"f": session.state}
+            if session.inlet_reference is not None:
+                arrays[INLET_REFERENCE] = np.asarray(session.inlet_reference, dtype=np.float64)
+            zf.writestr(STATE, _npz_bytes(arrays))
     return buf.getvalue()
 
 
@@ -295,9 +302,10 @@ def load_session(path) -> Session:
     if starts and STATE not in data:
         fail(f"the recording starts on a running flow but member {STATE} is missing")
     state = _npz_member(data[STATE], STATE, STATE_ARRAYS, fail)["f"] if starts else None
+    reference = _optional_array(data[STATE], STATE, INLET_REFERENCE, fail) if starts else None
     try:
         return _validate(manifest, parameters, _npz_member(data[INPUTS], INPUTS, INPUT_ARRAYS, fail),
-                         _npz_member(data[FORCES], FORCES, FORCE_ARRAYS, fail), src, state)
+                         _npz_member(data[FORCES], FORCES, FORCE_ARRAYS, fail), src, state, reference)
     except SessionError as exc:
         if str(exc).startswith(src + ": "):
             raise
@@ -353,7 +361,19 @@ def _npz_member(raw: bytes, member: str, spec: dict, fail) -> dict:
     return arrays
 
 
-def _validate(manifest, parameters, inputs, forces, src, state=None) -> Session:
+def _optional_array(raw: bytes, member: str, name: str, fail):
+    """Array `name` of an .npz member already read by _npz_member (so readable, no pickle), as
+    a one-dimensional float64 array, or None when the member lacks it."""
+    with np.load(io.BytesIO(raw), allow_pickle=False) as npz:
+        if name not in npz.files:
+            return None
+        a = npz[name]
+    if a.dtype != np.float64 or a.ndim != 1:
+        fail(f"{member}: array {name!r} must be one-dimensional float64, got {a.dtype} with shape {a.shape}")
+    return a
+
+
+def _validate(manifest, parameters, inputs, forces, src, state=None, inlet_reference=None) -> Session:
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         raise SessionError(f"{MANIFEST}: not a FeelFlow session (expected \"format\": \"{FORMAT}\")")
     version = manifest.get("version")
@@ -455,7 +475,19 @@ def _validate(manifest, parameters, inputs, forces, src, state=None) -> Session:
             raise SessionError(f"event {s} is stamped step {order[s][1]} but happens at step {clock}")
     return Session(manifest=manifest, config=config, body=body, backend=manifest["backend"],
                    force_models=tuple(initial_models), inputs=inputs, parameters=params,
-                   forces=forces, models=tuple(models), start=start, state=state, source=src)
+                   forces=forces, models=tuple(models), start=start, state=state,
+                   inlet_reference=_validate_inlet_reference(inlet_reference, config), source=src)
+
+
+def _validate_inlet_reference(reference, config: FlowConfig):
+    """state.npz's quiet-inlet reference: only with a quiet inlet, ny finite numbers."""
+    if reference is None:
+        return None
+    if not (config.x_boundary == "tunnel" and config.inlet_nonreflecting > 0):
+        raise SessionError(f"{STATE}: {INLET_REFERENCE!r} given but the scene has no quiet inlet (inlet_nonreflecting = 0)")
+    if reference.shape != (config.ny,) or not np.isfinite(reference).all():
+        raise SessionError(f"{STATE}: {INLET_REFERENCE!r} must be {config.ny} finite numbers, got shape {reference.shape}")
+    return reference
 
 
 def _validate_start(start, state, config: FlowConfig):

@@ -47,6 +47,7 @@ class SessionRecorder:
         #: set by SessionSolver.start_recording: how the running flow was when recording began
         self.start: dict | None = None
         self.state: np.ndarray | None = None  # its populations f (9, ny, nx)
+        self.inlet_reference: np.ndarray | None = None  # and the quiet inlet's reference (ny,)
 
     @classmethod
     def from_scene(cls, scene, *, scene_toml: str | None = None, backend: str | None = None,
@@ -126,7 +127,7 @@ class SessionRecorder:
                     "n": np.array([r[2] for r in self._forces], dtype=np.int64),
                     "body": np.array([r[3] for r in self._forces], dtype=np.float64).reshape(nf, 4),
                     "values": values},
-            models=tuple(self._models), start=self.start, state=self.state,
+            models=tuple(self._models), start=self.start, state=self.state, inlet_reference=self.inlet_reference,
         )
 
     def _manifest(self) -> dict:

@@ -59,7 +59,8 @@ class SessionPlayer:
             if start is None:
                 solver = factory(session.config)
             else:  # the flow as it was when recording began, then its placement as it was
-                solver = carry_flow(factory, session.config, session.state, start["time"], placed)
+                solver = carry_flow(factory, session.config, session.state, start["time"], placed,
+                                    session.inlet_reference)
         except (ValueError, BackendError) as exc:  # ShapeError, ConfigError, or not on this backend
             raise SessionError(f"{session.source}: the recorded scene cannot be built: "
                                f"{str(exc).splitlines()[0]}") from None
@@ -70,6 +71,7 @@ class SessionPlayer:
         if start is not None:
             d = self._driver
             self.recorder.start, self.recorder.state = start, session.state
+            self.recorder.inlet_reference = session.inlet_reference
             d.models, d.inflow_speed = tuple(start["force_models"]), start["inflow_speed"]
             d.shape, d.velocity, d.omega = placed, tuple(start["velocity"]), start["omega"]
             d._reapply(solver)

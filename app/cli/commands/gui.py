@@ -1,4 +1,5 @@
-"""`feelflow gui [SESSION] [--exercise FILE]` (the default command) and `feelflow --selftest [--screenshot PATH] [--seconds S]`.
+"""`feelflow gui [SESSION] [--exercise FILE]` (the default command) and `feelflow --selftest [--screenshot PATH]
+[--seconds S] [--frame-profile]`.
 
 `feelflow gui FILE.ffsession` opens the window and replays that session in it as soon as the live
 tunnel runs (what File > Replay session does); the desktop entry's `Exec=... gui %f` uses it, so
@@ -113,7 +114,8 @@ def main(args) -> int:
     if selftest:
         from feelflow.app.gui.selftest import SelfTest
 
-        test = SelfTest(window, seconds=args.seconds, screenshot=args.screenshot, replay=session is not None)
+        test = SelfTest(window, seconds=args.seconds, screenshot=args.screenshot, replay=session is not None,
+                        frame_profile=getattr(args, "frame_profile", False))
         window.show()
         app.exec()
         if window.startup_error:

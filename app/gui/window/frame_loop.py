@@ -1,5 +1,7 @@
-"""The frame loop: each frame runs as many solver steps as keep the window at >= 30 fps
-(adaptive stepping: the cost of a step and of the rest of the frame, each smoothed), uploads
+"""The frame loop: each frame runs as many solver steps as fit its length (adaptive stepping:
+the cost of a step and of the rest of the frame, each smoothed; `FrameLoop.frame_seconds`:
+60 frames per second where drawing takes at most half a frame, down to 30 as it takes more,
+so that the solver keeps at least half of each frame), uploads
 the field, moves the tracers, sets the force arrows and redraws; twice a second the readouts
 follow. Pause, the display mode and the unstable-flow dialog live here too.
 
@@ -21,11 +23,20 @@ from feelflow.solver.backend import SolverDiverged
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
 
-TARGET_FRAME_S = 1.0 / 31.5    # aim just above 30 fps: every spare millisecond goes to the solver
+#: the frame's length: as short as 1/60 s (aim just above 60 fps), as long as keeps at least
+#: MIN_SOLVER_SHARE of it for the solver's steps, never longer than 1/30 s (just above 30 fps)
+FASTEST_FRAME_S = 1.0 / 61.5
+SLOWEST_FRAME_S = 1.0 / 31.5
+MIN_SOLVER_SHARE = 0.5
 MAX_STEPS_PER_FRAME = 200
 MIN_STEPS_PER_FRAME = 2   # the flow keeps moving even where drawing alone takes 1/30 s
 N_TRACERS = 900
 READOUT_MS = 500
+#: the live tunnel's physical-range check (SessionSolver.check_physical) runs once this many
+#: solver steps have passed, not after every frame: it reads the whole field back (on the gl
+#: backend a read-back of all populations), about 1.5 ms on a 2-core machine without a GPU;
+#: non-finite populations are still caught at every step by the backends themselves
+PHYSICAL_CHECK_STEPS = 64
 
 
 class FrameLoop:
@@ -51,6 +62,8 @@ class FrameLoop:
         self.slow_timer.timeout.connect(self.refresh_readouts)
 
     def start(self):
+        if self.w.sim is not None:
+            self.w.sim.solver.check_every = PHYSICAL_CHECK_STEPS
         self.timer.start()
         self.slow_timer.start()
 
@@ -89,6 +102,9 @@ class FrameLoop:
         if mode != "tracers":
             w.viewport.tracers = None
         w.panel.show_params(w.params_now(), mode)
+        if w.backend == "gl" and w.shown is not None:   # the field again: vorticity only where shown
+            w.make_current()
+            self.upload_field()
         w.viewport.update()
 
     # --- the field ----------------------------------------------------------------------------
@@ -98,8 +114,8 @@ class FrameLoop:
         model = w.shown
         if model is None:
             return None
-        if w.backend == "gl":
-            w.viewport.use_texture(model.solver.field_texture())
+        if w.backend == "gl":   # the vorticity (five nodes a texel) only where it is shown
+            w.viewport.use_texture(model.solver.field_texture(vorticity=self.display_mode == "vorticity"))
             return None
         rgba = model.field_rgba()
         w.viewport.makeCurrent()
@@ -185,7 +201,7 @@ class FrameLoop:
             other = max(0.0, (now - self._last_tick) - self._last_step_s)
             self.other_cost = 0.8 * self.other_cost + 0.2 * min(other, 0.2)
         self._last_tick, self._last_step_s = now, t1 - t0
-        budget = TARGET_FRAME_S - self.other_cost
+        budget = self.frame_seconds() - self.other_cost
         self.steps_per_frame = int(max(MIN_STEPS_PER_FRAME, min(MAX_STEPS_PER_FRAME, budget / max(self.step_cost, 1e-6))))
         rw = self._rate_window
         rw[1] += n
@@ -195,6 +211,14 @@ class FrameLoop:
             cfg = self.w.shown.config
             self.rates = {"steps_per_s": rw[1] / dt, "fps": rw[2] / dt, "mlups": rw[1] * cfg.nx * cfg.ny / dt / 1e6}
             self._rate_window = [now, 0, 0]
+
+    def frame_seconds(self) -> float:
+        """The frame length the steps per frame aim at: 1/60 s where the rest of the frame
+        (drawing, Qt) takes at most half of it, longer as the rest takes more, so that the
+        solver keeps half of each frame; never longer than 1/30 s: where the rest takes more
+        than half of that, the solver gets what is left (at least MIN_STEPS_PER_FRAME steps)."""
+        wanted = self.other_cost / (1.0 - MIN_SOLVER_SHARE)
+        return min(SLOWEST_FRAME_S, max(FASTEST_FRAME_S, wanted))
 
     def _free_stream_density(self, rgba) -> float:
         """Median density of the fluid: the reference of the pressure coefficient (the lattice's
