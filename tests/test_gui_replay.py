@@ -184,9 +184,11 @@ def test_gl_window_replays_in_its_own_context(qtbot, tmp_path, monkeypatch):
     recorded = np.asarray(session.forces["values"])
     split = np.isin(np.asarray(session.forces["step"]), split_ends)
     # same backend, same machine: bit for bit, except rows run in parts, whose forces the gl
-    # step pass sums over each part in float32 (lbm_step.glsl LINK_SUMS): equal to that rounding
+    # step pass sums over each part in float32 (lbm_step.glsl LINK_SUMS): equal to that rounding,
+    # which is relative to the size of the summed link terms (the force's scale), not to a
+    # component that happens to be small (a lift near zero)
     np.testing.assert_allclose(values[~split], recorded[~split], rtol=1e-12, atol=1e-15)
-    np.testing.assert_allclose(values[split], recorded[split], rtol=1e-6, atol=1e-12)
+    np.testing.assert_allclose(values[split], recorded[split], rtol=1e-6, atol=1e-6 * np.abs(recorded).max())
     print(f"\n  rows run in parts: {int(split.sum())} of {split.size}", end="")
     w.replays.stop()
     assert w.viewport.field_texture is live_texture
