@@ -18,6 +18,8 @@ PARAMETERS = {
     "plate": {"length": ("Length (cells)", 2.0, 60.0, 0.5), "thickness": ("Thickness (cells)", 0.5, 20.0, 0.5)},
     "wedge": {"length": ("Length (cells)", 2.0, 60.0, 0.5), "apex_angle": ("Apex angle (degrees)", 5.0, 170.0, 1.0)},
     "half_airfoil": {"chord": ("Chord (cells)", 4.0, 60.0, 0.5), "thickness": ("Thickness (cells)", 0.5, 20.0, 0.25)},
+    "naca": {"chord": ("Chord (cells)", 8.0, 120.0, 1.0), "thickness": ("Thickness (x chord)", 0.04, 0.3, 0.01),
+             "camber": ("Camber (x chord)", 0.0, 0.09, 0.01), "camber_position": ("Camber at (x chord)", 0.1, 0.9, 0.1)},
 }
 THUMB = QSize(72, 44)
 BAD = "#d03030"
