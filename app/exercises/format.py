@@ -170,6 +170,10 @@ class Exercise:
     def folder(self) -> Path:
         return self.path.parent if self.path else Path(".")
 
+    def input_files(self) -> tuple[Path, ...]:
+        """Every shape file the exercise names (start, references, check shapes)."""
+        return (self.start, *(r.path for r in self.references), *self.check_shapes)
+
 
 def load_exercise(path) -> Exercise:
     """Read and validate an exercise file; UserError (one line) on any problem."""
