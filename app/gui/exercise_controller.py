@@ -19,6 +19,8 @@ from feelflow import EXERCISE_DIR
 from feelflow.app.errors import UserError
 from feelflow.app.exercises import scoring
 from feelflow.app.gui.exercise_panel import PARAMETERS, PANEL_WIDTH, ExercisePanel, ScrollingPanel
+from feelflow.app.model import readouts
+from feelflow.app.model.readouts import EXERCISE_LENGTH, ReferenceLength
 from feelflow.shapes.base import ShapeError
 
 BROKEN_EDGE = QColor(230, 40, 40)
@@ -72,6 +74,7 @@ class ExerciseController(QObject):
         self.timer = QTimer(self)
         self.timer.setInterval(CHECK_INTERVAL_MS)
         self.timer.timeout.connect(self.refresh_constraints)
+        self.timer.timeout.connect(self.refresh_live)
 
     # --- menus -------------------------------------------------------------------------------
     def build_menu(self, bar, presets_menu=None):
@@ -154,6 +157,8 @@ class ExerciseController(QObject):
             w.flow.refuse_dialog("This exercise cannot be opened", exc)
             return False
         self.exercise = exercise
+        # the live readouts use the length the score uses (app/model/readouts.py)
+        w.sim.reference_override = ReferenceLength(s.reference_length, EXERCISE_LENGTH)
         w.undo.clear()
         w.bodies.set_hold_still(True)
         self._ensure_panel()
@@ -242,6 +247,8 @@ class ExerciseController(QObject):
             self.cancel()
         self.timer.stop()
         self.exercise = None
+        if self.window.sim is not None:
+            self.window.sim.reference_override = None
         self.window.viewport.body_edge = None
         if self.dock is not None:
             self.dock.hide()
@@ -317,6 +324,13 @@ class ExerciseController(QObject):
             self.window.viewport.body_edge = edge
             self.window.viewport.update()
 
+    def refresh_live(self):
+        """The panel's line of the live tunnel's coefficients, as the plot shows them."""
+        sim = self.window.sim
+        if self.exercise is None or self.panel is None or sim is None:
+            return
+        self.panel.show_live(readouts.readout(sim.history, sim.params.force_model, sim.reference_length()))
+
     # --- scoring -------------------------------------------------------------------------------
     def score(self, _=False) -> bool:
         """Score the current shape in a worker thread; refused (with the reasons) while a
@@ -357,7 +371,9 @@ class ExerciseController(QObject):
         ex = self.exercise
         if result.ok:
             o = ex.objective
-            lines = [f"<b>Score {result.score:.4f}</b> ({o.quantity}; C_D {result.cd:.4f}, C_L {result.cl:.4f}; "
+            s = ex.scene
+            lines = [f"<b>Score {result.score:.4f}</b> ({o.quantity}; C_D {result.cd:.4f}, C_L {result.cl:.4f} "
+                     f"with L = {s.reference_length:g} cells ({EXERCISE_LENGTH}), U = {s.inflow_speed:.3f}; "
                      f"{result.steps} steps, {result.seconds:.1f} s)"]
             if result.hit is not None:
                 lines.append("A hit: within the tolerance." if result.hit else "Not a hit yet: outside the tolerance.")

@@ -13,6 +13,8 @@ from PySide6.QtWidgets import (QComboBox, QDoubleSpinBox, QFormLayout, QGroupBox
                                QListWidgetItem, QProgressBar, QPushButton, QScrollArea, QTextBrowser,
                                QVBoxLayout, QWidget)
 
+from feelflow.app.model import readouts
+
 #: parametric kinds: parameter -> (label, minimum, maximum, step); angles in degrees
 PARAMETERS = {
     "cylinder": {"diameter": ("Diameter (cells)", 2.0, 60.0, 0.5)},
@@ -174,6 +176,11 @@ class ExercisePanel(QWidget):
         self.result.setWordWrap(True)
         self.result.setTextFormat(Qt.RichText)
         layout.addWidget(self.result)
+        #: the live tunnel's coefficients, as the force plot shows them (same reference length)
+        self.live = QLabel()
+        self.live.setWordWrap(True)
+        self.live.setTextFormat(Qt.RichText)
+        layout.addWidget(self.live)
 
         self.attempts_label = QLabel("Attempts")
         self.attempts_label.setWordWrap(True)
@@ -251,6 +258,12 @@ class ExercisePanel(QWidget):
         if kind == "wedge":
             d["pointing"] = self.pointing.currentData()
         return d
+
+    def show_live(self, readout):
+        """The live tunnel's C_D and C_L (an app.model.readouts.Readout) with their reference."""
+        fmt = readouts.format_coefficient
+        self.live.setText(f"In the tunnel now: C<sub>D</sub> {fmt(readout.cd)}, C<sub>L</sub> {fmt(readout.cl)} "
+                          f"<small>({readout.reference_text()}; the window's flow, float32)</small>")
 
     def set_problems(self, problems: list[str]):
         if problems:
