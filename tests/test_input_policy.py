@@ -20,7 +20,8 @@ from feelflow.app.errors import UserError
 from feelflow.app.model.scene import load_scene, scene_from_dict
 from feelflow.app.sessions import SessionError, load_session
 from feelflow.shapes.base import ShapeError
-from feelflow.shapes.io import from_dict, load_shape
+from feelflow.shapes.io import from_dict
+from feelflow.app.shape_files import load_shape
 
 from test_file_policy import SCENE, one_error_line
 
@@ -68,7 +69,7 @@ def test_deep_nesting_and_huge_integers_are_one_line(tmp_path):
     cases = [
         (tmp_path / "a.toml", f"x = {deep}\n", load_scene, UserError, "nested"),
         (tmp_path / "b.toml", "[grid]\nnx = " + "9" * 5000 + "\n", load_scene, UserError, "too large"),
-        (tmp_path / "c.json", '{"a": ' + deep + "}", load_shape, ShapeError, "deeply"),
+        (tmp_path / "c.json", '{"a": ' + deep + "}", load_shape, ShapeError, "deep"),
         (tmp_path / "d.json", wrap({"kind": "cylinder", "diameter": int("9" * 20)}), load_shape, ShapeError, "large"),
     ]
     for path, text, load, error, words in cases:
