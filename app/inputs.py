@@ -95,19 +95,23 @@ def is_folder(path) -> bool:
 
 
 def check_document(doc, source: str) -> None:
-    """Bound nesting depth, integer size and list length of a parsed document (iteratively)."""
-    stack = [(doc, 1)]
+    """Bound nesting depth, integer size and list length of a parsed document (iteratively); the
+    message names the key where the problem is (`scene.steps`, `reference[0].score`)."""
+    stack = [(doc, 1, "")]
     while stack:
-        value, depth = stack.pop()
+        value, depth, where = stack.pop()
+        at = f"{shown(where)}: " if where else ""
         if isinstance(value, (dict, list)):
             if depth > MAX_DEPTH:
-                raise UserError(f"{source}: nested more than {MAX_DEPTH} levels deep")
-            items = value.values() if isinstance(value, dict) else value
+                raise UserError(f"{source}: {at}nested more than {MAX_DEPTH} levels deep")
             if isinstance(value, list) and len(value) > MAX_ITEMS:
-                raise UserError(f"{source}: a list of {len(value)} items (at most {MAX_ITEMS})")
-            stack.extend((v, depth + 1) for v in items)
+                raise UserError(f"{source}: {at}a list of {len(value)} items (at most {MAX_ITEMS})")
+            if isinstance(value, dict):
+                stack.extend((v, depth + 1, f"{where}.{k}" if where else str(k)) for k, v in value.items())
+            else:
+                stack.extend((v, depth + 1, f"{where}[{i}]") for i, v in enumerate(value))
         elif isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_INTEGER:
-            raise UserError(f"{source}: the integer {shown(value)} is too large (at most 2**53)")
+            raise UserError(f"{source}: {at}the integer {shown(value)} is too large (at most 2**53)")
 
 
 def _text(data: bytes, source: str, kind: str) -> str:

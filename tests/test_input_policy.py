@@ -209,6 +209,38 @@ def test_bad_sessions_are_refused_fast_in_one_line(good, tmp_path):
         assert words in str(info.value) and "\n" not in str(info.value), (name, info.value)
 
 
+def malformed_header_npz(name: str) -> bytes:
+    """An .npz whose entry's .npy header is cut off inside a bracket (numpy's header parser
+    raises tokenize.TokenError on it)."""
+    head = b"{'descr': '<f8', 'fortran_order': False, 'shape': (3,"
+    head += b" " * (64 - 10 - len(head) - 1) + b"\n"
+    out = io.BytesIO()
+    with zipfile.ZipFile(out, "w") as zf:
+        zf.writestr(name + ".npy", b"\x93NUMPY\x01\x00" + len(head).to_bytes(2, "little") + head + bytes(24))
+    return out.getvalue()
+
+
+def test_session_leftovers_are_one_line(good, tmp_path, capsys):
+    """A malformed .npy header (`session info`), a recorded rebuild to 8192 x 8192 (`session
+    replay`) and `run /proc/self/mem`: one line and exit 2 each."""
+    bad_header = write_session(tmp_path / "header.ffsession", {**good, "forces.npz": malformed_header_npz("values")})
+    params = json.loads(good["parameters.json"])
+    manifest = json.loads(good["manifest.json"])
+    config = dict(manifest["scene"]["config"], nx=8192, ny=8192)
+    params.append({"seq": 10 ** 6, "step": 0, "name": "rebuild", "value": {"config": config, "keep_flow": False}})
+    manifest["counts"]["parameters"] = len(params)
+    rebuild = write_session(tmp_path / "rebuild.ffsession", {**good, "parameters.json": json.dumps(params).encode(),
+                                                             "manifest.json": json.dumps(manifest).encode()})
+    for argv, words in [(["session", "info", str(bad_header)], "not a readable .npz"),
+                        (["session", "replay", str(rebuild)], "more than 4194304"),
+                        (["run", "/proc/self/mem", "--out", str(tmp_path / "f.csv")], "cannot be read")]:
+        t0 = time.perf_counter()
+        assert cli_main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert time.perf_counter() - t0 < 10
+        assert err.count("\n") == 1 and words in err and "Traceback" not in err, (argv, err)
+
+
 def test_a_zip_bomb_is_refused_before_it_inflates(good, tmp_path):
     """64 MB of zeros deflate to about 64 KB; the forces member may hold a few KB here."""
     path = write_session(tmp_path / "bomb.ffsession", {**good, "forces.npz": bytes(64 << 20)},

@@ -8,13 +8,13 @@ loaded back; `best()` is the best scored attempt for the exercise's objective.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import asdict, dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
 from feelflow.app.errors import UserError, shown, shown_path
 from feelflow.app.files import write_json_atomic
-from feelflow.app.inputs import exists
 
 FORMAT = "feelflow-attempts"
 VERSION = 1
@@ -58,7 +58,7 @@ class Attempts:
         self.exercise = exercise
         self.path = attempts_path(exercise, folder)
         self.items: list[Attempt] = []
-        if exists(self.path):   # never raises, even for a name too long or a loop of links
+        if os.path.lexists(self.path):   # a link that cannot be followed is read (and refused)
             self.items = _read(self.path)
 
     def add(self, shape, result) -> Attempt:
