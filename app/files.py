@@ -215,3 +215,20 @@ def save_json(path, data, option: str = "--json") -> pathlib.Path:
 def save_text(path, text: str, option: str = "output") -> pathlib.Path:
     """`write_text_atomic` through `write_or_rescue`."""
     return write_or_rescue(path, lambda target: write_text_atomic(target, text), option)
+
+
+def save_bytes(path, data: bytes, option: str = "output") -> pathlib.Path:
+    """`write_bytes_atomic` through `write_or_rescue`."""
+    return write_or_rescue(path, lambda target: write_bytes_atomic(target, data), option)
+
+
+def save_csv(path, header, rows, option: str = "--out") -> pathlib.Path:
+    """A CSV file (`header`, then `rows`) written atomically through `write_or_rescue`."""
+    import csv
+    import io
+
+    buf = io.StringIO(newline="")
+    writer = csv.writer(buf)
+    writer.writerow(header)
+    writer.writerows(rows)
+    return save_text(path, buf.getvalue(), option)

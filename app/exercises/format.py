@@ -26,7 +26,7 @@ OBJECTIVES = {
     "target_cl": ("|C_L - target|", "lower"),
 }
 #: shape kinds a student may edit (shapes/io.py KINDS)
-EDIT_KINDS = ("polygon", "cylinder", "plate", "wedge", "half_airfoil")
+EDIT_KINDS = ("polygon", "cylinder", "plate", "wedge", "half_airfoil", "naca")
 WALLS = ("free_slip", "no_slip")
 DOC = "docs/reference/exercise-format.md"
 
@@ -169,6 +169,10 @@ class Exercise:
     @property
     def folder(self) -> Path:
         return self.path.parent if self.path else Path(".")
+
+    def input_files(self) -> tuple[Path, ...]:
+        """Every shape file the exercise names (start, references, check shapes)."""
+        return (self.start, *(r.path for r in self.references), *self.check_shapes)
 
 
 def load_exercise(path) -> Exercise:

@@ -10,7 +10,6 @@ Format: docs/reference/exercise-format.md. Bad input is one line on stderr and e
 """
 from __future__ import annotations
 
-import csv
 import sys
 import time
 from pathlib import Path
@@ -26,7 +25,11 @@ def add_arguments(parser):
     p = sub.add_parser("score", help="score shape files (or folders of them) and rank them")
     p.add_argument("exercise", metavar="EXERCISE.toml")
     p.add_argument("shapes", metavar="SHAPES", nargs="+", help="shape JSON files or folders of them")
-    p.add_argument("--out", default="scores.csv", metavar="PATH", help="CSV file to write (default: scores.csv)")
+    p.add_argument("--out", default="scores.csv", metavar="PATH",
+                   help="CSV file to write (default: scores.csv); an existing file is refused before "
+                        "scoring starts unless --force is given")
+    p.add_argument("--force", action="store_true",
+                   help="replace --out if it exists (never the exercise file or a shape being scored)")
     p.add_argument("--workers", default=None, metavar="N", help="processes (default: every core)")
     p.add_argument("--scale", default=None, metavar="N",
                    help="score at N times the exercise's resolution (default 1; 2 to confirm a close ranking)")
@@ -103,14 +106,13 @@ def _list() -> int:
 
 def _score(exercise, args) -> int:
     from feelflow.app.exercises import grading
-    from feelflow.app.files import atomic_path
+    from feelflow.app.files import check_output, save_csv
 
-    out = Path(args.out)
-    if out.is_dir():
-        raise UserError(f"--out: {args.out!r} is a directory")
-    if not (out.parent if str(out.parent) else Path(".")).is_dir():
-        raise UserError(f"--out: directory {str(out.parent)!r} does not exist")
     files = grading.shape_files(args.shapes)
+    # the output is checked before any scoring: never an input, never a device, never an
+    # existing file without --force (app/files.py)
+    out = check_output(args.out, "--out", inputs=[exercise.path, *exercise.input_files(), *files],
+                       force=args.force)
     workers = _workers(args.workers) or grading.default_workers()
     scale = 1 if args.scale is None else _positive("--scale", args.scale)
     s = exercise.scene.scaled(scale)
@@ -119,10 +121,7 @@ def _score(exercise, args) -> int:
           f"(numpy float64, {s.nx} x {s.ny}, {s.steps} steps each)", flush=True)
     rows, wall = grading.grade(exercise, files, workers, scales=(scale,), progress=ProgressBar("shapes"))
     rows = grading.ranked(exercise, rows)
-    with atomic_path(out, suffix=".tmp") as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(grading.CSV_HEADER)
-        writer.writerows(grading.csv_rows(rows))
+    save_csv(out, grading.CSV_HEADER, grading.csv_rows(rows), "--out")
     o = exercise.objective
     print(f"\nobjective: {o.kind} (score = {o.quantity}, {o.better} is better"
           + (f"; hit within {o.tolerance:g} of {o.target:g}" if o.target is not None else "") + ")")

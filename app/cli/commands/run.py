@@ -6,7 +6,6 @@ during the last step, forces averaged over the interval. The file is written ato
 """
 from __future__ import annotations
 
-import csv
 import math
 import sys
 import time
@@ -43,19 +42,6 @@ def positive_int_option(name: str, text):
     return value
 
 
-def write_csv_atomic(path: Path, header, rows, option: str = "--out") -> Path:
-    """Write a CSV next to its destination, then rename it into place (never half a file); if
-    that fails, the rows go to a rescue file and OutputError (one line) says where."""
-    from feelflow.app.files import atomic_path, write_or_rescue
-
-    def write(target):
-        with atomic_path(target, suffix=".tmp") as tmp, open(tmp, "w", newline="") as fh:
-            writer = csv.writer(fh)
-            writer.writerow(header)
-            writer.writerows(rows)
-    return write_or_rescue(path, write, option)
-
-
 def _fmt(v: float) -> str:
     return f"{v:.10g}"
 
@@ -64,7 +50,7 @@ def main(args) -> int:
     from feelflow.app.headless import make_solver, resolve_backend
     from feelflow.app.model.scene import load_scene
 
-    from feelflow.app.files import check_output
+    from feelflow.app.files import check_output, save_csv
     from feelflow.app.inputs import check_work
     from feelflow.app.model.scene import check_path_inside
 
@@ -103,7 +89,7 @@ def main(args) -> int:
 
     csv_error = None
     try:
-        write_csv_atomic(out, header, rows)
+        save_csv(out, header, rows, "--out")
     except UserError as exc:   # the rows went to a rescue file; the session is still saved
         csv_error = exc
     if recorder is not None:
