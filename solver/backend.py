@@ -65,6 +65,8 @@ class FlowSolver(Protocol):
     name: str                # the backend's registry name
     time: int                # steps done
     speed_capped: bool       # the last body motion or inflow was reduced to config.max_speed
+    max_speed_seen: float    # the largest |u| the last physical-range check read (solver/local_guard.py)
+    max_speed_at: int | None  # the step of that check (None: no check yet)
 
     @property
     def gl_context(self) -> Any:

@@ -50,7 +50,7 @@ def test_the_local_guard_raises_the_viscosity_in_the_window_and_says_so(window, 
     ux, uy = sim.params.wind - swirl * dy / r, swirl * dx / r
     nu0 = sim.params.nu
     assert not local_guard.check(sim.config.collision, nu0, float(np.hypot(ux, uy).max())).inside
-    sim.solver.set_distributions(equilibrium(np.ones_like(ux), ux, uy))
+    sim.solver.solver.set_distributions(equilibrium(np.ones_like(ux), ux, uy))
     qtbot.waitUntil(lambda: sim.params.nu > nu0, timeout=60000)
     qtbot.waitUntil(lambda: window.statusBar().currentMessage().startswith("Viscosity raised to"), timeout=10000)
     message = window.statusBar().currentMessage()

@@ -58,7 +58,7 @@ def test_the_window_raises_the_viscosity_where_the_flow_leaves_the_region(grid):
     sim = Simulation(Params(grid=grid, size=8.0, wind=0.05, nu=0.01))
     assert sim.config.collision == "trt"
     ux, uy = _vortex(ny, nx, 0.6 * nx, 0.5 * ny, 0.2)
-    sim.solver.set_distributions(equilibrium(np.ones_like(ux), ux, uy))
+    sim.solver.solver.set_distributions(equilibrium(np.ones_like(ux), ux, uy))
     sim.advance(1)
     nu = sim.params.nu
     print(f"\n  {grid}: nu 0.01 -> {nu}; {sim.guard_note}", end="")

@@ -436,7 +436,7 @@ class Simulation:
         `guard_note` and `guard_changed` say so in one line. Returns whether it acted."""
         from feelflow.solver import local_guard
 
-        at = getattr(self.solver, "max_speed_at", None)
+        at = self.solver.max_speed_at
         if at is None or at == self._guard_read_at:
             return False
         self._guard_read_at = at

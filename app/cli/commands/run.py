@@ -149,7 +149,7 @@ def warn_outside_local_region(scene, solver, step: int) -> bool:
     from feelflow.solver import local_guard
     from feelflow.solver.operator_choice import NAMES
 
-    if getattr(solver, "max_speed_at", None) is None:
+    if solver.max_speed_at is None:
         return False
     cfg = scene.config
     verdict = local_guard.check(cfg.collision, cfg.nu, solver.max_speed_seen)
