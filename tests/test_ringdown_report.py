@@ -33,3 +33,20 @@ def test_report_ringdown_refuses_bad_input_in_one_line():
         r = subprocess.run([*CLI, "report", "ringdown", *extra], capture_output=True, text=True, cwd=ROOT)
         assert r.returncode == 2, r.stderr
         assert len(r.stderr.strip().splitlines()) == 1 and extra[1] in r.stderr
+
+
+def test_report_towed_quick_runs_held_and_towed_rows():
+    """`feelflow report towed --quick` (app/reports/towed.py): the held row and one towed row per
+    impulse scheme asked for; the absolute impulse is the noisy one (a smoke test, not physics)."""
+    r = subprocess.run([*CLI, "report", "towed", "--quick", "--impulse", "relative,absolute"], capture_output=True,
+                       text=True, cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+    rows = [line for line in r.stdout.splitlines() if line.startswith("| held") or line.startswith("| towed")]
+    assert len(rows) == 3 and "relative" in rows[1] and "absolute" in rows[2]
+
+
+def test_report_towed_refuses_bad_schemes_in_one_line():
+    for extra in (["--impulse", "smooth"], ["--refill", "magic"], ["--backend", "fast"]):
+        r = subprocess.run([*CLI, "report", "towed", "--quick", *extra], capture_output=True, text=True, cwd=ROOT)
+        assert r.returncode == 2, r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1 and extra[1] in r.stderr

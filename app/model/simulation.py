@@ -10,6 +10,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from feelflow.app.model.body_input import BodyInput
+from feelflow.app.model.body_motion import advance_with_motion, is_moving
 from feelflow.app.model.coupling import AngleSpring, SpringDamper
 from feelflow.solver import units
 from feelflow.app.sessions import SessionSolver
@@ -456,7 +457,7 @@ class Simulation:
         return (wind - self.vel[0], -self.vel[1])
 
     def advance(self, n: int):
-        """Run n steps, moving the body in chunks of at most half a cell; record a sample."""
+        """Run n steps, the body's pose advanced every step while it moves; record a sample."""
         n = max(1, int(n))
         if self.sweep is not None:
             wind = self.sweep_wind()
@@ -476,19 +477,18 @@ class Simulation:
                 self.runner = None
                 self.vel = (0.0, 0.0)
             done = n
-        while done < n:
-            speed = math.hypot(*self.vel)
-            chunk = n - done if speed < 1e-9 else max(1, min(n - done, int(0.5 / speed)))
-            self._move_body(chunk)
-            self.solver.step(chunk)   # raises solver.backend.SolverDiverged when the flow blows up
+        if done < n:   # the pose advances every step while the body moves (app/model/body_motion.py)
+            acc = advance_with_motion(self.solver, n, self._move_body, self._body_moves)
             self.capped |= bool(getattr(self.solver, "speed_capped", False))
-            for name, (fx, fy) in self.solver.forces().items():
-                ax, ay = acc.get(name, (0.0, 0.0))
-                acc[name] = (ax + fx * chunk, ay + fy * chunk)
-            done += chunk
         forces = {k: (v[0] / n, v[1] / n) for k, v in acc.items()}
         self.history.add(self.solver.time, self.vel, self.relative_wind(), forces)
         return forces
+
+    def _body_moves(self) -> bool:
+        """Whether the next step moves or turns the body (app/model/body_motion.py is_moving)."""
+        if self.hold_still:
+            return bool(self.rate) or self.vel != (0.0, 0.0)
+        return is_moving(self.vel, self.rate, self.pos, self._target, self.angle, self.angle_target)
 
     def _move_body(self, steps: int):
         old = (self.pos, self.angle)
