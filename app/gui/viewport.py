@@ -196,7 +196,7 @@ class Viewport(QWidget):
         if self.ctx is None:       # not yet shown, or no OpenGL 3.3: a cpu_field.CpuCanvas paints over it
             painter.end()
             return
-        field = self._field_image()
+        field = self.field_image()
         if field is not None:
             image, where = field
             painter.setRenderHint(QPainter.SmoothPixmapTransform)
@@ -209,7 +209,7 @@ class Viewport(QWidget):
         """What the viewport shows (the field and its overlay), for screenshots."""
         return self.grab().toImage()
 
-    def _field_image(self):
+    def field_image(self):
         """(image, where): the field coloured by display.glsl into a QImage (top row first), at
         the lattice's own size or the lattice rectangle's size in device pixels, whichever is
         smaller, read back; `where` is the rectangle (logical pixels) to draw it in. The window

@@ -14,7 +14,7 @@ from pathlib import Path
 from feelflow.app.model.body_input import BodyInput
 from feelflow.app.model.readouts import ReferenceLength
 from feelflow.app.sessions import SessionPlayer
-from feelflow.app.model.simulation import FORCE_MODELS, History, Params, field_rgba, shape_hit
+from feelflow.app.model.simulation import FORCE_MODELS, History, Params, shape_hit
 from feelflow.solver import units
 
 
@@ -149,7 +149,7 @@ class ReplaySimulation:
         return f"{NAMES.get(c, c)}: as recorded"
 
     def field_rgba(self):
-        return field_rgba(self.solver)
+        return self.solver.field_rgba()
 
     def script_phase(self):
         return None

@@ -248,7 +248,7 @@ class Simulation:
         config = self.flow_config()
         same_grid = self.solver is not None and (self.solver.config.nx, self.solver.config.ny) == (config.nx, config.ny)
         if self.solver is None:   # one SessionSolver for the life of the window (app/sessions/)
-            backend = create_solver(self.backend, config, **({"ctx": self.ctx} if self.backend == "gl" else {}))
+            backend = create_solver(self.backend, config, ctx=self.ctx)
             self.solver = SessionSolver(backend)
         else:                     # recorded as a rebuild when a session is being recorded
             self.solver.rebuild(config, keep_flow=keep_flow and same_grid)
@@ -326,7 +326,7 @@ class Simulation:
         only_wind = ((params.nu, params.wall) == (self.params.nu, self.params.wall)
                      and new.collision == self.config.collision)
         self.params = params
-        if only_wind and hasattr(self.solver, "set_inflow_speed"):
+        if only_wind:
             self.solver.set_inflow_speed(params.wind)   # live, no rebuild
         else:
             self._build(keep_flow=True)
@@ -500,7 +500,7 @@ class Simulation:
             chunk = n - done if speed < 1e-9 else max(1, min(n - done, int(0.5 / speed)))
             self._move_body(chunk)
             self.solver.step(chunk)   # raises solver.backend.SolverDiverged when the flow blows up
-            self.capped |= bool(getattr(self.solver, "speed_capped", False))
+            self.capped |= self.solver.speed_capped
             for name, (fx, fy) in self.solver.forces().items():
                 ax, ay = acc.get(name, (0.0, 0.0))
                 acc[name] = (ax + fx * chunk, ay + fy * chunk)
@@ -562,7 +562,7 @@ class Simulation:
         return self.operator_for().reason
 
     def field_rgba(self) -> np.ndarray:
-        return field_rgba(self.solver)
+        return self.solver.field_rgba()
 
 
 def shape_hit(shape, x: float, y: float, tolerance: float = 2.0) -> bool:
@@ -573,13 +573,3 @@ def shape_hit(shape, x: float, y: float, tolerance: float = 2.0) -> bool:
     px = x + np.array([0, -1, 1, 0, 0]) * tolerance
     py = y + np.array([0, 0, 0, -1, 1]) * tolerance
     return bool(np.any(shape.contains(px, py)))
-
-
-def field_rgba(solver) -> np.ndarray:
-    """(ny, nx, 4) float32: rho, ux, uy, vorticity of `solver`'s flow (numpy path; the gl
-    backend has a texture)."""
-    rho, ux, uy = solver.macroscopic()
-    out = np.empty(rho.shape + (4,), np.float32)
-    out[..., 0], out[..., 1], out[..., 2] = rho, ux, uy
-    out[..., 3] = np.gradient(uy, axis=1) - np.gradient(ux, axis=0)
-    return out
