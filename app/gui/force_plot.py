@@ -17,7 +17,8 @@ from feelflow.app.gui.polar_views import VIEWS as LIFT_VIEWS, LiftViews
 from feelflow.app.model.power_law import fit_power_law
 from feelflow.app.model import readouts
 from feelflow.app.model.readouts import start_pulse_steps
-from feelflow.app.model.simulation import FORCE_MODELS, History
+from feelflow.app.model.force_history import History
+from feelflow.app.model.simulation import FORCE_MODELS
 from feelflow.app.model.tunnel import TunnelModel
 
 MODEL_COLOURS = {"momentum_exchange": ((220, 40, 40), (40, 110, 240)),

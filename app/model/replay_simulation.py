@@ -14,7 +14,8 @@ from pathlib import Path
 from feelflow.app.model.body_input import BodyInput
 from feelflow.app.model.readouts import ReferenceLength
 from feelflow.app.sessions import SessionPlayer
-from feelflow.app.model.simulation import FORCE_MODELS, History, Params, shape_hit
+from feelflow.app.model.force_history import History
+from feelflow.app.model.simulation import FORCE_MODELS, Params, shape_hit
 from feelflow.solver import units
 
 

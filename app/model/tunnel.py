@@ -16,13 +16,15 @@ import numpy as np
 
 from feelflow.app.model.body_input import BodyInput
 from feelflow.app.model.readouts import ReferenceLength
+from feelflow.app.model.wind_sweep import WindSweep
 from feelflow.app.sessions import SessionSolver
 from feelflow.shapes.base import Shape
 from feelflow.solver.config import FlowConfig
 from feelflow.solver.motion import MotionRunner
 
 if TYPE_CHECKING:   # simulation.py defines them and implements this interface
-    from feelflow.app.model.simulation import History, Params
+    from feelflow.app.model.force_history import History
+    from feelflow.app.model.simulation import Params
 
 
 @runtime_checkable
@@ -42,7 +44,7 @@ class TunnelModel(Protocol):
     hold_still: bool     # the body ignores pulls and turns (the polygon editor, some lessons)
     polygon: list | None   # the custom polygon's vertices (body frame), or None
     capped: bool         # the Mach cap limited the body's speed in the last frame
-    sweep: tuple | None  # a lesson's wind sweep (speeds, steps each, first step), or None
+    sweep: WindSweep | None   # a lesson's wind sweep, or None
     runner: MotionRunner | None   # a motion script driving the pose, or None
 
     def advance(self, n: int) -> dict:

@@ -52,7 +52,7 @@ def run_lesson(key: str, backend: str = "numpy", plain: bool = False, make_ctx=N
         if lesson.wind_sweep:
             sim.start_sweep(lesson.wind_sweep, lesson.hold_steps)
             steps = sim.sweep_end()
-            first = sim.sweep[2]
+            first = sim.sweep.start
         else:
             steps = scene.steps
         start = time.perf_counter()

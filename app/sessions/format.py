@@ -23,12 +23,14 @@ from pathlib import Path
 
 import numpy as np
 
+from feelflow.app.sessions import versions
 from feelflow.app.sessions.bounds import MAX_FILE_BYTES, MAX_JSON_BYTES, check_npz, member_limits
 from feelflow.solver.config import ConfigError, FlowConfig
 
 FORMAT = "feelflow-session"
-#: bumped whenever a version-1 reader would misread a file (docs/reference/session-format.md, "Versioning")
-VERSION = 1
+#: the format version written; bumped whenever an older reader would misread a file, with a
+#: loader for the new version (app/sessions/versions.py; docs/reference/session-format.md, "Versioning")
+VERSION = versions.VERSION
 SUFFIX = ".ffsession"
 
 MANIFEST = "manifest.json"
@@ -73,12 +75,9 @@ class SessionError(ValueError):
 # --- the scene as the session stores it -------------------------------------------------------
 
 def config_to_dict(config: FlowConfig) -> dict:
-    """FlowConfig -> JSON-ready dict (tuples become lists; `extra` is kept if JSON-able)."""
-    d = {}
-    for f in dataclasses.fields(config):
-        v = getattr(config, f.name)
-        d[f.name] = list(v) if isinstance(v, tuple) else v
-    return d
+    """FlowConfig -> the current version's JSON-ready dict (app/sessions/versions.py's schema;
+    tuples become lists; `extra` is kept if JSON-able)."""
+    return versions.config_to_dict(config)
 
 
 def config_from_dict(d) -> FlowConfig:
@@ -376,14 +375,10 @@ def _optional_array(raw: bytes, member: str, name: str, fail):
 def _validate(manifest, parameters, inputs, forces, src, state=None, inlet_reference=None) -> Session:
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         raise SessionError(f"{MANIFEST}: not a FeelFlow session (expected \"format\": \"{FORMAT}\")")
-    version = manifest.get("version")
-    if isinstance(version, bool) or not isinstance(version, int):
-        raise SessionError(f"{MANIFEST}: version must be an integer, got {version!r}")
-    if version > VERSION:
-        raise SessionError(f"session format version {version} was written by a newer FeelFlow "
-                           f"(this one reads version {VERSION})")
-    if version != VERSION:
-        raise SessionError(f"unsupported session format version {version} (this FeelFlow reads {VERSION})")
+    try:   # one loader per format version: the file in the current version's form
+        manifest, parameters = versions.loader_for(manifest.get("version")).upgrade(manifest, parameters)
+    except versions.SessionFormatError as exc:
+        raise SessionError(f"{MANIFEST}: {exc}") from None
     for key, kind in (("feelflow_version", str), ("created", str), ("backend", str), ("renderer", str),
                       ("scene", dict), ("forces", dict), ("counts", dict)):
         if not isinstance(manifest.get(key), kind):
