@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from feelflow.app.errors import shown
 from feelflow.app.sessions import versions
 from feelflow.app.sessions.bounds import MAX_FILE_BYTES, MAX_JSON_BYTES, check_npz, member_limits
 from feelflow.solver.config import ConfigError, FlowConfig
@@ -87,7 +88,7 @@ def config_from_dict(d) -> FlowConfig:
     names = {f.name for f in dataclasses.fields(FlowConfig)}
     unknown = sorted(set(d) - names)
     if unknown:
-        raise SessionError(f"scene.config has unknown key {unknown[0]!r}")
+        raise SessionError(f"scene.config has unknown key {shown(unknown[0])!r}")
     kwargs = {}
     for key, v in d.items():
         if key in ("body_force", "initial_velocity"):
@@ -96,11 +97,19 @@ def config_from_dict(d) -> FlowConfig:
             v = (float(v[0]), float(v[1]))
         kwargs[key] = v
     try:
-        return FlowConfig(**kwargs).validate()
+        config = FlowConfig(**kwargs).validate()
     except ConfigError as exc:
         raise SessionError(f"scene.config.{exc}") from None
     except TypeError as exc:  # a missing nx/ny, or a value of the wrong type
         raise SessionError(f"scene.config: {str(exc).splitlines()[0]}") from None
+    from feelflow.app.errors import UserError
+    from feelflow.app.inputs import check_work
+
+    try:   # the scene files' grid bound (MAX_NODES), also for a recorded rebuild
+        check_work(config.nx, config.ny, 0, "scene.config", "grid")
+    except UserError as exc:
+        raise SessionError(str(exc)) from None
+    return config
 
 
 def is_number(v) -> bool:
@@ -197,25 +206,15 @@ def _fmt(v) -> str:
 # --- files ------------------------------------------------------------------------------------
 
 def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
-    """Write `data` through `feelflow.app.files.atomic_path` (temp file beside, fsync, os.replace): never
-    half a file. SessionError naming the path if it cannot (the old file is left as it was)."""
-    from feelflow.app.files import atomic_path, rescue_path
+    """Write `data` through the app's one writer (app/files.py: temp file beside, fsync,
+    os.replace; on failure a rescue copy in the temp folder). SessionError naming the path if it
+    cannot (the old file is left as it was)."""
+    from feelflow.app.files import OutputError, save_bytes
 
-    path = Path(path)
-    if path.is_dir():
-        raise SessionError(f"{path}: is a directory")
     try:
-        with atomic_path(path, suffix=".tmp") as tmp:
-            tmp.write_bytes(data)
-    except OSError as exc:
-        try:   # the work is not lost: it goes to a new file in the temp folder
-            saved = rescue_path(path)
-            saved.write_bytes(data)
-            where = f"it was saved to {saved} instead"
-        except OSError:
-            where = "no rescue copy could be written either"
-        raise SessionError(f"{path}: cannot write {what} ({exc.strerror or exc}); {where}") from None
-    return path
+        return save_bytes(path, data, what)
+    except OutputError as exc:
+        raise SessionError(str(exc)) from None
 
 
 def _npz_bytes(arrays: dict) -> bytes:
