@@ -87,6 +87,10 @@ class FlowSolver(Protocol):
         """Compute only these force models (solver/forces)."""
         ...
 
+    def add_force_model(self, model) -> None:
+        """Enable an already-built model instance too, keyed by its name (solver/forces)."""
+        ...
+
     def set_inflow_speed(self, speed: float) -> None:
         """The inlet's speed from the next step on (capped at config.max_speed)."""
         ...
