@@ -165,6 +165,11 @@ class SessionSolver:
         self._solver.enable_force_models(names)
         self.models = names
 
+    def add_force_model(self, model) -> None:
+        """Enable an already-built model instance beside them (the C_p view's wall sampling,
+        solver/forces/surface_pressure.py); not recorded: a replay computes its own."""
+        self._solver.add_force_model(model)
+
     def step(self, n: int = 1) -> None:
         n = int(n)
         if n < 1:
