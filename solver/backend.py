@@ -89,6 +89,10 @@ class FlowSolver(Protocol):
         """Compute only these force models (solver/forces)."""
         ...
 
+    def add_force_model(self, model) -> None:
+        """Enable an already-built model instance too, keyed by its name (solver/forces)."""
+        ...
+
     def set_inflow_speed(self, speed: float) -> None:
         """The inlet's speed from the next step on (capped at config.max_speed)."""
         ...
@@ -150,6 +154,9 @@ class Solver(ABC):
         self.body = None      # solver.body.BodyState of the body, or None
         self._models = {}     # enabled force models by name
         self._forces: dict[str, tuple[float, float]] = {}  # their means over the last step(n)
+        from feelflow.solver.body import DEFAULT_IMPULSE, DEFAULT_REFILL
+
+        self.body_refill, self.body_impulse = DEFAULT_REFILL, DEFAULT_IMPULSE   # set_body_schemes
 
     @property
     def gl_context(self):
@@ -171,6 +178,16 @@ class Solver(ABC):
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
         """Place the body (a `shapes` shape at its pose, or None) moving at `velocity`,
         rotating at `omega`; covers/uncovers nodes and books their momentum (algorithm.md)."""
+
+    def set_body_schemes(self, refill: str | None = None, impulse: str | None = None) -> None:
+        """How a moving body refills the nodes it uncovers and books the momentum of the nodes it
+        covers and uncovers (solver/body.py REFILL_SCHEMES, IMPULSE_SCHEMES); None keeps one."""
+        from feelflow.solver.body import check_schemes
+
+        refill = self.body_refill if refill is None else refill
+        impulse = self.body_impulse if impulse is None else impulse
+        check_schemes(refill, impulse)
+        self.body_refill, self.body_impulse = refill, impulse
 
     def _body_state(self, shape, velocity, omega, raster=None):
         """The rasterised, speed-capped body state for `set_body` (None without a body), with a

@@ -11,6 +11,7 @@ import numpy as np
 
 from feelflow.app.model import readouts
 from feelflow.app.model.body_input import BodyInput
+from feelflow.app.model.body_motion import advance_with_motion, is_moving
 from feelflow.app.model.force_history import History
 from feelflow.app.model.wind_sweep import SLEW_STEPS, WindSweep
 from feelflow.app.model.coupling import AngleSpring, SpringDamper
@@ -149,6 +150,8 @@ class Simulation:
         self.params, self.guard_note = stable_params(self.params, self.guard_operator)
         self._guard_read_at = None   # solver step of the last max |u| the local guard read
         self.guard_changed = False   # the local guard changed the flow (the window shows guard_note)
+        self.polar = None            # app/model/live_polar.LivePolar: an angle-of-attack sweep
+        self.surface_watch = None    # app/model/live_polar.SurfacePressureWatch: C_p along the surface
         self.capped = False          # the Mach cap limited the body's speed in the last frame
         #: the coefficients' reference length when it is not the body's size (an exercise's)
         self.reference_override: readouts.ReferenceLength | None = None
@@ -234,6 +237,32 @@ class Simulation:
     def _enable_models(self):
         names = list(FORCE_MODELS) if self.params.compare_all else [self.params.force_model]
         self.solver.enable_force_models(names)
+        for probe in self._probes():
+            self.solver.add_force_model(probe)
+
+    def _probes(self):
+        """The surface-pressure probes switched on (the C_p view, the polar), beside the force models."""
+        watch = self.polar or self.surface_watch   # one probe: the polar's serves the C_p view too
+        return [] if watch is None else [watch.probe]
+
+    def watch_surface_pressure(self, on: bool = True):
+        """Switch the pressure model's wall sampling on for C_p along the surface (the C_p view)."""
+        if on and self.surface_watch is None:
+            from feelflow.app.model.live_polar import SurfacePressureWatch
+
+            self.surface_watch = SurfacePressureWatch()
+        elif not on:
+            self.surface_watch = None
+        self._enable_models()
+
+    def start_polar(self, angles, sample_steps: int = 25, **settling):
+        """An angle-of-attack sweep (app/model/live_polar.py): the body held still at each angle
+        of `angles` (degrees, nose up positive) until its forces settle, then the next."""
+        from feelflow.app.model.live_polar import LivePolar
+
+        self.polar = LivePolar(self, angles, sample_steps=sample_steps, **settling)
+        self._enable_models()
+        self.polar.start(self)
 
     # --- what the panel changes ------------------------------------------------------------
     def set_shape(self, kind=None, size=None, angle_deg=None, polygon=None):
@@ -280,7 +309,7 @@ class Simulation:
     def reset_flow(self):
         """The flow from its initial state again (time 0), body where it was, at rest; history cleared."""
         self.solver.reset()
-        self.runner = self.sweep = None
+        self.runner = self.sweep = self.polar = None
         self.vel, self.rate, self._target = (0.0, 0.0), 0.0, None
         self.angle_target = self.angle
         self.shape = self.shape.moved(*self.pos, self.angle)
@@ -335,7 +364,7 @@ class Simulation:
         self.params, self.guard_note = stable_params(self.params, self.guard_operator)
         self.polygon = verts
         self.runner = None
-        self.sweep = None
+        self.sweep = self.polar = None
         self._build(keep_flow=False)
         self.pos = (scene.body.x, scene.body.y)
         self.shape = self.shape.moved(*self.pos, self.angle)
@@ -394,7 +423,7 @@ class Simulation:
         return (wind - self.vel[0], -self.vel[1])
 
     def advance(self, n: int):
-        """Run n steps, moving the body in chunks of at most half a cell; record a sample."""
+        """Run n steps, the body's pose advanced every step while it moves; record a sample."""
         n = max(1, int(n))
         if self.sweep is not None:
             wind = self.sweep.wind(self.solver.time)
@@ -414,17 +443,14 @@ class Simulation:
                 self.runner = None
                 self.vel = (0.0, 0.0)
             done = n
-        while done < n:
-            speed = math.hypot(*self.vel)
-            chunk = n - done if speed < 1e-9 else max(1, min(n - done, int(0.5 / speed)))
-            self._move_body(chunk)
-            self.solver.step(chunk)   # raises solver.backend.SolverDiverged when the flow blows up
+        if done < n:   # the pose advances every step while the body moves (app/model/body_motion.py)
+            acc = advance_with_motion(self.solver, n, self._move_body, self._body_moves)
             self.capped |= self.solver.speed_capped
-            for name, (fx, fy) in self.solver.forces().items():
-                ax, ay = acc.get(name, (0.0, 0.0))
-                acc[name] = (ax + fx * chunk, ay + fy * chunk)
-            done += chunk
         forces = {k: (v[0] / n, v[1] / n) for k, v in acc.items()}
+        for probe in self._probes():   # a probe's force is the pressure model's: not a model of its own
+            forces.pop(probe.name, None)
+        if self.polar is not None:
+            self.polar.after_advance(self, forces, n)
         self.history.add(self.solver.time, self.vel, self.relative_wind(), forces)
         self.apply_local_guard()
         return forces
@@ -460,6 +486,12 @@ class Simulation:
         self.guard_note = verdict.line(label, nu_set=self.params.nu)
         self.guard_changed = True
         return True
+
+    def _body_moves(self) -> bool:
+        """Whether the next step moves or turns the body (app/model/body_motion.py is_moving)."""
+        if self.hold_still:
+            return bool(self.rate) or self.vel != (0.0, 0.0)
+        return is_moving(self.vel, self.rate, self.pos, self._target, self.angle, self.angle_target)
 
     def _move_body(self, steps: int):
         old = (self.pos, self.angle)
