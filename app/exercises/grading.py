@@ -141,7 +141,8 @@ def grade(exercise, paths, workers: int | None = None, scales=(1,), progress=Non
 
 
 def ranked(exercise, rows: list[Row]) -> list[Row]:
-    """Best first (scoring.rank_key); not settled, broken and invalid last; ties by file name."""
+    """Best first (by score, in the objective's direction); not settled, broken and invalid last;
+    ties by file name."""
     order = {scoring.SCORED: 0, scoring.NOT_SETTLED: 1, BREAKS: 2, INVALID: 3}
 
     def key(r: Row):

@@ -11,6 +11,7 @@ import numpy as np
 
 from feelflow.app.model import readouts
 from feelflow.app.model.body_input import BodyInput
+from feelflow.app.model.body_motion import advance_with_motion, is_moving
 from feelflow.app.model.force_history import History
 from feelflow.app.model.wind_sweep import SLEW_STEPS, WindSweep
 from feelflow.app.model.coupling import AngleSpring, SpringDamper
@@ -147,13 +148,17 @@ class Simulation:
         # the collision operator: a given base configuration names it; else chosen per flow
         self.operator_named = None if base_config is None else base_config.collision
         self.params, self.guard_note = stable_params(self.params, self.guard_operator)
+        self._guard_read_at = None   # solver step of the last max |u| the local guard read
+        self.guard_changed = False   # the local guard changed the flow (the window shows guard_note)
+        self.polar = None            # app/model/live_polar.LivePolar: an angle-of-attack sweep
+        self.surface_watch = None    # app/model/live_polar.SurfacePressureWatch: C_p along the surface
         self.capped = False          # the Mach cap limited the body's speed in the last frame
         #: the coefficients' reference length when it is not the body's size (an exercise's)
         self.reference_override: readouts.ReferenceLength | None = None
         self.config = self.flow_config()
         # one SessionSolver for the life of the window (app/sessions/): rebuilt, never replaced
         self.solver = SessionSolver(create_solver(self.backend, self.config, ctx=ctx))
-        self.coupling = SpringDamper(max_speed=self.config.max_speed)
+        self.coupling = SpringDamper(max_speed=self.config.max_speed, stream=self._stream(self.config))
         # the body's pose: reference point (cells), velocity (cells per step), angle and its rate
         self.pos, self.vel = self.start_position(self.config), (0.0, 0.0)
         self.angle, self.rate = math.radians(self.params.angle_deg), 0.0
@@ -210,7 +215,7 @@ class Simulation:
         if self.runner is not None and not keep_flow:
             self.runner = None
         self.config = config
-        self.coupling = SpringDamper(max_speed=config.max_speed)
+        self.coupling = SpringDamper(max_speed=config.max_speed, stream=self._stream(config))
         if not keep_flow:
             self.shape = self.make_shape(self.params, self.polygon, *self.pos, self.angle).validate(config.nx, config.ny)
         self._place_body()
@@ -221,9 +226,43 @@ class Simulation:
         self._enable_models()
         self.solver.set_body(self.shape, self.vel, 0.0)
 
+    @staticmethod
+    def _stream(config: FlowConfig, wind: float | None = None) -> tuple[float, float]:
+        """The wind the body's speed is capped relative to (app/model/coupling.py): the inflow in
+        the tunnel, none in a periodic box."""
+        if config.x_boundary != "tunnel":
+            return (0.0, 0.0)
+        return (float(config.inflow_speed if wind is None else wind), 0.0)
+
     def _enable_models(self):
         names = list(FORCE_MODELS) if self.params.compare_all else [self.params.force_model]
         self.solver.enable_force_models(names)
+        for probe in self._probes():
+            self.solver.add_force_model(probe)
+
+    def _probes(self):
+        """The surface-pressure probes switched on (the C_p view, the polar), beside the force models."""
+        watch = self.polar or self.surface_watch   # one probe: the polar's serves the C_p view too
+        return [] if watch is None else [watch.probe]
+
+    def watch_surface_pressure(self, on: bool = True):
+        """Switch the pressure model's wall sampling on for C_p along the surface (the C_p view)."""
+        if on and self.surface_watch is None:
+            from feelflow.app.model.live_polar import SurfacePressureWatch
+
+            self.surface_watch = SurfacePressureWatch()
+        elif not on:
+            self.surface_watch = None
+        self._enable_models()
+
+    def start_polar(self, angles, sample_steps: int = 25, **settling):
+        """An angle-of-attack sweep (app/model/live_polar.py): the body held still at each angle
+        of `angles` (degrees, nose up positive) until its forces settle, then the next."""
+        from feelflow.app.model.live_polar import LivePolar
+
+        self.polar = LivePolar(self, angles, sample_steps=sample_steps, **settling)
+        self._enable_models()
+        self.polar.start(self)
 
     # --- what the panel changes ------------------------------------------------------------
     def set_shape(self, kind=None, size=None, angle_deg=None, polygon=None):
@@ -254,6 +293,7 @@ class Simulation:
         self.params = params
         if only_wind:
             self.solver.set_inflow_speed(params.wind)   # live, no rebuild
+            self.coupling.stream = self._stream(self.config, params.wind)
         else:
             self._build(keep_flow=True)
 
@@ -269,7 +309,7 @@ class Simulation:
     def reset_flow(self):
         """The flow from its initial state again (time 0), body where it was, at rest; history cleared."""
         self.solver.reset()
-        self.runner = self.sweep = None
+        self.runner = self.sweep = self.polar = None
         self.vel, self.rate, self._target = (0.0, 0.0), 0.0, None
         self.angle_target = self.angle
         self.shape = self.shape.moved(*self.pos, self.angle)
@@ -324,7 +364,7 @@ class Simulation:
         self.params, self.guard_note = stable_params(self.params, self.guard_operator)
         self.polygon = verts
         self.runner = None
-        self.sweep = None
+        self.sweep = self.polar = None
         self._build(keep_flow=False)
         self.pos = (scene.body.x, scene.body.y)
         self.shape = self.shape.moved(*self.pos, self.angle)
@@ -383,7 +423,7 @@ class Simulation:
         return (wind - self.vel[0], -self.vel[1])
 
     def advance(self, n: int):
-        """Run n steps, moving the body in chunks of at most half a cell; record a sample."""
+        """Run n steps, the body's pose advanced every step while it moves; record a sample."""
         n = max(1, int(n))
         if self.sweep is not None:
             wind = self.sweep.wind(self.solver.time)
@@ -403,19 +443,55 @@ class Simulation:
                 self.runner = None
                 self.vel = (0.0, 0.0)
             done = n
-        while done < n:
-            speed = math.hypot(*self.vel)
-            chunk = n - done if speed < 1e-9 else max(1, min(n - done, int(0.5 / speed)))
-            self._move_body(chunk)
-            self.solver.step(chunk)   # raises solver.backend.SolverDiverged when the flow blows up
+        if done < n:   # the pose advances every step while the body moves (app/model/body_motion.py)
+            acc = advance_with_motion(self.solver, n, self._move_body, self._body_moves)
             self.capped |= self.solver.speed_capped
-            for name, (fx, fy) in self.solver.forces().items():
-                ax, ay = acc.get(name, (0.0, 0.0))
-                acc[name] = (ax + fx * chunk, ay + fy * chunk)
-            done += chunk
         forces = {k: (v[0] / n, v[1] / n) for k, v in acc.items()}
+        for probe in self._probes():   # a probe's force is the pressure model's: not a model of its own
+            forces.pop(probe.name, None)
+        if self.polar is not None:
+            self.polar.after_advance(self, forces, n)
         self.history.add(self.solver.time, self.vel, self.relative_wind(), forces)
+        self.apply_local_guard()
         return forces
+
+    def apply_local_guard(self) -> bool:
+        """The local stability guard (solver/local_guard.py): when the last physical-range check
+        found the fastest node outside the running operator's stable region, raise the viscosity
+        to the one that brings it back (for the operator that viscosity gets), keeping the flow;
+        `guard_note` and `guard_changed` say so in one line. Returns whether it acted."""
+        from feelflow.solver import local_guard
+
+        at = self.solver.max_speed_at
+        if at is None or at == self._guard_read_at:
+            return False
+        self._guard_read_at = at
+        verdict = local_guard.check(self.config.collision, self.params.nu, self.solver.max_speed_seen)
+        if verdict.inside:
+            return False
+        if verdict.nu_needed is None:
+            self.guard_note = verdict.line(self.operator_for().label)
+            self.guard_changed = True
+            return True
+        nu = verdict.nu_needed
+        for _ in range(3):   # the chooser may pick another operator at the new viscosity: its region counts
+            op = self.operator_for(replace(self.params, nu=nu)).collision
+            again = local_guard.check(op, nu, verdict.max_speed).nu_needed
+            if again is None or again <= nu:
+                break
+            nu = again
+        nu = math.ceil(nu * 1e4 - 1e-6) / 1e4
+        label = self.operator_for().label
+        self.set_flow(nu=nu)
+        self.guard_note = verdict.line(label, nu_set=self.params.nu)
+        self.guard_changed = True
+        return True
+
+    def _body_moves(self) -> bool:
+        """Whether the next step moves or turns the body (app/model/body_motion.py is_moving)."""
+        if self.hold_still:
+            return bool(self.rate) or self.vel != (0.0, 0.0)
+        return is_moving(self.vel, self.rate, self.pos, self._target, self.angle, self.angle_target)
 
     def _move_body(self, steps: int):
         old = (self.pos, self.angle)
