@@ -148,6 +148,8 @@ class Simulation:
         # the collision operator: a given base configuration names it; else chosen per flow
         self.operator_named = None if base_config is None else base_config.collision
         self.params, self.guard_note = stable_params(self.params, self.guard_operator)
+        self._guard_read_at = None   # solver step of the last max |u| the local guard read
+        self.guard_changed = False   # the local guard changed the flow (the window shows guard_note)
         self.polar = None            # app/model/live_polar.LivePolar: an angle-of-attack sweep
         self.surface_watch = None    # app/model/live_polar.SurfacePressureWatch: C_p along the surface
         self.capped = False          # the Mach cap limited the body's speed in the last frame
@@ -156,7 +158,7 @@ class Simulation:
         self.config = self.flow_config()
         # one SessionSolver for the life of the window (app/sessions/): rebuilt, never replaced
         self.solver = SessionSolver(create_solver(self.backend, self.config, ctx=ctx))
-        self.coupling = SpringDamper(max_speed=self.config.max_speed)
+        self.coupling = SpringDamper(max_speed=self.config.max_speed, stream=self._stream(self.config))
         # the body's pose: reference point (cells), velocity (cells per step), angle and its rate
         self.pos, self.vel = self.start_position(self.config), (0.0, 0.0)
         self.angle, self.rate = math.radians(self.params.angle_deg), 0.0
@@ -213,7 +215,7 @@ class Simulation:
         if self.runner is not None and not keep_flow:
             self.runner = None
         self.config = config
-        self.coupling = SpringDamper(max_speed=config.max_speed)
+        self.coupling = SpringDamper(max_speed=config.max_speed, stream=self._stream(config))
         if not keep_flow:
             self.shape = self.make_shape(self.params, self.polygon, *self.pos, self.angle).validate(config.nx, config.ny)
         self._place_body()
@@ -223,6 +225,14 @@ class Simulation:
         self._clamp_pose()
         self._enable_models()
         self.solver.set_body(self.shape, self.vel, 0.0)
+
+    @staticmethod
+    def _stream(config: FlowConfig, wind: float | None = None) -> tuple[float, float]:
+        """The wind the body's speed is capped relative to (app/model/coupling.py): the inflow in
+        the tunnel, none in a periodic box."""
+        if config.x_boundary != "tunnel":
+            return (0.0, 0.0)
+        return (float(config.inflow_speed if wind is None else wind), 0.0)
 
     def _enable_models(self):
         names = list(FORCE_MODELS) if self.params.compare_all else [self.params.force_model]
@@ -283,6 +293,7 @@ class Simulation:
         self.params = params
         if only_wind:
             self.solver.set_inflow_speed(params.wind)   # live, no rebuild
+            self.coupling.stream = self._stream(self.config, params.wind)
         else:
             self._build(keep_flow=True)
 
@@ -441,7 +452,40 @@ class Simulation:
         if self.polar is not None:
             self.polar.after_advance(self, forces, n)
         self.history.add(self.solver.time, self.vel, self.relative_wind(), forces)
+        self.apply_local_guard()
         return forces
+
+    def apply_local_guard(self) -> bool:
+        """The local stability guard (solver/local_guard.py): when the last physical-range check
+        found the fastest node outside the running operator's stable region, raise the viscosity
+        to the one that brings it back (for the operator that viscosity gets), keeping the flow;
+        `guard_note` and `guard_changed` say so in one line. Returns whether it acted."""
+        from feelflow.solver import local_guard
+
+        at = self.solver.max_speed_at
+        if at is None or at == self._guard_read_at:
+            return False
+        self._guard_read_at = at
+        verdict = local_guard.check(self.config.collision, self.params.nu, self.solver.max_speed_seen)
+        if verdict.inside:
+            return False
+        if verdict.nu_needed is None:
+            self.guard_note = verdict.line(self.operator_for().label)
+            self.guard_changed = True
+            return True
+        nu = verdict.nu_needed
+        for _ in range(3):   # the chooser may pick another operator at the new viscosity: its region counts
+            op = self.operator_for(replace(self.params, nu=nu)).collision
+            again = local_guard.check(op, nu, verdict.max_speed).nu_needed
+            if again is None or again <= nu:
+                break
+            nu = again
+        nu = math.ceil(nu * 1e4 - 1e-6) / 1e4
+        label = self.operator_for().label
+        self.set_flow(nu=nu)
+        self.guard_note = verdict.line(label, nu_set=self.params.nu)
+        self.guard_changed = True
+        return True
 
     def _body_moves(self) -> bool:
         """Whether the next step moves or turns the body (app/model/body_motion.py is_moving)."""

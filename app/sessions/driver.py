@@ -88,6 +88,14 @@ class SessionSolver:
         return self._solver.speed_capped
 
     @property
+    def max_speed_seen(self) -> float:
+        return self._solver.max_speed_seen
+
+    @property
+    def max_speed_at(self) -> int | None:
+        return self._solver.max_speed_at
+
+    @property
     def gl_context(self):
         return self._solver.gl_context
 
