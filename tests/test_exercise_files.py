@@ -92,6 +92,8 @@ def test_score_refuses_devices_pipes_folders_and_missing_folders(exercise, capsy
 
 
 def test_score_with_force_replaces_the_results_atomically(exercise, capsys):
+    edited(exercise, "steps = 1500", "steps = 100")   # a short run: this test is about the file
+    edited(exercise, "average_steps = 500", "average_steps = 50")
     results = exercise.parent / "results.csv"
     results.write_text("old\n")
     before = digest(exercise.parent / "shapes")
