@@ -14,6 +14,7 @@ from pathlib import Path
 
 from feelflow.shapes.base import Shape, ShapeError
 from feelflow.shapes.cylinder import Cylinder
+from feelflow.shapes.naca import NacaAirfoil
 from feelflow.shapes.polygon import FlatPlate, HalfAirfoil, Polygon, Wedge
 
 #: kind -> (class, required parameter keys, optional keys with defaults)
@@ -23,6 +24,7 @@ KINDS: dict[str, tuple[type, tuple[str, ...], dict]] = {
     "plate": (FlatPlate, ("length", "thickness"), {}),
     "wedge": (Wedge, ("length", "apex_angle"), {"pointing": "upstream"}),
     "half_airfoil": (HalfAirfoil, ("chord", "thickness"), {}),
+    "naca": (NacaAirfoil, ("chord", "thickness"), {"camber": 0.0, "camber_position": 0.4}),
 }
 POSE = {"x": 0.0, "y": 0.0, "angle": 0.0}
 FILE_FORMAT = "feelflow-shape"

@@ -99,9 +99,9 @@ def test_examples_in_docs_parse():
     text = (Path(__file__).resolve().parents[1] / "docs" / "reference" / "shapes.md").read_text()
     blocks = [b.split("```", 1)[0] for b in text.split("```json\n")[1:]]
     one_line = [ln for ln in blocks[0].splitlines() if ln.strip()]
-    assert len(one_line) == 5
+    assert len(one_line) == 6
     assert {from_dict(json.loads(ln)).kind for ln in one_line} == {
-        "cylinder", "plate", "wedge", "half_airfoil", "polygon"}
+        "cylinder", "plate", "wedge", "half_airfoil", "polygon", "naca"}
     doc = json.loads(blocks[1])
     assert doc["format"] == "feelflow-shape" and from_dict(doc["shape"]).kind == "half_airfoil"
 

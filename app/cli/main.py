@@ -22,6 +22,7 @@ COMMANDS = {
     "report": "reports: the seed's experiments (Markdown), how steady the lessons and example scenes are",
     "session": "inspect, replay or export a recorded session file",
     "exercise": "shape-editing exercises: score a class's shapes, check an exercise file",
+    "polar": "an angle-of-attack sweep: C_L and C_D against alpha (CSV and image), C_p along the surface",
 }
 
 

@@ -26,7 +26,7 @@ OBJECTIVES = {
     "target_cl": ("|C_L - target|", "lower"),
 }
 #: shape kinds a student may edit (shapes/io.py KINDS)
-EDIT_KINDS = ("polygon", "cylinder", "plate", "wedge", "half_airfoil")
+EDIT_KINDS = ("polygon", "cylinder", "plate", "wedge", "half_airfoil", "naca")
 WALLS = ("free_slip", "no_slip")
 DOC = "docs/reference/exercise-format.md"
 

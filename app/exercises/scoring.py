@@ -4,7 +4,7 @@ the objective's score.
 
 Averaging (docs/reference/exercise-format.md, [scene]): the force coefficients
 C_D = 2 F_x / (rho_0 U^2 L), C_L = 2 F_y / (rho_0 U^2 L) (L = scene.reference_length, U the
-inflow speed, solver/units.py) are sampled as means over `sample_interval` steps; the score uses
+inflow speed; app/model/readouts.py, the definition the window shows) are sampled as means over `sample_interval` steps; the score uses
 the last `average_steps` steps of the run (the window).
 - Steady flow: the mean over the window; *settled* when the means of the window's two halves
   differ by at most `settle_tolerance` |C_D| in C_D and in C_L.
@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from feelflow.solver import units
+from feelflow.app.model import readouts
 
 FORCE_MODEL = "momentum_exchange"
 #: solvers a score may be computed with, both float64: numpy (the reference, what the window
@@ -156,6 +156,7 @@ def score_shape(exercise, shape, scale: int = 1, progress=None, cancelled=None, 
         solver.enable_force_models([FORCE_MODEL])
         solver.set_body(body)
         n = s.steps // s.sample_interval
+        reference = readouts.ReferenceLength(s.reference_length, readouts.EXERCISE_LENGTH)
         with np.errstate(all="ignore"):
             for k in range(n):
                 if cancelled is not None and cancelled():
@@ -169,8 +170,9 @@ def score_shape(exercise, shape, scale: int = 1, progress=None, cancelled=None, 
                 if not (math.isfinite(fx) and math.isfinite(fy)):
                     return Result(NOT_SETTLED, steps=solver.time, seconds=time.perf_counter() - start,
                                   reason="the flow diverged (NaN)", scale=scale)
-                cd.append(units.force_coefficient(fx, s.inflow_speed, s.reference_length))
-                cl.append(units.force_coefficient(fy, s.inflow_speed, s.reference_length))
+                c_d, c_l = readouts.coefficients(fx, fy, s.inflow_speed, reference, min_speed=0.0)   # flow along +x
+                cd.append(c_d)
+                cl.append(c_l)
                 if progress is not None:
                     progress((k + 1) / n)
     finally:

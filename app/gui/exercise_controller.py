@@ -20,6 +20,8 @@ from feelflow.app.errors import UserError
 from feelflow.app.exercises import scoring
 from feelflow.app.exercises.uncertainty import better_by, fmt, tied
 from feelflow.app.gui.exercise_panel import PARAMETERS, PANEL_WIDTH, ExercisePanel, ScrollingPanel
+from feelflow.app.model import readouts
+from feelflow.app.model.readouts import EXERCISE_LENGTH, ReferenceLength
 from feelflow.shapes.base import ShapeError
 
 BROKEN_EDGE = QColor(230, 40, 40)
@@ -73,6 +75,7 @@ class ExerciseController(QObject):
         self.timer = QTimer(self)
         self.timer.setInterval(CHECK_INTERVAL_MS)
         self.timer.timeout.connect(self.refresh_constraints)
+        self.timer.timeout.connect(self.refresh_live)
 
     # --- menus -------------------------------------------------------------------------------
     def build_menu(self, bar, presets_menu=None):
@@ -155,6 +158,8 @@ class ExerciseController(QObject):
             w.flow.refuse_dialog("This exercise cannot be opened", exc)
             return False
         self.exercise = exercise
+        # the live readouts use the length the score uses (app/model/readouts.py)
+        w.sim.reference_override = ReferenceLength(s.reference_length, EXERCISE_LENGTH)
         w.undo.clear()
         w.bodies.set_hold_still(True)
         self._ensure_panel()
@@ -244,6 +249,8 @@ class ExerciseController(QObject):
             self.cancel()
         self.timer.stop()
         self.exercise = None
+        if self.window.sim is not None:
+            self.window.sim.reference_override = None
         self.window.viewport.body_edge = None
         if self.dock is not None:
             self.dock.hide()
@@ -319,6 +326,13 @@ class ExerciseController(QObject):
             self.window.viewport.body_edge = edge
             self.window.viewport.update()
 
+    def refresh_live(self):
+        """The panel's line of the live tunnel's coefficients, as the plot shows them."""
+        sim = self.window.sim
+        if self.exercise is None or self.panel is None or sim is None:
+            return
+        self.panel.show_live(readouts.readout(sim.history, sim.params.force_model, sim.reference_length()))
+
     # --- scoring -------------------------------------------------------------------------------
     def score(self, _=False) -> bool:
         """Score the current shape in a worker thread; refused (with the reasons) while a
@@ -360,8 +374,11 @@ class ExerciseController(QObject):
         if result.ok:
             o = ex.objective
             u = o.uncertainty
+            s = ex.scene
             lines = [f"<b>Score {fmt(result.score, u, with_uncertainty=True)}</b> ({o.quantity}; "
-                     f"C_D {fmt(result.cd, u)}, C_L {fmt(result.cl, u)}; {result.steps} steps, {result.seconds:.1f} s)"]
+                     f"C_D {fmt(result.cd, u)}, C_L {fmt(result.cl, u)} "
+                     f"with L = {s.reference_length:g} cells ({EXERCISE_LENGTH}), U = {s.inflow_speed:.3f}; "
+                     f"{result.steps} steps, {result.seconds:.1f} s)"]
             if result.hit is not None:
                 lines.append("A hit: within the tolerance." if result.hit else "Not a hit yet: outside the tolerance.")
             for ref in ex.references:

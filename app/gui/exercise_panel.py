@@ -14,6 +14,7 @@ from PySide6.QtWidgets import (QComboBox, QDoubleSpinBox, QFormLayout, QGroupBox
                                QVBoxLayout, QWidget)
 
 from feelflow.app.exercises.uncertainty import fmt, tied
+from feelflow.app.model import readouts
 
 #: parametric kinds: parameter -> (label, minimum, maximum, step); angles in degrees
 PARAMETERS = {
@@ -21,6 +22,8 @@ PARAMETERS = {
     "plate": {"length": ("Length (cells)", 2.0, 60.0, 0.5), "thickness": ("Thickness (cells)", 0.5, 20.0, 0.5)},
     "wedge": {"length": ("Length (cells)", 2.0, 60.0, 0.5), "apex_angle": ("Apex angle (degrees)", 5.0, 170.0, 1.0)},
     "half_airfoil": {"chord": ("Chord (cells)", 4.0, 60.0, 0.5), "thickness": ("Thickness (cells)", 0.5, 20.0, 0.25)},
+    "naca": {"chord": ("Chord (cells)", 8.0, 120.0, 1.0), "thickness": ("Thickness (x chord)", 0.04, 0.3, 0.01),
+             "camber": ("Camber (x chord)", 0.0, 0.09, 0.01), "camber_position": ("Camber at (x chord)", 0.1, 0.9, 0.1)},
 }
 THUMB = QSize(72, 44)
 #: the panel's width in the window (logical pixels): the goal, references and attempts lines wrap to it
@@ -174,6 +177,11 @@ class ExercisePanel(QWidget):
         self.result.setWordWrap(True)
         self.result.setTextFormat(Qt.RichText)
         layout.addWidget(self.result)
+        #: the live tunnel's coefficients, as the force plot shows them (same reference length)
+        self.live = QLabel()
+        self.live.setWordWrap(True)
+        self.live.setTextFormat(Qt.RichText)
+        layout.addWidget(self.live)
 
         self.attempts_label = QLabel("Attempts")
         self.attempts_label.setWordWrap(True)
@@ -254,6 +262,12 @@ class ExercisePanel(QWidget):
         if kind == "wedge":
             d["pointing"] = self.pointing.currentData()
         return d
+
+    def show_live(self, readout):
+        """The live tunnel's C_D and C_L (an app.model.readouts.Readout) with their reference."""
+        fmt = readouts.format_coefficient
+        self.live.setText(f"In the tunnel now: C<sub>D</sub> {fmt(readout.cd)}, C<sub>L</sub> {fmt(readout.cl)} "
+                          f"<small>({readout.reference_text()}; the window's flow, float32)</small>")
 
     def set_problems(self, problems: list[str]):
         if problems:

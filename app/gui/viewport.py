@@ -71,7 +71,7 @@ class Viewport(QWidget):
         self.show_arrows = True
         self.editing = False
         self.body_edge = None    # a QColor for the body's outline instead of the usual, or None
-        self.arrow_forces = None       # {"drag": (fx, fy), "lift": (fx, fy)} lattice units
+        self.arrow_forces = None       # {"drag": (x, y), "lift": (x, y)} cells (app/model/readouts.py arrows)
         self.tracers = None
         self.frames = 0
         self.field_texture = None

@@ -12,6 +12,7 @@ import math
 from pathlib import Path
 
 from feelflow.app.model.body_input import BodyInput
+from feelflow.app.model.readouts import ReferenceLength
 from feelflow.app.sessions import SessionPlayer
 from feelflow.app.model.simulation import FORCE_MODELS, History, Params, field_rgba, shape_hit
 from feelflow.solver import units
@@ -128,6 +129,10 @@ class ReplaySimulation:
     def relative_wind(self):
         vx, vy = self.player.velocity
         return (self.player.inflow_speed - vx, -vy)
+
+    def reference_length(self) -> ReferenceLength:
+        """The body's size, the coefficients' reference length (app/model/readouts.py)."""
+        return ReferenceLength(self.params.size)
 
     def reynolds(self) -> float:
         p = self.params

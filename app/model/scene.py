@@ -294,6 +294,8 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
 
 #: shape parameters that are angles: radians in `shapes`, degrees in scene files
 ANGLE_KEYS = ("angle", "apex_angle")
+#: body parameters that may be zero (a NACA section without camber)
+NONNEGATIVE_KEYS = ("camber",)
 
 
 def _body(reader: _Reader, table: _Table, nx: int, ny: int):
@@ -316,6 +318,8 @@ def _body(reader: _Reader, table: _Table, nx: int, ny: int):
             description[key] = table.choice(key, _string_choices(kind, key), optional[key])
         elif key in ANGLE_KEYS:
             description[key] = math.radians(table.number(key, optional.get(key, MISSING), positive=True))
+        elif key in NONNEGATIVE_KEYS:
+            description[key] = table.number(key, optional.get(key, MISSING), nonnegative=True)
         else:
             description[key] = table.number(key, optional.get(key, MISSING), positive=True)
     table.done()

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from feelflow.app.model import readouts
 from feelflow.app.model.body_input import BodyInput
 from feelflow.app.model.coupling import AngleSpring, SpringDamper
 from feelflow.solver import units
@@ -134,27 +135,15 @@ class History:
         return len(self.time)
 
     def drag_lift(self, model: str):
-        """(t, drag, lift) arrays: force along and across the relative wind (NaN where absent)."""
+        """(t, drag, lift) arrays: force along and across the relative wind (NaN where absent;
+        app/model/readouts.py decomposes)."""
         n = len(self.time)
         series = self.forces.get(model, [])
         f = np.full((n, 2), np.nan)
         if series:
             f[n - len(series):] = np.asarray(series[-n:], float)
-        w = np.asarray(self.wind, float).reshape(n, 2)
-        along = drag_direction(w)
-        drag = (f * along).sum(axis=1)
-        lift = f[:, 1] * along[:, 0] - f[:, 0] * along[:, 1]
+        drag, lift = readouts.drag_lift(f, np.asarray(self.wind, float).reshape(n, 2))
         return np.asarray(self.time, float), drag, lift
-
-
-def drag_direction(wind):
-    """Unit vectors along the relative wind (+x where the relative wind is ~0)."""
-    w = np.atleast_2d(np.asarray(wind, float))
-    s = np.hypot(w[:, 0], w[:, 1])
-    out = np.tile([1.0, 0.0], (len(w), 1))
-    ok = s > 1e-9
-    out[ok] = w[ok] / s[ok, None]
-    return out
 
 
 def wrap_degrees(degrees: float) -> float:
@@ -223,6 +212,8 @@ class Simulation:
         self.sweep = None            # (wind speeds, steps each, first step): a wind-speed sweep
         self.sweep_slew_steps = self.SWEEP_SLEW_STEPS
         self.capped = False          # the Mach cap limited the body's speed in the last frame
+        #: the coefficients' reference length when it is not the body's size (an exercise's)
+        self.reference_override: readouts.ReferenceLength | None = None
         self.solver = None
         self._build(keep_flow=False)
 
@@ -522,6 +513,11 @@ class Simulation:
         return False
 
     # --- what the window shows -----------------------------------------------------------
+    def reference_length(self) -> readouts.ReferenceLength:
+        """The length the force coefficients use (app/model/readouts.py): the body's size, or
+        the one an exercise sets (`reference_override`)."""
+        return self.reference_override or readouts.ReferenceLength(self.params.size)
+
     def reynolds(self) -> float:
         """Re of the wind over the body size (solver/units.py)."""
         return units.reynolds(self.params.wind, self.params.size, self.params.nu)

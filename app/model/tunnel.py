@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing import Any, Protocol, runtime_checkable
 
 from feelflow.app.model.body_input import BodyInput
+from feelflow.app.model.readouts import ReferenceLength
 
 
 @runtime_checkable
@@ -53,6 +54,10 @@ class TunnelModel(Protocol):
 
     def relative_wind(self) -> tuple[float, float]:
         """The wind the body meets: the inflow less the body's velocity."""
+        ...
+
+    def reference_length(self) -> ReferenceLength:
+        """The length the force coefficients are made dimensionless with (app/model/readouts.py)."""
         ...
 
     def reynolds(self) -> float:
