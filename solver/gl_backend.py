@@ -441,7 +441,8 @@ class GLSolver(Solver):
             self._write_texels(read["texels"], read["kbox"])
 
         # lbm_step.glsl's BODY pass gives every solid node f^eq(RHO0, u_body) each step
-        jx, jy = move_body(old, new, cfg, read_window, write_nodes, step_sets_solid=True)
+        jx, jy = move_body(old, new, cfg, read_window, write_nodes, step_sets_solid=True,
+                           refill_scheme=self.body_refill, impulse=self.body_impulse)
         self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         box = union_box(old.raster.window if old else None, new.raster.window if new else None)
         if box is not None:
@@ -565,6 +566,11 @@ class GLSolver(Solver):
                      grid_size=(float(size[0]), float(size[1])),
                      body_force=tuple(float(v) for v in self.config.body_force))
         return prog, tex, fbo, vao
+
+    @property
+    def gl_context(self):
+        """The moderngl.Context handed in (Solver.gl_context)."""
+        return self.ctx
 
     def close(self) -> None:
         for obj in [*(o for pair in self._vaos.values() for o in pair), *self._objects, *self._programs.values()]:

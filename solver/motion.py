@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from feelflow.solver.force_average import StepWeightedMean
+
 #: phase kinds a scene may name instead of an explicit velocity
 MOVES = ("stop", "with", "against")
 
@@ -113,13 +115,7 @@ class MotionRunner:
     def advance(self, n: int) -> dict[str, tuple[float, float]]:
         """Run n steps along the script; the force per model averaged over them. Raises
         `SolverDiverged` when the flow has left the physical range (`Solver.check_physical`)."""
-        total: dict[str, list[float]] = {}
-
-        def add(forces, weight):
-            for name, (fx, fy) in forces.items():
-                acc = total.setdefault(name, [0.0, 0.0])
-                acc[0] += weight * fx
-                acc[1] += weight * fy
+        total = StepWeightedMean()
 
         remaining = n
         while remaining > 0:
@@ -135,8 +131,8 @@ class MotionRunner:
                 left = self.script.steps_left_in_phase(self.t)
                 k = remaining if left is None else min(remaining, left)
             self.solver.step(k)
-            add(self.solver.forces(), k)
+            total.add(self.solver.forces(), k)
             self.t += k
             remaining -= k
         self.solver.check_physical()   # SolverDiverged when the flow left the physical range
-        return {name: (acc[0] / n, acc[1] / n) for name, acc in total.items()}
+        return total.mean()

@@ -74,7 +74,8 @@ class NumpySolver(Solver):
         cfg = self.config
         old = self.body
         new = self._body_state(shape, velocity, omega, raster)
-        jx, jy = move_body(old, new, cfg, self._read_window, self._write_nodes)
+        jx, jy = move_body(old, new, cfg, self._read_window, self._write_nodes,
+                           refill_scheme=self.body_refill, impulse=self.body_impulse)
         self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         self.body = new
         if new is not None:

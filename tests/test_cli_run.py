@@ -160,7 +160,6 @@ def test_validate_prints_a_table_and_writes_json(tmp_path):
 def test_run_on_gl_matches_numpy(tmp_path):
     """`--backend gl` (own EGL context) writes the same forces as the numpy reference, to the
     float32 tolerance of docs/science/algorithm.md."""
-    pytest.importorskip("feelflow.solver.gl_backend", reason="the gl backend is not built yet")
     scene = write(tmp_path, SMALL)
     tables = {}
     for backend in ("numpy", "gl"):

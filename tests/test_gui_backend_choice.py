@@ -4,14 +4,12 @@ the next start takes the remembered choice without measuring; the menu's choice 
 next start."""
 from __future__ import annotations
 
-import os
 
 import pytest
 
 from gui_fixtures import GRID
 
-pytestmark = [pytest.mark.gui,
-              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+pytestmark = pytest.mark.gui
 
 
 def started_window(qtbot, settings, backend):
@@ -52,7 +50,7 @@ def test_auto_measures_runs_the_fastest_and_remembers_it(qtbot, tmp_path):
 def test_the_menus_choice_waits_for_the_next_start(qtbot, tmp_path):
     from PySide6.QtCore import QSettings
 
-    from feelflow.app.gui.window.backend import requested_backend
+    from feelflow.app.gui.window.backend_controller import requested_backend
 
     settings = QSettings(str(tmp_path / "settings.ini"), QSettings.IniFormat)
     w = started_window(qtbot, settings, "gl")

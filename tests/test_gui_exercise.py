@@ -23,7 +23,7 @@ def test_edit_violate_fix_score_and_list_the_attempt(window, qtbot, tmp_path, mo
     from PySide6.QtWidgets import QMessageBox
 
     from feelflow.app.exercises import grading
-    from feelflow.shapes.io import save_shape
+    from feelflow.app.shape_files import save_shape
 
     warnings = []
     monkeypatch.setattr(QMessageBox, "warning", lambda *a, **k: warnings.append(a[2]))

@@ -3,13 +3,11 @@ lowest viscosity at the highest wind gives a finite running flow and one plain s
 status bar saying the viscosity was raised (app.simulation.stable_params)."""
 from __future__ import annotations
 
-import os
 
 import numpy as np
 import pytest
 
-pytestmark = [pytest.mark.gui,
-              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+pytestmark = pytest.mark.gui
 
 
 def test_lowest_viscosity_at_highest_wind_runs_finite_and_says_so(window, qtbot):

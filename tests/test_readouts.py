@@ -12,7 +12,7 @@ import pytest
 
 from feelflow.app.model import readouts
 from feelflow.app.model.readouts import EXERCISE_LENGTH, ReferenceLength
-from feelflow.app.model.simulation import History
+from feelflow.app.model.force_history import History
 from feelflow.app.model.tracers import Tracers
 
 

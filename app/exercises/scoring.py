@@ -187,10 +187,3 @@ def score_shape(exercise, shape, scale: int = 1, progress=None, cancelled=None, 
     score, hit = objective_score(exercise.objective, avg.cd, avg.cl)
     return Result(SCORED, score=score, cd=avg.cd, cl=avg.cl, steps=s.steps, seconds=seconds,
                   averaging=avg.how, hit=hit, scale=scale, cpu_seconds=cpu)
-
-
-def rank_key(objective, result: Result):
-    """Sort key: scored shapes best first (by score, then C_D), then not settled, then broken."""
-    if not result.ok:
-        return (1 if result.status == NOT_SETTLED else 2, 0.0)
-    return (0, result.score if objective.better == "lower" else -result.score)

@@ -133,7 +133,7 @@ class ExerciseController(QObject):
         show its panel; a dialog (one line) for a bad file."""
         from feelflow.app.exercises.format import load_exercise
         from feelflow.app.model.scene import scene_from_dict
-        from feelflow.shapes.io import load_shape
+        from feelflow.app.shape_files import load_shape
 
         w = self.window
         if w.sim is None or w.replays.refuse("exercises run in the live tunnel"):

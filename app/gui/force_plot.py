@@ -13,11 +13,13 @@ from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (QCheckBox, QComboBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget)
 
 from feelflow.app.files import atomic_path, write_text_atomic
+from feelflow.app.gui.polar_views import VIEWS as LIFT_VIEWS, LiftViews
 from feelflow.app.model.power_law import fit_power_law
 from feelflow.app.model import readouts
 from feelflow.app.model.display_units import DisplayUnits
 from feelflow.app.model.readouts import start_pulse_steps
-from feelflow.app.model.simulation import FORCE_MODELS, History
+from feelflow.app.model.force_history import History
+from feelflow.app.model.simulation import FORCE_MODELS
 from feelflow.app.model.tunnel import TunnelModel
 
 MODEL_COLOURS = {"momentum_exchange": ((220, 40, 40), (40, 110, 240)),
@@ -66,6 +68,8 @@ class ForcePlot(QWidget):
         self.view = QComboBox()
         self.view.addItem("Drag and lift against time", "time")
         self.view.addItem("Drag against relative speed (log-log)", "speed")
+        for key, (label, _, _) in LIFT_VIEWS.items():
+            self.view.addItem(label, key)
         self.pause_box = QCheckBox("Pause plot")
         self.clear_button = QPushButton("Clear")
         self.csv_button = QPushButton("Export CSV\u2026")
@@ -110,6 +114,7 @@ class ForcePlot(QWidget):
         self.follow_range = True   # the plot sets its ranges until the user zooms or pans
         self.plot.getViewBox().sigRangeChangedManually.connect(self._user_moved_range)
         self.curves = {}
+        self.lift_views = LiftViews(self.plot)
         self.scatter = self.fit_line = None
         self.fitted_exponent = None
         layout = QVBoxLayout(self)
@@ -147,8 +152,13 @@ class ForcePlot(QWidget):
         self.plot.enableAutoRange()
         self.plot.clear()
         self.curves.clear()
+        self.lift_views.reset()
+        self.plot.getPlotItem().invertY(False)
         self._reset_legend(1)
-        speed_view = self.view.currentData() == "speed"
+        view = self.view.currentData()
+        if self.sim is not None and hasattr(self.sim, "watch_surface_pressure"):
+            self.sim.watch_surface_pressure(view == "cp")   # the wall sampling runs only while C_p is shown
+        speed_view = view == "speed"
         self.plot.setLogMode(speed_view, speed_view)
         if speed_view:   # PlotDataItems: the log mode transforms them (bare scatter items it does not)
             self.scatter = self.plot.plot([], [], pen=None, symbol="o", symbolSize=10,
@@ -165,8 +175,12 @@ class ForcePlot(QWidget):
     def axis_labels(self) -> tuple[str, str]:
         """The (bottom, left) axis labels of the view shown, in the units shown."""
         u = self.units
-        if self.view.currentData() == "speed":
+        view = self.view.currentData()
+        if view == "speed":
             return f"relative speed |U - V| ({u.speed_unit})", f"drag ({u.force_unit})"
+        if view in LIFT_VIEWS:   # C_p and the polar: dimensionless (app/gui/polar_views.py)
+            _, xlabel, ylabel = LIFT_VIEWS[view]
+            return xlabel, ylabel
         return f"time ({u.time_unit})", f"force ({u.force_unit})"
 
     def set_units(self, units):
@@ -195,10 +209,29 @@ class ForcePlot(QWidget):
         if self.sim is None or (self.paused and not force):
             return
         self._update_readout()
-        if self.view.currentData() == "speed":
+        view = self.view.currentData()
+        if view == "speed":
             self._draw_speed_view()
+        elif view == "polar":
+            self.lift_views.draw_polar(self.sim)
+        elif view == "drag_polar":
+            self.lift_views.draw_drag_polar(self.sim)
+        elif view == "cp":
+            self.lift_views.draw_cp(self.surface_pressure())
         else:
             self._draw_time_view()
+
+    def surface_pressure(self):
+        """C_p along the surface now (app/model/live_polar.py): the polar's angle being held, else
+        the C_p view's own sampling; None where there is none (a replay, nothing sampled yet)."""
+        sim = self.sim
+        polar = getattr(sim, "polar", None)
+        if polar is not None and not polar.done:
+            return polar.live_cp(sim)
+        if polar is not None and polar.cp:
+            return polar.cp[-1][1]
+        watch = getattr(sim, "surface_watch", None)
+        return watch.take(sim) if watch is not None else None
 
     def readout(self, model=None) -> readouts.Readout:
         """The mean drag, lift and coefficients of the last samples, with the reference they use
@@ -289,6 +322,7 @@ class ForcePlot(QWidget):
             self._set_fit_text("fit: needs speeds 1.5\u00d7 apart" if len(us) else
                                f"fit: hold a speed {History.SETTLE_STEPS} steps")
         self.fitted_exponent = n
+        self.lift_views.draw_published_drag(self.sim, us)
         self._set_speed_ranges(us, fs)
 
     def fit_text(self) -> str:

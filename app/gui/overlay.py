@@ -211,7 +211,7 @@ class Overlay:
             notes.append((f"scripted motion: {words} (phase {k + 1} of {count})", QColor(255, 255, 255)))
         stage = sim.sweep_stage()
         if stage is not None:
-            notes.append((f"wind {sim.params.wind:.3f} (speed {stage + 1} of {len(sim.sweep[0])})", QColor(255, 255, 255)))
+            notes.append((f"wind {sim.params.wind:.3f} (speed {stage + 1} of {len(sim.sweep.speeds)})", QColor(255, 255, 255)))
         for i, (text, colour) in enumerate(notes):
             self._label(p, QPointF(r.left() + 10, r.top() + 24 + 20 * i), text, colour, size=15)
 

@@ -10,7 +10,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from feelflow.app.errors import UserError
+from feelflow.app.errors import UserError, shown
 from feelflow.app.inputs import MAX_STEPS, check_work
 from feelflow.solver.motion import MOVES, MotionScript, Phase, phase_velocity
 from feelflow.solver import units
@@ -153,7 +153,7 @@ class _Reader:
         self.source = source
 
     def fail(self, key: str, message: str):
-        raise UserError(f"{self.source}: {key}: {message}")
+        raise UserError(f"{self.source}: {shown(key)}: {message}")
 
 
 def _show(value) -> str:

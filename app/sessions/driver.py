@@ -12,6 +12,7 @@ from feelflow.app.sessions.format import SessionError, config_to_dict
 from feelflow.app.sessions.recorder import SessionRecorder
 from feelflow.solver.backend import SolverDiverged, create_solver
 from feelflow.solver.config import ConfigError, FlowConfig
+from feelflow.solver.force_average import StepWeightedMean
 
 
 def _geometry(shape):
@@ -29,16 +30,16 @@ def _geometry(shape):
 class SessionSolver:
     """The solver as the app drives it: a backend plus the commands a session records.
 
-    Drive it like a `feelflow.solver.backend.Solver` (set_body, set_inflow_speed, enable_force_models,
-    step, forces, distributions, time, ...: anything else is passed to the wrapped backend) plus
-    the session-level commands `set_viscosity`, `reset`, `rebuild`, `pause`, `resume`. While it
+    Drive it like a backend: it is a `feelflow.solver.backend.FlowSolver` (set_body,
+    set_inflow_speed, enable_force_models, step, forces, the field, the range check), plus the
+    session-level commands `set_viscosity`, `reset`, `rebuild`, `pause`, `resume`. While it
     has a `recorder`, every command is recorded; `replay` feeds a recording back through these
     same methods, which is why a replay reproduces the run. Keep one SessionSolver for the whole
     life of the flow (it remembers the last placement); `start_recording` can then begin at
     any moment between two `step` calls.
 
     `set_viscosity`, `reset` and `rebuild` build a new backend with `factory(config)`
-    (default: the same backend by name, handing on the wrapped solver's `.ctx` if it has one).
+    (default: the same backend by name, on the wrapped solver's GL context if it has one).
 
     The flow's physical range (`check_physical`) is checked after each `step` call (each force
     row), or, with `check_every` = N > 1, only once at least N solver steps have run since the
@@ -69,12 +70,47 @@ class SessionSolver:
         """The backend being driven (it changes on reset, rebuild and viscosity changes)."""
         return self._solver
 
-    def __getattr__(self, name):
-        return getattr(self._solver, name)
+    # --- the flow, as the backend has it (solver.backend.FlowSolver) ----------------------
+    @property
+    def config(self) -> FlowConfig:
+        return self._solver.config
+
+    @property
+    def name(self) -> str:
+        return self._solver.name
 
     @property
     def time(self) -> int:
         return self._solver.time
+
+    @property
+    def speed_capped(self) -> bool:
+        return self._solver.speed_capped
+
+    @property
+    def gl_context(self):
+        return self._solver.gl_context
+
+    def forces(self) -> dict[str, tuple[float, float]]:
+        return self._solver.forces()
+
+    def macroscopic(self):
+        return self._solver.macroscopic()
+
+    def distributions(self) -> np.ndarray:
+        return self._solver.distributions()
+
+    def inlet_reference(self) -> np.ndarray | None:
+        return self._solver.inlet_reference()
+
+    def field_rgba(self) -> np.ndarray:
+        return self._solver.field_rgba()
+
+    def field_texture(self, vorticity: bool = True):
+        return self._solver.field_texture(vorticity=vorticity)
+
+    def total_mass(self) -> float:
+        return self._solver.total_mass()
 
     # --- recording ------------------------------------------------------------
     def start_recording(self, **recorder_kwargs) -> SessionRecorder:
@@ -98,7 +134,7 @@ class SessionSolver:
         return rec
 
     # --- solver commands ------------------------------------------------------
-    def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, **kwargs) -> None:
+    def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
         rec = self.recorder
         if shape is None:
             if rec is not None:
@@ -112,13 +148,11 @@ class SessionSolver:
             if _geometry(shape) != _geometry(self.geometry_shape):
                 rec.record_parameter("body", shape.to_dict())
             rec.record_input(shape.x, shape.y, shape.angle, velocity[0], velocity[1], omega)
-        self._solver.set_body(shape, velocity=velocity, omega=omega, **kwargs)
+        self._solver.set_body(shape, velocity=velocity, omega=omega)
         self.geometry_shape = self.shape = shape
         self.velocity, self.omega = velocity, omega
 
     def set_inflow_speed(self, speed: float) -> None:
-        if not hasattr(self._solver, "set_inflow_speed"):
-            raise SessionError(f"the {self._solver.name} backend cannot change the inflow speed")
         if self.recorder is not None:
             self.recorder.record_parameter("inflow_speed", float(speed))
         self._solver.set_inflow_speed(float(speed))
@@ -130,6 +164,11 @@ class SessionSolver:
             self.recorder.record_parameter("force_models", list(names))
         self._solver.enable_force_models(names)
         self.models = names
+
+    def add_force_model(self, model) -> None:
+        """Enable an already-built model instance beside them (the C_p view's wall sampling,
+        solver/forces/surface_pressure.py); not recorded: a replay computes its own."""
+        self._solver.add_force_model(model)
 
     def step(self, n: int = 1) -> None:
         n = int(n)
@@ -155,7 +194,8 @@ class SessionSolver:
         k, row_steps = int(k), int(row_steps)
         part = self._part
         if part is None:
-            part = self._part = {"done": 0, "sums": {}, "body": self._body_row(), "start": self._solver.time}
+            part = self._part = {"done": 0, "mean": StepWeightedMean(), "body": self._body_row(),
+                                 "start": self._solver.time}
         k = max(1, min(k, row_steps - part["done"]))
         try:
             self._solver.step(k)
@@ -164,10 +204,7 @@ class SessionSolver:
             done = part["done"] + max(1, min(k, exc.step - part["start"] - part["done"]))
             self._record_row(done, {m: (math.nan, math.nan) for m in self.models}, part["body"])
             raise
-        sums = part["sums"]
-        for m, (fx, fy) in self._solver.forces().items():
-            sx, sy = sums.get(m, (0.0, 0.0))
-            sums[m] = (sx + fx * k, sy + fy * k)
+        part["mean"].add(self._solver.forces(), k)
         part["done"] += k
         if part["done"] < row_steps:
             return False
@@ -178,8 +215,7 @@ class SessionSolver:
             self._record_row(row_steps, {m: (math.nan, math.nan) for m in self.models}, part["body"])
             raise
         self._part = None
-        self._record_row(row_steps, {m: (sx / row_steps, sy / row_steps) for m, (sx, sy) in sums.items()},
-                         part["body"])
+        self._record_row(row_steps, part["mean"].mean(), part["body"])
         return True
 
     def check_physical(self) -> None:
@@ -279,8 +315,7 @@ class SessionSolver:
 
 def _same_backend_factory(solver):
     def factory(config):
-        ctx = getattr(solver, "ctx", None)
-        return create_solver(solver.name, config, **({"ctx": ctx} if ctx is not None else {}))
+        return create_solver(solver.name, config, ctx=solver.gl_context)
     return factory
 
 

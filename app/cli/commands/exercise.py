@@ -35,7 +35,9 @@ def add_arguments(parser):
                    help="replace --out if it exists (never the exercise file or a shape being scored)")
     p.add_argument("--workers", default=None, metavar="N", help="processes (default: every core)")
     p.add_argument("--scale", default=None, metavar="N",
-                   help="score at N times the exercise's resolution (default 1; 2 to confirm a close ranking)")
+                   help="score at N times the exercise's resolution (1..8; default 1; 2 to confirm a close "
+                        "ranking); refused before scoring when the grid, the steps or the memory it "
+                        "needs are beyond the bounds")
     p = sub.add_parser("check", help="validate an exercise file and score its reference solutions")
     p.add_argument("exercise", metavar="EXERCISE.toml")
     p.add_argument("--convergence", action="store_true",
@@ -55,8 +57,54 @@ def _positive(name, text):
     return positive_int_option(name, text)
 
 
+#: largest --scale (a scaled run must also fit the grid, steps and memory bounds: app/inputs.py)
+MAX_SCALE = 8
+#: most --workers processes
+MAX_WORKERS = 256
+
+
 def _workers(text):
-    return None if text is None else _positive("--workers", text)
+    if text is None:
+        return None
+    n = _positive("--workers", text)
+    if n > MAX_WORKERS:
+        raise UserError(f"--workers: at most {MAX_WORKERS}, got {n}")
+    return n
+
+
+def _scale(text) -> int:
+    if text is None:
+        return 1
+    n = _positive("--scale", text)
+    if n > MAX_SCALE:
+        raise UserError(f"--scale: must be in 1..{MAX_SCALE}, got {n}")
+    return n
+
+
+def _fit(exercise, scales, workers: int, jobs: int, option: str) -> int:
+    """Check the work and memory of scoring at `scales` before any run (grid, steps and memory
+    bounds of app/inputs.py); returns the processes that fit in memory (at most `workers`)."""
+    from feelflow.app.inputs import available_memory, check_memory, check_work, run_bytes
+    from feelflow.solver.config import ConfigError
+
+    for scale in scales:
+        s = exercise.scene.scaled(scale)
+        where = f"{option} {scale}" if option else exercise.source
+        check_work(s.nx, s.ny, s.steps, where, "scene.steps at this scale")
+        check_memory(s.nx, s.ny, where, "the scaled grid")
+        try:
+            s.flow_config()
+        except ConfigError as exc:
+            raise UserError(f"{where}: the scaled scene: {exc}") from None
+    need = max(run_bytes(exercise.scene.scaled(sc).nx, exercise.scene.scaled(sc).ny) for sc in scales)
+    limit = available_memory()
+    processes = max(1, min(workers, jobs))
+    if limit is not None and need * processes > limit:
+        fitting = max(1, int(limit // need))
+        print(f"memory: each run needs about {need / 2 ** 30:.2f} GiB and {limit / 2 ** 30:.2f} GiB "
+              f"can be used: {fitting} processes instead of {processes}", file=sys.stderr)
+        return fitting
+    return workers
 
 
 class ProgressBar:
@@ -138,7 +186,8 @@ def _score(exercise, args) -> int:
     out = check_output(args.out, "--out", inputs=[exercise.path, *exercise.input_files(), *files],
                        force=args.force)
     workers = _workers(args.workers) or grading.default_workers()
-    scale = 1 if args.scale is None else _positive("--scale", args.scale)
+    scale = _scale(args.scale)
+    workers = _fit(exercise, (scale,), workers, len(files), "--scale" if args.scale is not None else "")
     s = exercise.scene.scaled(scale)
     print(_machine_line())
     print(f"{exercise.title}: scoring {len(files)} shape files on {min(workers, len(files))} processes "
@@ -168,6 +217,9 @@ def _check(exercise, args) -> int:
     from feelflow.app.exercises import grading
 
     workers = _workers(args.workers) or grading.default_workers()
+    scales = (1, 2) if args.convergence else (1,)
+    workers = _fit(exercise, scales, workers, len(exercise.references) + len(exercise.check_shapes),
+                   "--convergence at scale" if args.convergence else "")
     print(_machine_line())
     s = exercise.scene
     print(f"{exercise.source}: valid. {exercise.title}: {s.nx} x {s.ny}, Re {s.reynolds:g}, "
@@ -176,7 +228,6 @@ def _check(exercise, args) -> int:
     print(_uncertainty_line(exercise))
     refs = [r.path for r in exercise.references]
     paths = refs + (list(exercise.check_shapes) if args.convergence else [])
-    scales = (1, 2) if args.convergence else (1,)
     rows, wall = grading.grade(exercise, paths, workers, scales, progress=ProgressBar("runs"), backend=args.backend)
     by = {(r.file, r.scale): r for r in rows}
     failed = False

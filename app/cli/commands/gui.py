@@ -47,7 +47,7 @@ def set_surface_format():
 
 def replay_when_ready(window, path) -> None:
     """Replay the session at `path` once, when the window's live simulation first runs
-    (`ReplayController.start`, app/gui/window/replay.py, needs it; a bad file is its one-line dialog)."""
+    (`ReplayController.start`, app/gui/window/replay_controller.py, needs it; a bad file is its one-line dialog)."""
     def start():
         window.simulationReady.disconnect(start)
         window.replays.start(path)
@@ -112,7 +112,7 @@ def main(args) -> int:
                              QSettings.IniFormat)
     else:
         settings = QSettings()
-    from feelflow.app.gui.window.backend import requested_backend
+    from feelflow.app.gui.window.backend_controller import requested_backend
 
     if not selftest:   # the self-test checks the shader path unless --backend says otherwise
         backend = requested_backend(getattr(args, "backend", None), settings)

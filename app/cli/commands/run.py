@@ -33,10 +33,14 @@ def add_arguments(parser):
 
 def positive_int_option(name: str, text):
     """An option that must be a positive integer; UserError (one line) otherwise."""
+    from feelflow.app.errors import shown
+
     try:
+        if len(str(text).strip()) > 18:
+            raise ValueError("too many digits")
         value = int(text)
     except (TypeError, ValueError):
-        raise UserError(f"{name}: must be a positive integer, got {text!r}") from None
+        raise UserError(f"{name}: must be a positive integer of at most 18 digits, got {shown(text)!r}") from None
     if value < 1:
         raise UserError(f"{name}: must be a positive integer, got {value}")
     return value
@@ -51,7 +55,7 @@ def main(args) -> int:
     from feelflow.app.model.scene import load_scene
 
     from feelflow.app.files import check_output, save_csv
-    from feelflow.app.inputs import check_work
+    from feelflow.app.inputs import check_memory, check_work
     from feelflow.app.model.scene import check_path_inside
 
     scene = load_scene(args.scene)
@@ -68,6 +72,7 @@ def main(args) -> int:
     out = check_output(args.out, "--out", inputs=[args.scene], force=args.force)
     if args.record:
         check_output(args.record, "--record", inputs=[args.scene], others=[args.out], force=args.force)
+    check_memory(scene.config.nx, scene.config.ny, args.scene, "grid.nx, grid.ny")
     warn_outside_stable_region(scene, args.scene)
 
     backend = resolve_backend(backend, scene.config)

@@ -104,20 +104,23 @@ class FrameLoop:
         if mode != "tracers":
             w.viewport.tracers = None
         w.panel.show_params(w.params_now(), mode)
-        if w.backend == "gl" and w.shown is not None:   # the field again: vorticity only where shown
+        if w.shown is not None and w.shown.solver.gl_context is not None:   # vorticity only where shown
             w.make_current()
             self.upload_field()
         w.viewport.update()
 
     # --- the field ----------------------------------------------------------------------------
     def upload_field(self):
-        """The shown model's field into the viewport; the numpy path returns its (ny, nx, 4) array."""
+        """The shown model's field into the viewport: the flow's own texture where it has one
+        (the gl backend, on the viewport's context; the vorticity, five nodes a texel, only where
+        it is shown), else its (ny, nx, 4) array, which it returns."""
         w = self.w
         model = w.shown
         if model is None:
             return None
-        if w.backend == "gl":   # the vorticity (five nodes a texel) only where it is shown
-            w.viewport.use_texture(model.solver.field_texture(vorticity=self.display_mode == "vorticity"))
+        texture = model.solver.field_texture(vorticity=self.display_mode == "vorticity")
+        if texture is not None:
+            w.viewport.use_texture(texture)
             return None
         rgba = model.field_rgba()
         w.viewport.makeCurrent()
