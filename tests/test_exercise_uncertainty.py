@@ -134,3 +134,16 @@ def test_score_table_prints_the_supported_digits(tmp_path, monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "grid uncertainty of a score: 0.1" in out
     assert "  1=       2.81" in out and "  1=       2.85" in out and "2.8123" not in out
+
+
+@pytest.mark.slow
+def test_the_cpu_backend_scores_numpys_digits():
+    """`exercise check --backend cpu` (used for the convergence tables) gives numpy's scores."""
+    from feelflow.shapes.io import load_shape
+
+    ex = load_exercise(TINY)
+    shape = load_shape(ex.references[0].path)
+    a = scoring.score_shape(ex, shape, backend="numpy")
+    b = scoring.score_shape(ex, shape, backend="cpu")
+    assert a.ok and b.ok
+    assert b.score == pytest.approx(a.score, rel=1e-12) and round(a.score, 4) == round(b.score, 4)
