@@ -139,7 +139,7 @@ def test_score_table_prints_the_supported_digits(tmp_path, monkeypatch, capsys):
 @pytest.mark.slow
 def test_the_cpu_backend_scores_numpys_digits():
     """`exercise check --backend cpu` (used for the convergence tables) gives numpy's scores."""
-    from feelflow.shapes.io import load_shape
+    from feelflow.app.shape_files import load_shape
 
     ex = load_exercise(TINY)
     shape = load_shape(ex.references[0].path)
