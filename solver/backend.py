@@ -65,6 +65,8 @@ class FlowSolver(Protocol):
     name: str                # the backend's registry name
     time: int                # steps done
     speed_capped: bool       # the last body motion or inflow was reduced to config.max_speed
+    max_speed_seen: float    # the largest |u| the last physical-range check read (solver/local_guard.py)
+    max_speed_at: int | None  # the step of that check (None: no check yet)
 
     @property
     def gl_context(self) -> Any:
@@ -140,6 +142,10 @@ class Solver(ABC):
 
     #: True when the last set_inflow_speed asked for more than config.max_speed
     inflow_capped: bool = False
+
+    #: the largest |u| the last physical-range check read, and the step it read it at (None: none yet)
+    max_speed_seen: float = 0.0
+    max_speed_at: int | None = None
 
     def __init__(self, config: FlowConfig):
         self.config = config.validate()
@@ -319,6 +325,7 @@ class Solver(ABC):
         if u_max > limit:
             raise SolverDiverged(self.time, f"max |u| = {u_max:.3g} is far above the Mach limit "
                                             f"(physical range |u| <= {limit:.3g})")
+        self.max_speed_seen, self.max_speed_at = u_max, self.time   # for the local guard (solver/local_guard.py)
         allowed = physical_density_deviation(self.config)
         if dev > allowed:
             lo, hi = float(np.min(rho)), float(np.max(rho))

@@ -137,7 +137,7 @@ class MainWindow(QMainWindow):
         p.displayModeChanged.connect(self.loop.set_display_mode)
         p.arrowsToggled.connect(lambda on: setattr(self.viewport, "show_arrows", on))
         p.inputChanged.connect(self.inputs.set_input)
-        vp.contextReady.connect(self._on_context)
+        vp.contextReady.connect(self.on_context)
         first_start.watch_gl(self)   # no OpenGL 3.3: a dialog, then the numpy solver on the CPU
         vp.bodyPulled.connect(self.inputs.mouse_pulled)
         vp.polygonEdited.connect(self.bodies.edit_polygon)
@@ -171,7 +171,7 @@ class MainWindow(QMainWindow):
         QTimer.singleShot(0, lambda: (QMessageBox.critical(self, "FeelFlow cannot start", message + hint),
                                       self.close()))
 
-    def _on_context(self, ctx):
+    def on_context(self, ctx):
         from feelflow.solver.backend import BackendError
 
         self.backend = self.backends.resolve(ctx)

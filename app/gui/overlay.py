@@ -83,7 +83,7 @@ class Overlay:
         p.setBrush(QBrush(BODY_FILL))
         p.drawPolygon(v.body_outline_points())
         if v.editing and sim.polygon is not None:
-            verts = v._edit_preview if v._edit_preview is not None else sim.polygon
+            verts = v.edit_preview if v.edit_preview is not None else sim.polygon
             world = v.body_to_world(verts)
             p.setPen(QPen(QColor(255, 200, 0), 1.5, Qt.DashLine))
             p.setBrush(Qt.NoBrush)
@@ -233,11 +233,11 @@ class Overlay:
         if not v.handle_shown():
             return
         centre, knob, reach = v.handle_geometry()
-        turn = v._turn
+        turn = v.turn
         if turn is not None and abs(math.radians(turn.target) - v.sim.angle) > 1e-3:
             target = turn_handle.knob_position(centre, reach, math.radians(turn.target))
             turn_handle.paint_turn_target(p, centre, target)
-        state = "refused" if v.turn_blocker() else "active" if turn is not None or v._hover == "handle" else "idle"
+        state = "refused" if v.turn_blocker() else "active" if turn is not None or v.hover == "handle" else "idle"
         turn_handle.paint_handle(p, centre, knob, state)
         if turn is not None:
             shown = (turn.target + 180.0) % 360.0 - 180.0

@@ -129,6 +129,21 @@ class Viewport(QWidget):
             return
         self._init_programs()
 
+    @property
+    def edit_preview(self):
+        """The polygon's vertices (body frame) while the editor drags one, else None."""
+        return self._edit_preview
+
+    @property
+    def turn(self):
+        """The handle's drag in progress (turn_handle.Turn), or None."""
+        return self._turn
+
+    @property
+    def hover(self):
+        """What the pointer is over: "handle", "body" or "near", or None."""
+        return self._hover
+
     def makeCurrent(self):
         """The viewport's GL context current (the gl solver draws with it too)."""
         if self._gl is not None:

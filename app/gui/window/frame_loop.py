@@ -162,6 +162,11 @@ class FrameLoop:
         if not all(math.isfinite(v) for f in forces.values() for v in f):
             self._on_nan()
             return
+        if getattr(sim, "guard_changed", False):   # the local stability guard raised the viscosity
+            sim.guard_changed = False
+            w.flow.say_guard()
+            w.panel.show_params(sim.params, self.display_mode)
+            w.flow.after_rebuild()
         w.inputs.after_frame(forces)
         self._frame_done(now, t0, t1, n, forces, rgba)
 
