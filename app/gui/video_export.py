@@ -70,7 +70,6 @@ class FrameRenderer:
             view.rho_ref = readouts.free_stream_density(rgba)
         view.arrow_forces = (readouts.arrows(forces.get(model.params.force_model), model.relative_wind(),
                                              model.reference_length()) if forces else None)
-        view._outline_cache = None   # noqa: SLF001 - the body moves between frames
         image = QImage(view.width(), view.height(), QImage.Format_RGB32)
         cpu_field.paint(view, rgba, image)
         return image_to_rgb(image)

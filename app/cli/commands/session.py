@@ -41,7 +41,7 @@ def add_arguments(parser):
                    help="replace --csv / --manifest if they exist (never the session itself)")
     p = sub.add_parser("render", help="replay a session into a video file (MP4 or animated GIF), no window needed")
     p.add_argument("file", metavar="FILE")
-    p.add_argument("--out", required=True, metavar="CLIP.mp4|CLIP.gif", help="the video to write (.mp4 or .gif)")
+    p.add_argument("--out", default=None, metavar="CLIP.mp4|CLIP.gif", help="the video to write (.mp4 or .gif; required)")
     p.add_argument("--steps-per-frame", default="50", metavar="N",
                    help="solver steps replayed between two frames (default 50)")
     p.add_argument("--fps", default="25", metavar="F", help="frames per second of the video (default 25)")
@@ -196,11 +196,13 @@ def render(args) -> int:
 
     from feelflow.app.video import video_format
 
-    video_format(args.out)
+    if not args.out:
+        raise UserError("session render: give --out CLIP.mp4 (or CLIP.gif), the video to write")
+    out = check_output(args.out, "--out", inputs=[args.file], force=args.force)
+    video_format(out)
     steps = _number("--steps-per-frame", args.steps_per_frame, 1, integer=True)
     fps = _number("--fps", args.fps, 1)
     width = _number("--width", args.width, 64, integer=True)
-    out = check_output(args.out, "--out", inputs=[args.file], force=args.force)
     s = _load(args.file)
     backend = args.backend or s.backend
     factory = _make_factory(backend)
