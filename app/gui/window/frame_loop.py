@@ -224,6 +224,7 @@ class FrameLoop:
         if self.display_mode == "pressure" and vp.frames % 5 == 0:
             vp.rho_ref = self._free_stream_density(rgba)
         self.update_arrows(forces)
+        self.w.probes.sample_frame(rgba if rgba is not None else self._field_array)   # app/gui/window/probes.py
         vp.update()
         # adaptive stepping: cost per step and the rest of the frame, smoothed
         self.step_cost = 0.8 * self.step_cost + 0.2 * (t1 - t0) / n
