@@ -47,8 +47,24 @@ class Overlay:
         self._paint_turn_handle(p)
         if v.show_arrows and v.arrow_forces and v.sim.shape is not None:
             self._paint_arrows(p)
+        if v.probe_marks:
+            self._paint_probes(p)
         self._paint_colour_bar(p)
         self._paint_notes(p)
+
+    def _paint_probes(self, p: QPainter):
+        """Each probe: a ring with a cross in its plot colour, and its number."""
+        v = self.view
+        for x, y, colour, label in v.probe_marks:
+            c = v.to_widget(x, y)
+            p.setPen(QPen(QColor(0, 0, 0, 160), 4))
+            p.drawEllipse(c, 6, 6)
+            p.setPen(QPen(colour, 2))
+            p.setBrush(Qt.NoBrush)
+            p.drawEllipse(c, 6, 6)
+            p.drawLine(c.x() - 9, c.y(), c.x() + 9, c.y())
+            p.drawLine(c.x(), c.y() - 9, c.x(), c.y() + 9)
+            p.drawText(c.x() + 8, c.y() - 8, label)
 
     def _paint_body(self, p: QPainter):
         v = self.view
