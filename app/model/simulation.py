@@ -12,6 +12,7 @@ import numpy as np
 from feelflow.app.model import readouts
 from feelflow.app.model.body_input import BodyInput
 from feelflow.app.model.body_motion import advance_with_motion, is_moving
+from feelflow.app.model.flow_choice import QUIET_INLET_RATE, FlowChoice, default_base_config, stable_params  # noqa: F401 (re-exported)
 from feelflow.app.model.force_history import History
 from feelflow.app.model.wind_sweep import SLEW_STEPS, WindSweep
 from feelflow.app.model.coupling import AngleSpring, SpringDamper
@@ -21,8 +22,7 @@ from feelflow.solver.backend import create_solver
 from feelflow.solver.config import FlowConfig
 from feelflow.solver.inflow import ramp
 from feelflow.solver.motion import MotionRunner
-from feelflow.solver.operator_choice import MOST_STABLE, Choice, choose
-from feelflow.solver.stability_limit import inside, min_stable_viscosity
+from feelflow.solver.operator_choice import Choice
 
 #: grid presets offered in the side panel: label -> (nx, ny)
 GRID_PRESETS = {
@@ -43,26 +43,6 @@ FORCE_MODELS = {
 #: y-boundaries offered as "wall type": config value -> label
 WALLS = {"no_slip": "Solid walls (no slip)", "free_slip": "Slippery walls (free slip)",
          "periodic": "No walls (periodic)"}
-
-#: the quiet inlet's rate in the window's tunnel (FlowConfig.inlet_nonreflecting, solver/quiet_inlet.py)
-QUIET_INLET_RATE = 1e-3
-
-
-def default_base_config(grid) -> FlowConfig:
-    """What the panel does not edit: TRT, float32, an outlet sponge with its absorbing layer,
-    and the wind blowing everywhere from the first step (initial velocity = inflow, no ramp).
-    Ramping the inlet up from fluid at rest excites a slow slosh of the whole tunnel, its
-    quarter-wave sound mode (mean u swings +-60 % of U with a 1000-step ramp, +-6 % with 2000,
-    measured at 256 x 128); starting in uniform flow keeps the mean within +-4 % from the start.
-    The absorbing layer (sponge_absorb, docs/science/algorithm.md step 3) lets that sound out: after a
-    1000-step ramp at 256 x 128 the mean u swings by 0.3 % of U instead of 46 % (a test,
-    tests/test_solver_boundaries.py), so a change of wind settles at once. The quiet inlet
-    (inlet_nonreflecting) lets out the sound a moving or stopping body sends upstream
-    (docs/science/quiet-tunnel.md)."""
-    nx, ny = grid
-    return FlowConfig(nx=nx, ny=ny, dtype="float32", inflow_ramp_steps=0, sponge_cells=32, sponge_absorb=0.1,
-                      inlet_nonreflecting=QUIET_INLET_RATE)
-
 
 #: distance (cells) the body's bounding box keeps from the domain edges
 EDGE_MARGIN = 8.0
@@ -98,26 +78,12 @@ def phase_name(velocity, wind: float) -> str:
     return f"moving at ({vx:.3f}, {vy:.3f})"
 
 
-def stable_params(params: Params, collision: str) -> tuple[Params, str | None]:
-    """`params` kept inside the measured stable region (solver/stability_limit.py): where the
-    wind and body size over the viscosity, U sqrt(d) / nu, exceed what the scheme survives, the viscosity
-    is raised to the limit (the wind is what the student sees and feels, and what the lessons
-    step through; viscosity is the scheme's stability lever). Returns (params, plain sentence
-    for the status bar, or None when nothing changed)."""
-    if inside(params.wind, params.nu, collision, params.size):
-        return params, None
-    nu = math.ceil(min_stable_viscosity(params.wind, collision, params.size) * 1e4 - 1e-6) / 1e4   # 4 decimals
-    return replace(params, nu=nu), (f"Viscosity raised to {nu:.4f}: at wind {params.wind:.3f} past a "
-                                    f"{params.size:g}-cell body a thinner fluid makes this grid unstable "
-                                    f"(lower the wind or the size to go thinner).")
-
-
 class Simulation:
     """The running tunnel: owns the solver (a `SessionSolver`), the body and its pose, and runs
     `advance(n)`: n steps and one force sample. Its parts, each set up here:
-    - the panel's parameters (`params`) kept inside the measured stable region (`stable_params`;
-      `guard_note` says what the last change had to adjust, None when nothing), and the
-      collision operator chosen for them (`operator_for`, solver/operator_choice.py);
+    - the panel's parameters (`params`) and the flow they make (`flow_choice`,
+      app/model/flow_choice.py: the base configuration, the collision operator, the stability
+      guard; `guard_note` says what the last change had to adjust, None when nothing);
     - the body's pose and its input: the mouse's spring-damper (`coupling`) and the angle spring
       (app/model/coupling.py), through `drive(BodyInput)`;
     - a motion script (`runner`, solver/motion.py) or a wind sweep (`sweep`,
@@ -143,11 +109,9 @@ class Simulation:
         self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
         self.sweep: WindSweep | None = None       # a wind-speed sweep (a lesson), or None
         self.sweep_slew_steps = self.SWEEP_SLEW_STEPS   # for the next sweep (0: changes at once)
-        self.base_config = base_config or default_base_config(self.params.grid)
-        self._wind_starts_everywhere = base_config is None   # default tunnel: no ramp, see below
-        # the collision operator: a given base configuration names it; else chosen per flow
-        self.operator_named = None if base_config is None else base_config.collision
-        self.params, self.guard_note = stable_params(self.params, self.guard_operator)
+        #: the base configuration, the collision operator and the stability guard (app/model/flow_choice.py)
+        self.flow_choice = FlowChoice(base_config, self.params.grid)
+        self.params, self.guard_note = self.flow_choice.stable(self.params)
         self._guard_read_at = None   # solver step of the last max |u| the local guard read
         self.guard_changed = False   # the local guard changed the flow (the window shows guard_note)
         self.polar = None            # app/model/live_polar.LivePolar: an angle-of-attack sweep
@@ -175,29 +139,13 @@ class Simulation:
         return (config.nx * 0.3, config.ny * 0.5)
 
     # --- construction --------------------------------------------------------------------
-    @property
-    def guard_operator(self) -> str:
-        """The operator whose measured region the stability guard keeps the flow in: the named
-        one, else the most stable one the chooser can pick."""
-        return self.operator_named or MOST_STABLE
-
     def operator_for(self, params: Params | None = None) -> Choice:
-        """The collision operator for `params` (solver/operator_choice.py) and why, in one line."""
-        p = params or self.params
-        base = self.base_config
-        return choose(p.wind, p.nu, p.size, base.mach_limit, named=self.operator_named,
-                      smagorinsky=base.smagorinsky)
+        """The collision operator for `params` (default: the panel's) and why (FlowChoice)."""
+        return self.flow_choice.operator_for(params or self.params)
 
     def flow_config(self, params: Params | None = None) -> FlowConfig:
-        """The base configuration (scene or default) with what the panel edits, and the operator."""
-        p = params or self.params
-        nx, ny = p.grid
-        base = self.base_config
-        op = self.operator_for(p)
-        extra = {"initial_velocity": (p.wind, 0.0)} if self._wind_starts_everywhere else {}
-        return replace(base, nx=nx, ny=ny, nu=p.nu, inflow_speed=p.wind, y_boundary=p.wall,
-                       collision=op.collision, smagorinsky=op.smagorinsky,
-                       sponge_cells=min(base.sponge_cells, nx // 4), **extra).validate()
+        """The flow configuration for `params` (default: the panel's; FlowChoice)."""
+        return self.flow_choice.config_for(params or self.params)
 
     def _build(self, keep_flow: bool):
         """The flow for the parameters now, from the old one where `keep_flow` and the grid is the
@@ -276,7 +224,7 @@ class Simulation:
         self.angle = self.angle_target = angle
         self._clamp_pose()
         self.solver.set_body(self.shape, self.vel, 0.0)
-        guarded, note = stable_params(self.params, self.guard_operator)
+        guarded, note = self.flow_choice.stable(self.params)
         if note:   # a larger body needs a thicker fluid at this wind
             self.set_flow(nu=guarded.nu)
         elif self.operator_for().collision != self.config.collision:   # the size changed the operator
@@ -286,7 +234,7 @@ class Simulation:
     def set_flow(self, wind=None, nu=None, wall=None):
         """Change inflow speed, viscosity or walls, keeping the flow as it is (raises ConfigError)."""
         params = replace(self.params, **{k: v for k, v in (("wind", wind), ("nu", nu), ("wall", wall)) if v is not None})
-        params, self.guard_note = stable_params(params, self.guard_operator)
+        params, self.guard_note = self.flow_choice.stable(params)
         new = self.flow_config(params)  # validate first: a bad value leaves everything as it was
         only_wind = ((params.nu, params.wall) == (self.params.nu, self.params.wall)
                      and new.collision == self.config.collision)
@@ -355,13 +303,11 @@ class Simulation:
         kind, size, verts = params_for_shape(scene.body)
         cfg = scene.config
         models = [m for m in scene.force_models if m in FORCE_MODELS] or [self.params.force_model]
-        self.base_config = cfg
-        self.operator_named = scene.operator_named
-        self._wind_starts_everywhere = False
+        self.flow_choice.use_scene(scene)
         self.params = replace(self.params, grid=(cfg.nx, cfg.ny), shape=kind, size=size or self.params.size,
                               angle_deg=math.degrees(scene.body.angle), wind=cfg.inflow_speed, nu=cfg.nu,
                               wall=cfg.y_boundary, force_model=models[0], compare_all=len(models) > 1)
-        self.params, self.guard_note = stable_params(self.params, self.guard_operator)
+        self.params, self.guard_note = self.flow_choice.stable(self.params)
         self.polygon = verts
         self.runner = None
         self.sweep = self.polar = None
@@ -540,6 +486,9 @@ class Simulation:
     def operator_line(self) -> str:
         """Which collision operator runs and why, in one line (the status bar's)."""
         return self.operator_for().reason
+
+    def field_texture(self, vorticity: bool = True):
+        return self.solver.field_texture(vorticity=vorticity)
 
     def field_rgba(self) -> np.ndarray:
         return self.solver.field_rgba()

@@ -264,7 +264,7 @@ class SessionSolver:
         self.flow_config = config
         old = self._solver
         new = carry_flow(self._factory, config, old.distributions(), old.time, self.shape, old.inlet_reference())
-        self._reapply(new)
+        self.adopt(new)
         old.close()
 
     def reset(self) -> None:
@@ -273,7 +273,7 @@ class SessionSolver:
         if self.recorder is not None:
             self.recorder.record_parameter("reset")
         old = self._solver
-        self._reapply(self._factory(self.flow_config))
+        self.adopt(self._factory(self.flow_config))
         old.close()
 
     def rebuild(self, config: FlowConfig, keep_flow: bool = True) -> None:
@@ -297,7 +297,7 @@ class SessionSolver:
         self._solver = new
         old.close()
 
-    def _reapply(self, new) -> None:
+    def adopt(self, new) -> None:
         if self.models:
             new.enable_force_models(self.models)
         if self.inflow_speed is not None:

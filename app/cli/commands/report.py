@@ -60,7 +60,7 @@ def add_arguments(parser):
 
 
 def main(args) -> int:
-    from feelflow.app.files import check_output
+    from feelflow.app.files import check_output, check_output_folder
 
     if args.json:   # before any run
         check_output(args.json, "--json", force=args.force)
@@ -74,9 +74,7 @@ def main(args) -> int:
         return towed(args)
     from feelflow.app.reports.seed import PARTS, PROTOCOL, run_part, save_part, write_report
 
-    out = Path(args.out)
-    if not out.is_dir():
-        raise UserError(f"--out: {args.out!r} is not a folder")
+    out = check_output_folder(args.out, "--out")
     phase_steps = phase_steps_option(args.phase_steps, 1)
     parts = PARTS
     keys = None  # protocol diameters
