@@ -57,6 +57,7 @@ class ForcePlot(QWidget):
         small = self.reference_label.font()
         small.setPointSizeF(small.pointSizeF() * 0.85)
         self.reference_label.setFont(small)
+        self.reference_label.setWordWrap(True)   # a long reference ("the exercise's ...") wraps, the window keeps its width
         self.reference_label.setToolTip("C = 2 F / (\u03c1 U\u00b2 L): U the relative wind's speed, "
                                         "L the reference length")
         bar = QHBoxLayout()
