@@ -233,6 +233,19 @@ def move_body(old, new, config, read_window, write_nodes, step_sets_solid: bool 
     return impulse
 
 
+def same_solid_motion(old, new) -> bool:
+    """Whether a move from body state `old` to `new` leaves every solid node as it was: the same
+    solid nodes (no node covered or uncovered) at the same u_body (same velocity and angular
+    velocity, and for a turning body the same centre). The solid nodes then already hold
+    f^eq(RHO0, u_body), so the move writes nothing (a sub-cell move of a towed body, most of
+    its steps); only the links change."""
+    if old is None or new is None or old.velocity != new.velocity or old.omega != new.omega:
+        return False
+    if new.omega != 0.0 and (old.shape.x, old.shape.y) != (new.shape.x, new.shape.y):
+        return False
+    return old.raster.box == new.raster.box and np.array_equal(old.raster.box_solid, new.raster.box_solid)
+
+
 @dataclass
 class BodyState:
     """The body on the grid: shape at its pose, capped motion, raster, windows and links.

@@ -50,6 +50,7 @@ from feelflow.app.gui.window.flow import FlowController  # noqa: E402
 from feelflow.app.gui.window.frame_loop import FrameLoop  # noqa: E402
 from feelflow.app.gui.window.input_controller import InputController  # noqa: E402
 from feelflow.app.gui.window.lessons import LessonController  # noqa: E402
+from feelflow.app.gui.window.events import WindowEvents  # noqa: E402
 from feelflow.app.gui.window.menus import build_menus  # noqa: E402
 from feelflow.app.gui.window.replay_controller import ReplayController  # noqa: E402
 from feelflow.app.gui.window.settings import WindowSettings  # noqa: E402
@@ -89,7 +90,8 @@ class MainWindow(QMainWindow):
         for label in self.status.values():
             self.statusBar().addPermanentWidget(label)
 
-        # controllers
+        # controllers, and the events they tell each other (window/events.py)
+        self.events = WindowEvents(self)
         self.loop = FrameLoop(self)
         self.replays = ReplayController(self)
         self.inputs = InputController(self)
@@ -195,13 +197,11 @@ class MainWindow(QMainWindow):
             self.bodies.install_default_polygon()
 
     def _simulation_started(self):
-        self.viewport.sim = self.sim
-        self.plot.sim = self.sim
         self.viewport.mode = self.loop.display_mode
+        self.events.shownChanged.emit(self.sim)   # the viewport and the plot show it, its field drawn
         self.panel.show_params(self.sim.params, self.loop.display_mode)
         self.status["renderer"].setText(self.backends.status_text(self.viewport.renderer().split(' (')[0], self.backend))
         self.status["renderer"].setToolTip(f"{self.viewport.renderer()}; {self.backends.description}")
-        self.loop.upload_field()
         self.inputs.refresh_devices()
         self.flow.say_guard()
         self.loop.start()

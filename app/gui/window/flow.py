@@ -20,6 +20,12 @@ class FlowController:
 
     def __init__(self, window: "MainWindow"):
         self.w = window
+        window.events.replayStopped.connect(self._replay_stopped)
+
+    def _replay_stopped(self, _paused: bool):
+        """Back on the live tunnel: the panel shows its parameters, the status bar its operator."""
+        self.w.panel.show_params(self.w.sim.params, self.w.loop.display_mode)
+        self.after_rebuild()
 
     def apply(self, **changes):
         """`Simulation.set_flow(**changes)` (wind, nu, wall); a bad value is a dialog."""

@@ -62,6 +62,9 @@ class FrameLoop:
         self.slow_timer = QTimer(window)
         self.slow_timer.setInterval(READOUT_MS)
         self.slow_timer.timeout.connect(self.refresh_readouts)
+        window.events.shownChanged.connect(self.show_model)
+        window.events.replayStarted.connect(lambda: self.timer.setInterval(0))
+        window.events.replayStopped.connect(self._replay_stopped)
 
     def start(self):
         if self.w.sim is not None:
@@ -72,6 +75,23 @@ class FrameLoop:
     def stop(self):
         self.timer.stop()
         self.slow_timer.stop()
+
+    def show_model(self, model):
+        """Point the viewport and the plot at `model` (the live tunnel or a replay) and draw it."""
+        w = self.w
+        vp = w.viewport
+        vp.sim = w.plot.sim = model
+        vp.locked = model is not w.sim
+        vp.tracers = vp.arrow_forces = None
+        self.forget_last_frame()
+        self.upload_field()
+        w.plot.refresh(force=True)
+        vp.update()
+
+    def _replay_stopped(self, paused: bool):
+        """Back on the live tunnel: its own pace and pause."""
+        self.w.actions.pause.setChecked(paused)
+        self.timer.setInterval(30 if paused else 0)
 
     def forget_last_frame(self):
         """The next frame starts afresh (the model shown changed): no frame time to smooth."""
