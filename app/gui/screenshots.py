@@ -23,12 +23,7 @@ def make_screenshots(out_dir, seconds: float = 6.0, out=sys.stdout) -> list[Path
     from PySide6.QtWidgets import QApplication
 
     from feelflow import EXERCISE_DIR
-    from feelflow.app.cli.commands.gui import set_surface_format
-    from feelflow.app.gui.qt_runtime import make_none_immortal
-
-    make_none_immortal()
-    set_surface_format()
-    from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.main_window import MainWindow   # the caller set Qt up (feelflow screenshots)
     from feelflow.app.model.display_units import UnitsChoice
 
     app = QApplication.instance() or QApplication(["feelflow"])

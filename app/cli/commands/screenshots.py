@@ -25,6 +25,11 @@ def main(args) -> int:
     problem = display_problem()
     if problem is not None:
         raise UserError(problem)
+    from feelflow.app.cli.commands.gui import set_surface_format
+    from feelflow.app.gui.qt_runtime import make_none_immortal
+
+    make_none_immortal()
+    set_surface_format()   # before the QApplication exists, as for the window
     from feelflow.app.gui.screenshots import make_screenshots
 
     make_screenshots(out, seconds)
