@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from feelflow.solver.backend import Solver, SolverDiverged
-from feelflow.solver.body import move_body, shifted, unshifted
+from feelflow.solver.body import move_body, same_solid_motion, shifted, unshifted
 from feelflow.solver.bouzidi import incoming
 from feelflow.solver.collision import Collider
 from feelflow.solver.config import FlowConfig
@@ -74,7 +74,12 @@ class NumpySolver(Solver):
         cfg = self.config
         old = self.body
         new = self._body_state(shape, velocity, omega, raster)
-        jx, jy = move_body(old, new, cfg, self._read_window, self._write_nodes)
+        if same_solid_motion(old, new):   # a sub-cell move at the same motion: nothing to write
+            self.body = new
+            self.speed_capped = new.capped or self.inflow_capped
+            return
+        jx, jy = move_body(old, new, cfg, self._read_window, self._write_nodes,
+                           refill_scheme=self.body_refill, impulse=self.body_impulse)
         self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         self.body = new
         if new is not None:

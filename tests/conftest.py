@@ -18,7 +18,6 @@ os.environ.setdefault("XDG_CACHE_HOME", _cache)
 def gl_context():
     """The process's standalone EGL OpenGL 3.3 core context (app.headless.gl_context: llvmpipe
     where there is no GPU), the one the CLI's gl solvers get too."""
-    pytest.importorskip("moderngl")
     from feelflow.app.errors import UserError
     from feelflow.app.headless import gl_context as egl_context, release_gl_context
 

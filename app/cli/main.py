@@ -56,10 +56,10 @@ def build_parser() -> argparse.ArgumentParser:
         except ModuleNotFoundError as exc:  # command not built yet
             if exc.name != f"feelflow.app.cli.commands.{name}":
                 raise
-            p.set_defaults(_missing=name)
+            p.set_defaults(missing_command=name)
             continue
         module.add_arguments(p)
-        p.set_defaults(_module=module)
+        p.set_defaults(command_module=module)
     return parser
 
 
@@ -68,26 +68,26 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     if args.selftest or args.command is None:
         args.command = "gui"
-    if not hasattr(args, "_module") and not hasattr(args, "_missing"):
+    if not hasattr(args, "command_module") and not hasattr(args, "missing_command"):
         # no sub-command on the line (`feelflow`, `feelflow --selftest`): the gui's defaults
         try:
             module = importlib.import_module("feelflow.app.cli.commands.gui")
         except ModuleNotFoundError as exc:
             if exc.name != "feelflow.app.cli.commands.gui":
                 raise
-            args._missing = "gui"
+            args.missing_command = "gui"
         else:
             sub = _Parser()
             module.add_arguments(sub)
             for key, value in vars(sub.parse_args([])).items():
                 if not hasattr(args, key):
                     setattr(args, key, value)
-            args._module = module
-    if getattr(args, "_missing", None):
+            args.command_module = module
+    if getattr(args, "missing_command", None):
         print(f"feelflow: '{args.command}' is not available in this version", file=sys.stderr)
         return 2
     try:
-        return int(args._module.main(args) or 0)
+        return int(args.command_module.main(args) or 0)
     except UserError as exc:
         print(f"feelflow: {one_line(str(exc))}", file=sys.stderr)
         return 2

@@ -16,6 +16,7 @@ from feelflow.app.files import atomic_path, write_text_atomic
 from feelflow.app.gui.polar_views import VIEWS as LIFT_VIEWS, LiftViews
 from feelflow.app.model.power_law import fit_power_law
 from feelflow.app.model import readouts
+from feelflow.app.model.display_units import DisplayUnits
 from feelflow.app.model.readouts import start_pulse_steps
 from feelflow.app.model.force_history import History
 from feelflow.app.model.simulation import FORCE_MODELS
@@ -26,11 +27,41 @@ MODEL_COLOURS = {"momentum_exchange": ((220, 40, 40), (40, 110, 240)),
                  "pressure": ((150, 60, 190), (40, 160, 60))}
 
 
+def si_columns(head: list[str], rows: list[list[str]], units) -> tuple[list[str], list[list[str]]]:
+    """The CSV with SI columns added after the lattice ones: time_s, and for every force
+    (`*_fx`, `*_fy`, `*_drag`, `*_lift`) a `*_N`, every velocity (`body_v*`, `wind_*`,
+    `probe*_u*`, `probe*_speed`) a `*_m_s`, every probe pressure a `*_Pa` (units.physical,
+    solver/units.py PhysicalUnits, for the flow now)."""
+    convert = []
+    for i, name in enumerate(head):
+        if name == "step":
+            convert.append((i, "time_s", units.time))
+        elif name.endswith(("_fx", "_fy", "_drag", "_lift")):
+            convert.append((i, f"{name}_N", units.force))
+        elif name.startswith(("body_v", "wind_")) or (name.startswith("probe") and name.endswith(("_ux", "_uy", "_speed"))):
+            convert.append((i, f"{name}_m_s", units.speed))
+        elif name.startswith("probe") and name.endswith("_p"):
+            convert.append((i, f"{name}_Pa", units.pressure))
+    out_rows = []
+    for row in rows:
+        extra = []
+        for i, _, fn in convert:
+            cell = row[i] if i < len(row) else ""
+            try:
+                extra.append(f"{fn(float(cell)):.8g}" if cell not in ("", "nan") else cell)
+            except ValueError:
+                extra.append("")
+        out_rows.append(row + extra)
+    return head + [name for _, name, _ in convert], out_rows
+
+
 class ForcePlot(QWidget):
     """Shows `sim.history`; `refresh()` redraws (the window calls it a few times a second)."""
 
     def __init__(self, parent=None):
         super().__init__(parent)
+        self.probes = None   # app.model.probes.Probes, set by the window: their columns join the CSV
+        self.units = DisplayUnits()   # lattice or SI (app/model/display_units.py), set by the window
         self.sim: TunnelModel | None = None   # what the plot shows (the window sets it)
         self.paused = False
         self._frozen = None
@@ -73,8 +104,8 @@ class ForcePlot(QWidget):
         self.plot = pg.PlotWidget()
         self.plot.showGrid(x=False, y=True, alpha=0.3)   # the grid is redrawn with the axes: keep it light
         self.legend = self.plot.addLegend(offset=(10, 5))
-        self.plot.getAxis("bottom").setLabel("time (solver steps)")
-        self.plot.getAxis("left").setLabel("force (lattice units)")
+        self.plot.getAxis("bottom").setLabel(self.axis_labels()[0])
+        self.plot.getAxis("left").setLabel(self.axis_labels()[1])
         for ax in ("bottom", "left"):
             self.plot.getAxis(ax).enableAutoSIPrefix(False)
             f = self.plot.getAxis(ax).label.font()
@@ -136,16 +167,32 @@ class ForcePlot(QWidget):
             self.fit_line = self.plot.plot([], [], pen=pg.mkPen((40, 40, 40), width=2, style=Qt.DashLine),
                                            name="fit")
             self._set_speed_ranges(np.array([]), np.array([]))
-            self.plot.getAxis("bottom").setLabel("relative speed |U - V| (lattice units)")
-            self.plot.getAxis("left").setLabel("drag (lattice units)")
-        elif view in LIFT_VIEWS:
-            _, xlabel, ylabel = LIFT_VIEWS[view]
-            self.plot.getAxis("bottom").setLabel(xlabel)
-            self.plot.getAxis("left").setLabel(ylabel)
-        else:
-            self.plot.getAxis("bottom").setLabel("time (solver steps)")
-            self.plot.getAxis("left").setLabel("force (lattice units)")
+        x, y = self.axis_labels()
+        self.plot.getAxis("bottom").setLabel(x)
+        self.plot.getAxis("left").setLabel(y)
         self.refresh(force=True)
+
+    def axis_labels(self) -> tuple[str, str]:
+        """The (bottom, left) axis labels of the view shown, in the units shown."""
+        u = self.units
+        view = self.view.currentData()
+        if view == "speed":
+            return f"relative speed |U - V| ({u.speed_unit})", f"drag ({u.force_unit})"
+        if view in LIFT_VIEWS:   # C_p and the polar: dimensionless (app/gui/polar_views.py)
+            _, xlabel, ylabel = LIFT_VIEWS[view]
+            return xlabel, ylabel
+        return f"time ({u.time_unit})", f"force ({u.force_unit})"
+
+    def set_units(self, units):
+        """Show numbers in `units` (app.model.display_units.DisplayUnits) from now on."""
+        changed = (units.is_si, units.describe()) != (self.units.is_si, self.units.describe())
+        self.units = units
+        if changed:
+            x, y = self.axis_labels()
+            self.plot.getAxis("bottom").setLabel(x)
+            self.plot.getAxis("left").setLabel(y)
+            self.follow_range = True
+            self.refresh(force=True)
 
     def _reset_legend(self, columns: int):
         """The plot keeps one legend across clear(): empty it and set its layout."""
@@ -221,11 +268,13 @@ class ForcePlot(QWidget):
             t, drag, lift = sim.history.drag_lift(model)
             first = int(np.argmax(np.isfinite(drag))) if np.isfinite(drag).any() else len(t)
             t, drag, lift = t[first:], drag[first:], lift[first:]   # from when the model was switched on
+            settled = t >= start_pulse_steps(sim.params.size)
+            u = self.units
+            t, drag, lift = u.time(t), u.force(drag), u.force(lift)
             cd, cl = MODEL_COLOURS.get(model, ((0, 0, 0), (90, 90, 90)))
             self._curve((model, "drag"), pg.mkPen(cd, width=2.5), self._name((model, "drag"))).setData(t, drag, connect="finite")
             self._curve((model, "lift"), pg.mkPen(cl, width=2.5, style=Qt.DashLine if len(shown) > 1 else Qt.SolidLine),
                         self._name((model, "lift"))).setData(t, lift, connect="finite")
-            settled = t >= start_pulse_steps(sim.params.size)
             values.append(np.r_[drag[settled], lift[settled]])
         self._set_force_range(np.concatenate(values) if values else np.array([]))
 
@@ -260,6 +309,8 @@ class ForcePlot(QWidget):
 
     def _draw_speed_view(self):
         us, fs, n = fit_power_law(*self.speed_drag())
+        u = self.units
+        us, fs = np.asarray(u.speed(np.asarray(us, float))), np.asarray(u.force(np.asarray(fs, float)))
         self.scatter.setData(us, fs)
         if n is not None:
             c = np.mean(np.log(fs) - n * np.log(us))
@@ -301,9 +352,26 @@ class ForcePlot(QWidget):
 
     # --- export ---------------------------------------------------------------------------
     def csv_text(self) -> str:
-        """The forces CSV (app/model/readouts.py `forces_csv`)."""
+        """The forces CSV (app/model/readouts.py `forces_csv`), with the probes' columns
+        (app/model/probes.py) joined on the step when there are probes."""
         sim = self.sim
-        return readouts.forces_csv(sim.history, FORCE_MODELS, sim.reference_length())
+        text = readouts.forces_csv(sim.history, FORCE_MODELS, sim.reference_length())
+        probes = self.probes if self.probes is not None and len(self.probes) else None
+        if probes is None and not self.units.is_si:
+            return text
+        import csv
+        import io
+
+        rows = list(csv.reader(io.StringIO(text)))
+        out = io.StringIO()
+        w = csv.writer(out)
+        head = rows[0] + (probes.columns() if probes else [])
+        body = [row + (probes.values_at(int(float(row[0]))) if probes else []) for row in rows[1:]]
+        if self.units.is_si:   # SI columns beside the lattice ones (app/model/display_units.py)
+            head, body = si_columns(head, body, self.units)
+        w.writerow(head)
+        w.writerows(body)
+        return out.getvalue()
 
     def export_csv(self, path):
         write_text_atomic(path, self.csv_text())

@@ -88,6 +88,14 @@ class SessionSolver:
         return self._solver.speed_capped
 
     @property
+    def max_speed_seen(self) -> float:
+        return self._solver.max_speed_seen
+
+    @property
+    def max_speed_at(self) -> int | None:
+        return self._solver.max_speed_at
+
+    @property
     def gl_context(self):
         return self._solver.gl_context
 
@@ -256,7 +264,7 @@ class SessionSolver:
         self.flow_config = config
         old = self._solver
         new = carry_flow(self._factory, config, old.distributions(), old.time, self.shape, old.inlet_reference())
-        self._reapply(new)
+        self.adopt(new)
         old.close()
 
     def reset(self) -> None:
@@ -265,7 +273,7 @@ class SessionSolver:
         if self.recorder is not None:
             self.recorder.record_parameter("reset")
         old = self._solver
-        self._reapply(self._factory(self.flow_config))
+        self.adopt(self._factory(self.flow_config))
         old.close()
 
     def rebuild(self, config: FlowConfig, keep_flow: bool = True) -> None:
@@ -289,7 +297,7 @@ class SessionSolver:
         self._solver = new
         old.close()
 
-    def _reapply(self, new) -> None:
+    def adopt(self, new) -> None:
         if self.models:
             new.enable_force_models(self.models)
         if self.inflow_speed is not None:

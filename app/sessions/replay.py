@@ -73,7 +73,7 @@ class SessionPlayer:
             self.recorder.inlet_reference = session.inlet_reference
             d.models, d.inflow_speed = tuple(start["force_models"]), start["inflow_speed"]
             d.shape, d.velocity, d.omega = placed, tuple(start["velocity"]), start["omega"]
-            d._reapply(solver)
+            d.adopt(solver)
         self.geometry = session.body   # the geometry the next input places
         self.diverged_at: int | None = None
         self.rows: list[ReplayedRow] = []

@@ -85,6 +85,11 @@ def main(args) -> int:
         from feelflow.app.exercises.format import load_exercise
 
         load_exercise(exercise)
+    if getattr(args, "screenshot", None):   # before any window: never a device, a folder or an input
+        from feelflow.app.files import check_output
+
+        # the self-test's screenshot is regenerated on every run (as the report's own files)
+        check_output(args.screenshot, "--screenshot", inputs=[session, exercise], force=True)
     from feelflow.app.gui.first_start import display_problem
 
     problem = display_problem()

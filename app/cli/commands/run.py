@@ -142,6 +142,24 @@ def warn_outside_stable_region(scene, name) -> bool:
     return True
 
 
+def warn_outside_local_region(scene, solver, step: int) -> bool:
+    """One line on stderr the first time the flow's fastest node leaves the operator's stable
+    region (the local guard, solver/local_guard.py, from the physical-range check's max |u|); the
+    scene runs as written (the window, by contrast, raises the viscosity)."""
+    from feelflow.solver import local_guard
+    from feelflow.solver.operator_choice import NAMES
+
+    if solver.max_speed_at is None:
+        return False
+    cfg = scene.config
+    verdict = local_guard.check(cfg.collision, cfg.nu, solver.max_speed_seen)
+    if verdict.inside:
+        return False
+    print(f"feelflow: warning: step {step}: {verdict.line(NAMES.get(cfg.collision, cfg.collision))} "
+          f"The scene runs as written.", file=sys.stderr)
+    return True
+
+
 def run_scene(scene, solver, steps: int):
     """Step `scene` in `solver` along its motion script for `steps` steps.
 
@@ -157,6 +175,7 @@ def run_scene(scene, solver, steps: int):
     for m in scene.force_models:
         header += [f"fx_{m}", f"fy_{m}"]
     rows = []
+    warned = False
     start = time.perf_counter()
     while runner.t < steps:
         t0 = runner.t
@@ -170,6 +189,8 @@ def run_scene(scene, solver, steps: int):
         values = [v for m in scene.force_models for v in forces[m]]
         if not all(math.isfinite(v) for v in values) or not math.isfinite(solver.total_mass()):
             return header, rows, time.perf_counter() - start, (t0, t0 + n, "NaN")
+        if not warned:
+            warned = warn_outside_local_region(scene, solver, runner.t)
         x, y = runner.position
         rows.append([runner.t] + [_fmt(v) for v in (x, y, *velocity, *values)])
     return header, rows, time.perf_counter() - start, None

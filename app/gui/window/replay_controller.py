@@ -72,19 +72,16 @@ class ReplayController:
             return False
         if self.replay is not None:
             self.stop()
-        w.bodies.set_editing(False)
-        w.viewport.cancel_drag()
-        w.inputs.replay_started()    # lets go of the body; a device's force fades, its moves are refused
+        w.events.replayStarted.emit()   # before the replay takes over: editing ends, the body is let go
         self.replay = replay
         w.actions.undo.setEnabled(False)
         w.actions.redo.setEnabled(False)
-        self._show(replay)
+        w.events.shownChanged.emit(replay)
         w.actions.pause.setChecked(False)
         w.actions.stop_replay.setEnabled(True)
         w.actions.replay_toolbar.show()
         w.statusBar().clearMessage()   # a passing message (the mouse hint) would be drawn over the label
         self.label.show()
-        w.loop.timer.setInterval(0)
         self.show_progress()
         return True
 
@@ -105,7 +102,7 @@ class ReplayController:
             return
         w = self.w
         w.make_current()
-        self._show(w.sim)
+        w.events.shownChanged.emit(w.sim)
         replay.close()
         w.viewport.banner = None
         self.label.hide()
@@ -113,12 +110,7 @@ class ReplayController:
         w.actions.stop_replay.setEnabled(False)
         w.actions.undo.setEnabled(w.undo.canUndo())
         w.actions.redo.setEnabled(w.undo.canRedo())
-        paused = w.loop.paused
-        w.actions.pause.setChecked(paused)
-        w.loop.timer.setInterval(30 if paused else 0)
-        w.inputs.replay_stopped(paused)
-        w.panel.show_params(w.sim.params, w.loop.display_mode)
-        w.flow.after_rebuild()
+        w.events.replayStopped.emit(w.loop.paused)
         w.statusBar().showMessage("Replay stopped: back to the live tunnel.", 4000)
 
     def close(self):
@@ -126,17 +118,6 @@ class ReplayController:
         if self.replay is not None:
             self.w.make_current()
             self.replay.close()
-
-    def _show(self, model):
-        """Point the viewport and the plot at `model` (live or replay) and draw it."""
-        w = self.w
-        w.viewport.sim = w.plot.sim = model
-        w.viewport.locked = model is self.replay
-        w.viewport.tracers = w.viewport.arrow_forces = None
-        w.loop.forget_last_frame()
-        w.loop.upload_field()
-        w.plot.refresh(force=True)
-        w.viewport.update()
 
     def show_progress(self):
         r = self.replay
