@@ -7,7 +7,8 @@ The region is the operator's linear (von Neumann) stability region, measured by
 solver/validation/linear_stability.py on the numpy reference operators: a uniform flow at
 speed |u| and viscosity nu is stable when no disturbance of any wavelength grows, along every
 direction of the flow (0, 22.5 and 45 degrees; 22.5 is the weakest for TRT, 45 for rr).
-`LINEAR_LIMIT` holds, per operator, the largest such |u| at each tabulated viscosity
+`LINEAR_LIMIT` holds, per operator, the largest such |u| at each tabulated viscosity (an
+operator without a row, KBC, whose entropic gamma is not linearisable at equilibrium, gets BGK's)
 (`python -m feelflow.solver.local_guard` prints and checks the table). A flow whose fastest node
 moves faster than `MARGIN` x that limit at its viscosity has left the region there: the guard
 asks for the smallest tabulated-and-interpolated viscosity whose limit covers it.

@@ -29,7 +29,7 @@ def _window(qtbot, tmp_path, size):
         w.resize(*size)
     w.show()
     qtbot.waitUntil(lambda: w.exercises.exercise is not None, timeout=20000)
-    qtbot.wait(300)   # the docks settle, the tunnel is fitted
+    qtbot.wait(1200)  # the docks settle, the tunnel is fitted, the readouts show the exercise's reference
     return w
 
 
@@ -67,6 +67,8 @@ def test_exercise_opens_readable_without_the_lesson_chooser(qtbot, tmp_path, siz
         assert r.width() >= 0.97 * (vp.width() - COLOUR_BAR_MARGIN)
         assert r.height() >= 0.85 * vp.height(), (r, vp.size())
         assert vp.width() >= 0.6 * w.width()
+        if size is not None:   # the panel fits: the window keeps the size it was given
+            assert (w.width(), w.height()) == size
     finally:
         w.loop.timer.stop()
         w.loop.slow_timer.stop()

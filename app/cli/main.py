@@ -23,6 +23,7 @@ COMMANDS = {
     "session": "inspect, replay or export a recorded session file",
     "exercise": "shape-editing exercises: score a class's shapes, check an exercise file",
     "polar": "an angle-of-attack sweep: C_L and C_D against alpha (CSV and image), C_p along the surface",
+    "screenshots": "the guide's pictures of the window (exercise, probes and units)",
 }
 
 

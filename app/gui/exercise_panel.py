@@ -28,6 +28,8 @@ PARAMETERS = {
 THUMB = QSize(72, 44)
 #: the panel's width in the window (logical pixels): the goal, references and attempts lines wrap to it
 PANEL_WIDTH = 340
+#: the narrowest it gets (the window keeps 1280 pixels with the forces' toolbar below the flow)
+PANEL_MIN_WIDTH = 290
 BAD = "#d03030"
 GOOD = "#208040"
 
@@ -84,7 +86,7 @@ class ScrollingPanel(QScrollArea):
         self.setWidget(panel)
         self.setWidgetResizable(True)
         self.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
-        self.setMinimumWidth(PANEL_WIDTH)
+        self.setMinimumWidth(PANEL_MIN_WIDTH)
 
 
 class ExercisePanel(QWidget):

@@ -16,7 +16,7 @@ from feelflow.app.files import atomic_path, write_text_atomic
 from feelflow.app.gui.polar_views import VIEWS as LIFT_VIEWS, LiftViews
 from feelflow.app.model.power_law import fit_power_law
 from feelflow.app.model import readouts
-from feelflow.app.model.display_units import DisplayUnits
+from feelflow.app.model.display_units import DisplayUnits, si_columns
 from feelflow.app.model.readouts import start_pulse_steps
 from feelflow.app.model.force_history import History
 from feelflow.app.model.simulation import FORCE_MODELS
@@ -25,34 +25,6 @@ from feelflow.app.model.tunnel import TunnelModel
 MODEL_COLOURS = {"momentum_exchange": ((220, 40, 40), (40, 110, 240)),
                  "macroscopic": ((230, 140, 20), (20, 170, 190)),
                  "pressure": ((150, 60, 190), (40, 160, 60))}
-
-
-def si_columns(head: list[str], rows: list[list[str]], units) -> tuple[list[str], list[list[str]]]:
-    """The CSV with SI columns added after the lattice ones: time_s, and for every force
-    (`*_fx`, `*_fy`, `*_drag`, `*_lift`) a `*_N`, every velocity (`body_v*`, `wind_*`,
-    `probe*_u*`, `probe*_speed`) a `*_m_s`, every probe pressure a `*_Pa` (units.physical,
-    solver/units.py PhysicalUnits, for the flow now)."""
-    convert = []
-    for i, name in enumerate(head):
-        if name == "step":
-            convert.append((i, "time_s", units.time))
-        elif name.endswith(("_fx", "_fy", "_drag", "_lift")):
-            convert.append((i, f"{name}_N", units.force))
-        elif name.startswith(("body_v", "wind_")) or (name.startswith("probe") and name.endswith(("_ux", "_uy", "_speed"))):
-            convert.append((i, f"{name}_m_s", units.speed))
-        elif name.startswith("probe") and name.endswith("_p"):
-            convert.append((i, f"{name}_Pa", units.pressure))
-    out_rows = []
-    for row in rows:
-        extra = []
-        for i, _, fn in convert:
-            cell = row[i] if i < len(row) else ""
-            try:
-                extra.append(f"{fn(float(cell)):.8g}" if cell not in ("", "nan") else cell)
-            except ValueError:
-                extra.append("")
-        out_rows.append(row + extra)
-    return head + [name for _, name, _ in convert], out_rows
 
 
 class ForcePlot(QWidget):
@@ -85,6 +57,7 @@ class ForcePlot(QWidget):
         small = self.reference_label.font()
         small.setPointSizeF(small.pointSizeF() * 0.85)
         self.reference_label.setFont(small)
+        self.reference_label.setWordWrap(True)   # a long reference ("the exercise's ...") wraps, the window keeps its width
         self.reference_label.setToolTip("C = 2 F / (\u03c1 U\u00b2 L): U the relative wind's speed, "
                                         "L the reference length")
         bar = QHBoxLayout()

@@ -35,11 +35,17 @@ class ProbePlot(QWidget):
             self.quantity.addItem(text, key)
         self.quantity.currentIndexChanged.connect(lambda _=0: self.refresh(force=True))
         self.hint = QLabel("View > Place probes, then click in the flow")
+        self.hint.setWordWrap(True)
+        self.hint.setMinimumWidth(40)
+        self.quantity.setMinimumContentsLength(8)
+        self.quantity.setSizeAdjustPolicy(QComboBox.AdjustToMinimumContentsLengthWithIcon)
         row.addWidget(self.quantity)
         row.addWidget(self.hint, 1)
         col.addLayout(row)
         self.plot = pg.PlotWidget(background="w")
         self.plot.showGrid(x=True, y=True, alpha=0.3)
+        for ax in ("bottom", "left"):
+            self.plot.getAxis(ax).enableAutoSIPrefix(False)   # the unit is in the label
         self.legend = self.plot.addLegend(offset=(10, 5))
         col.addWidget(self.plot, 1)
         self._curves = []

@@ -48,7 +48,7 @@ def field_is_alive(window) -> tuple[bool, str]:
     if window.backend == "gl":
         nx, ny = sim.config.nx, sim.config.ny
         window.make_current()
-        f = np.frombuffer(sim.solver.field_texture().read(), np.float32).reshape(ny, nx, 4)
+        f = np.frombuffer(sim.field_texture().read(), np.float32).reshape(ny, nx, 4)
     else:
         f = sim.field_rgba()
     if not np.isfinite(f).all():

@@ -239,9 +239,10 @@ class SidePanel(QScrollArea):
             self.lift.setText("\u2013")
             return
         u = self.units
-        if u.is_si:
-            drag, lift = u.force(drag), u.force(lift)
-        d, l_ = force_pair_text(drag, lift)
+        if u.is_si:   # newtons: four significant digits (forces of micronewtons in water)
+            d, l_ = f"{u.force(drag):.4g}", f"{u.force(lift):.4g}"
+        else:
+            d, l_ = force_pair_text(drag, lift)
         self.drag.setText(f"{d} ({'N' if u.is_si else 'lattice units'})")
         self.lift.setText(f"{l_} ({'N' if u.is_si else 'lattice units'})")
 

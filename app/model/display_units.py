@@ -86,3 +86,55 @@ def for_model(choice: UnitsChoice, model) -> DisplayUnits:
         return DisplayUnits(PhysicalUnits(FLUIDS[choice.fluid], choice.size_m, choice.span_m, length, p.wind, p.nu))
     except ValueError:
         return DisplayUnits()
+
+
+def _column_unit(name: str, units: DisplayUnits):
+    """(SI column name, conversion) for a CSV column of lattice values, or None to leave it."""
+    if name == "step":
+        return "time_s", units.time
+    if name.endswith(("_fx", "_fy", "_drag", "_lift")) or name.startswith(("fx_", "fy_")):
+        return f"{name}_N", units.force
+    if name in ("vx", "vy") or name.startswith(("body_v", "wind_")) or \
+            (name.startswith("probe") and name.endswith(("_ux", "_uy", "_speed"))):
+        return f"{name}_m_s", units.speed
+    if name.startswith("probe") and name.endswith("_p"):
+        return f"{name}_Pa", units.pressure
+    if name in ("x", "y"):
+        return f"{name}_m", lambda v: v * units.physical.dx
+    return None
+
+
+def si_columns(head: list[str], rows: list[list], units: DisplayUnits) -> tuple[list[str], list[list]]:
+    """A CSV table with SI columns added after the lattice ones: `time_s` for the step, `*_N`
+    for forces (`*_fx`, `*_fy`, `*_drag`, `*_lift`, `fx_*`, `fy_*`), `*_m_s` for velocities,
+    `*_Pa` for probe pressures, `x_m`, `y_m` for positions (solver/units.py PhysicalUnits)."""
+    convert = [(i, *c) for i, name in enumerate(head) if (c := _column_unit(name, units)) is not None]
+    out_rows = []
+    for row in rows:
+        extra = []
+        for i, _, fn in convert:
+            cell = str(row[i]) if i < len(row) else ""
+            try:
+                extra.append(f"{fn(float(cell)):.8g}" if cell not in ("", "nan") else cell)
+            except ValueError:
+                extra.append("")
+        out_rows.append(list(row) + extra)
+    return list(head) + [name for _, name, _ in convert], out_rows
+
+
+def parse_si(text: str) -> UnitsChoice:
+    """`--si FLUID:SIZE_M[:SPAN_M]` (for example water:0.01 or air:0.05:0.2) as a UnitsChoice;
+    ValueError (one line) for anything else."""
+    parts = str(text).split(":")
+    fluids = ", ".join(FLUIDS)
+    if len(parts) not in (2, 3) or parts[0] not in FLUIDS:
+        raise ValueError(f"--si: give FLUID:SIZE_M[:SPAN_M] with FLUID one of {fluids} (for example water:0.01), "
+                         f"got {text!r}")
+    try:
+        size = float(parts[1])
+        span = float(parts[2]) if len(parts) == 3 else DEFAULT_SPAN_M
+    except ValueError:
+        raise ValueError(f"--si: the body's size and span are lengths in metres, got {text!r}") from None
+    if not (size > 0 and span > 0 and size < 1e6 and span < 1e6):
+        raise ValueError(f"--si: the body's size and span must be positive lengths in metres, got {text!r}")
+    return UnitsChoice(parts[0], size, span)

@@ -150,6 +150,9 @@ class ReplaySimulation:
         c = self.config.collision
         return f"{NAMES.get(c, c)}: as recorded"
 
+    def field_texture(self, vorticity: bool = True):
+        return self.solver.field_texture(vorticity=vorticity)
+
     def field_rgba(self):
         return self.solver.field_rgba()
 

@@ -487,6 +487,9 @@ class Simulation:
         """Which collision operator runs and why, in one line (the status bar's)."""
         return self.operator_for().reason
 
+    def field_texture(self, vorticity: bool = True):
+        return self.solver.field_texture(vorticity=vorticity)
+
     def field_rgba(self) -> np.ndarray:
         return self.solver.field_rgba()
 

@@ -124,7 +124,7 @@ class FrameLoop:
         if mode != "tracers":
             w.viewport.tracers = None
         w.panel.show_params(w.params_now(), mode)
-        if w.shown is not None and w.shown.solver.gl_context is not None:   # vorticity only where shown
+        if w.shown is not None:   # the field again (a gl texture computes the vorticity only where shown)
             w.make_current()
             self.upload_field()
         w.viewport.update()
@@ -138,7 +138,7 @@ class FrameLoop:
         model = w.shown
         if model is None:
             return None
-        texture = model.solver.field_texture(vorticity=self.display_mode == "vorticity")
+        texture = model.field_texture(vorticity=self.display_mode == "vorticity")
         if texture is not None:
             w.viewport.use_texture(texture)
             return None

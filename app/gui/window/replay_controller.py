@@ -89,8 +89,10 @@ class ReplayController:
         """A ReplaySimulation of the file on the window's backend; SessionError (one line)."""
         from feelflow.app.model.replay_simulation import ReplaySimulation
         from feelflow.app.sessions import load_session
+        from feelflow.app.sessions.replay import check_replay_memory
 
         session = load_session(path)
+        check_replay_memory(session, path)   # before any grid is allocated
         w = self.w
         w.make_current()
         return ReplaySimulation(session, w.backend, ctx=w.viewport.ctx)
