@@ -55,10 +55,10 @@ PRESETS = {
                             note="The flow leaves the upper side; watch the lift swing as vortices shed. A 2D "
                                  "flow: a real stalled wing sheds three-dimensional vortices and its lift swings "
                                  "less."),
-    "polar": Lesson("Polar: a NACA 0012 from 0 to 16 degrees, Re 1000", "polar_naca0012.toml", display="pressure",
-                    plot_view="polar", angle_sweep=(0, 2, 4, 6, 8, 10, 12, 14, 16),
-                    note="Each angle is held until C_L and C_D settle, then the nose turns up by 2 degrees; "
-                         "the polar builds up point by point beside the thin-airfoil line 2 pi alpha."),
+    "polar": Lesson("Polar: a NACA 0012 from 0 to 24 degrees, Re 1000", "polar_naca0012.toml", display="pressure",
+                    plot_view="polar", angle_sweep=(0, 2, 4, 6, 8, 10, 12, 16, 20, 24),
+                    note="Each angle is held until C_L and C_D settle, then the nose turns up; the polar builds "
+                         "up point by point beside the thin-airfoil line 2 pi alpha."),
     "seed_protocol": Lesson("The seed's experiment: stopped, with, against the stream", "seed_protocol.toml",
                             hold_still=False,
                             note="Four phases of 2500 steps: stopped, with the stream, stopped, against it."),
