@@ -23,7 +23,7 @@ import stat
 import tempfile
 from contextlib import contextmanager
 
-from feelflow.app.errors import UserError
+from feelflow.app.errors import UserError, shown_path
 
 #: the process umask (read once: os.umask can only be read by setting it)
 _UMASK = os.umask(0o022)
@@ -94,9 +94,9 @@ def check_output(path, option: str = "output", *, inputs=(), others=(), force: b
     outputs), exists and `force` is false, or its folder is missing or not writable. Stale
     temporaries in the folder are removed."""
     path = pathlib.Path(path)
-    label = f"{option}: {str(path)!r}"
+    label = f"{option}: {shown_path(path)!r}"
     if not str(path) or path.name in ("", ".", "..") or "\x00" in str(path):
-        raise OutputError(f"{option}: {str(path)!r} is not a file name")
+        raise OutputError(f"{option}: {shown_path(path)!r} is not a file name")
     for other in inputs:
         if other is not None and _same_file(path, other):
             raise OutputError(f"{label} is an input of this command; it would be destroyed (choose another name)")
@@ -116,13 +116,17 @@ def check_output(path, option: str = "output", *, inputs=(), others=(), force: b
             raise OutputError(f"{label} is not a regular file (a device, pipe or socket); refused")
         if not force:
             raise OutputError(f"{label} already exists; {hint}")
-    folder = _folder(path)
-    if not folder.is_dir():
-        raise OutputError(f"{option}: directory {str(folder)!r} does not exist; cannot write {path.name!r} there")
     if len(path.name.encode()) > 255:
         raise OutputError(f"{label}: the file name is too long")
+    folder = _folder(path)
+    try:
+        folder_is_dir = stat.S_ISDIR(os.stat(folder).st_mode)
+    except (OSError, ValueError):
+        folder_is_dir = False
+    if not folder_is_dir:
+        raise OutputError(f"{option}: directory {shown_path(folder)!r} does not exist; cannot write {shown_path(path.name)!r} there")
     if not os.access(folder, os.W_OK | os.X_OK):
-        raise OutputError(f"{option}: directory {str(folder)!r} is not writable; cannot write {path.name!r} there")
+        raise OutputError(f"{option}: directory {shown_path(folder)!r} is not writable; cannot write {shown_path(path.name)!r} there")
     clean_stale_temporaries(folder)
     return path
 
@@ -203,7 +207,7 @@ def write_or_rescue(path, write, option: str = "output") -> pathlib.Path:
             where = f"the work was saved to {saved} instead"
         except OSError as exc2:
             where = f"and the rescue copy failed too ({exc2.strerror or exc2})"
-        raise OutputError(f"{option}: cannot write {str(path)!r} ({reason}); {where}") from None
+        raise OutputError(f"{option}: cannot write {shown_path(path)!r} ({reason}); {where}") from None
 
 
 def save_json(path, data, option: str = "--json") -> pathlib.Path:
@@ -215,3 +219,20 @@ def save_json(path, data, option: str = "--json") -> pathlib.Path:
 def save_text(path, text: str, option: str = "output") -> pathlib.Path:
     """`write_text_atomic` through `write_or_rescue`."""
     return write_or_rescue(path, lambda target: write_text_atomic(target, text), option)
+
+
+def save_bytes(path, data: bytes, option: str = "output") -> pathlib.Path:
+    """`write_bytes_atomic` through `write_or_rescue`."""
+    return write_or_rescue(path, lambda target: write_bytes_atomic(target, data), option)
+
+
+def save_csv(path, header, rows, option: str = "--out") -> pathlib.Path:
+    """A CSV file (`header`, then `rows`) written atomically through `write_or_rescue`."""
+    import csv
+    import io
+
+    buf = io.StringIO(newline="")
+    writer = csv.writer(buf)
+    writer.writerow(header)
+    writer.writerows(rows)
+    return save_text(path, buf.getvalue(), option)

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from feelflow.app.errors import UserError
-from feelflow.solver.backend import BACKENDS, BackendError, create_solver
+from feelflow.solver.backend import BACKENDS, BackendError, create_solver, needs_gl_context
 
 _gl_context = None
 
@@ -34,9 +34,8 @@ def make_solver(backend: str, config):
     """Create the named backend for `config`; UserError (one line) when it cannot run here."""
     if backend not in BACKENDS:
         raise UserError(f"--backend: must be one of {', '.join(sorted(BACKENDS))}, got {backend!r}")
-    kwargs = {"ctx": gl_context()} if backend == "gl" else {}
     try:
-        return create_solver(backend, config, **kwargs)
+        return create_solver(backend, config, ctx=gl_context() if needs_gl_context(backend) else None)
     except ModuleNotFoundError as exc:
         module = BACKENDS[backend].split(":")[0]
         if exc.name != module:

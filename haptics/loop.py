@@ -1,7 +1,7 @@
 """The 1 kHz force loop, in its own thread (never the GUI thread).
 
 Every tick: read the device pose (non-blocking), map it into the tunnel, move the body through
-the virtual coupling (haptics.coupling), turn the solver's latest force samples into a smooth
+the virtual coupling (haptics.virtual_coupling), turn the solver's latest force samples into a smooth
 force (haptics.shaping), apply the safety gain (haptics.safety), clamp to the device maximum and
 send it. The app talks to it only through thread-safe calls:
 
@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from feelflow.haptics.coupling import TunnelMap, VirtualCoupling
+from feelflow.haptics.virtual_coupling import TunnelMap, VirtualCoupling
 from feelflow.haptics.drivers.base import clamp_force
 from feelflow.haptics.errors import DeviceDisconnected, DeviceError
 from feelflow.haptics.safety import SafetyConfig, SafetyGate

@@ -7,7 +7,6 @@ Every I/O error becomes `DeviceDisconnected`, so the force loop has one thing to
 from __future__ import annotations
 
 import os
-import time
 
 from feelflow.haptics.errors import DeviceDisconnected, DeviceError
 from feelflow.haptics.permissions import hid_fix, is_permission_error, serial_fix
@@ -70,20 +69,6 @@ class SerialTransport:
             return self._port.read(n) if n else b""
         except (self._serial_exc, OSError, TypeError, AttributeError) as exc:
             raise DeviceDisconnected(f"serial port {self.name} lost: {exc}") from None
-
-    def read_exact(self, n: int, timeout: float) -> bytes:
-        """Up to n bytes, waiting at most `timeout` seconds (fewer if it runs out)."""
-        out = bytearray()
-        deadline = time.monotonic() + timeout
-        while len(out) < n:
-            chunk = self.read_available()
-            if chunk:
-                out += chunk
-                continue
-            if time.monotonic() >= deadline:
-                break
-            time.sleep(0.0002)
-        return bytes(out)
 
     def reset_input(self) -> None:
         try:

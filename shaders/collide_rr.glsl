@@ -3,6 +3,7 @@
 // variant RR (included by lbm_step.glsl); the same operator and terms as the numpy reference
 // solver/regularised.py (Latt & Chopard 2006; Malaspinas 2015; Coreixas et al. 2017;
 // Smagorinsky after Hou et al. 1995; Guo, Zheng & Shi 2002 forcing):
+//   feq: the third-order Hermite equilibrium, with 27/2 rho (H_xxy ux^2 uy + H_xyy ux uy^2);
 //   n = f - feq projected on the Hermite polynomials up to order 2 plus the recursive order-3
 //   terms a_xxy = 2 ux a_xy + uy a_xx, a_xyy = 2 uy a_xy + ux a_yy;
 //   f* = feq + (1 - omega) n_reg + (1 - omega / 2) S.
@@ -18,11 +19,14 @@ void collide_rr(inout float f[9], float drho, float deq, float rho, float ux, fl
     float pxx = 0.0;
     float pyy = 0.0;
     float pxy = 0.0;
+    float eq_xxy = rho * ux * uy * ux;
+    float eq_xyy = rho * ux * uy * uy;
     for (int i = 0; i < Q; ++i) {
         float cx = float(C[i].x);
         float cy = float(C[i].y);
         float cu = 3.0 * (cx * ux + cy * uy);
-        feq[i] = W[i] * (deq + rho * (cu + 0.5 * cu * cu - usq));
+        float eq3 = 13.5 * ((cx * cx - 1.0 / 3.0) * cy * eq_xxy + (cy * cy - 1.0 / 3.0) * cx * eq_xyy);
+        feq[i] = W[i] * (deq + rho * (cu + 0.5 * cu * cu - usq) + eq3);
         float n = f[i] - feq[i];
         a0 += n;
         a1x += cx * n;

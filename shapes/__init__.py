@@ -4,11 +4,12 @@ Qt-free and solver-free (numpy only). Geometry in lattice units, angles in radia
 """
 from feelflow.shapes.base import BodyRaster, Shape, ShapeError
 from feelflow.shapes.cylinder import Cylinder
+from feelflow.shapes.naca import NacaAirfoil
 from feelflow.shapes.polygon import FlatPlate, HalfAirfoil, Polygon, PolygonalShape, Wedge
-from feelflow.shapes.io import from_dict, load_shape, save_shape, to_dict
+from feelflow.shapes.io import from_dict, to_dict
 from feelflow.shapes.raster import rasterise
 
 __all__ = [
     "BodyRaster", "Shape", "ShapeError", "Cylinder", "Polygon", "PolygonalShape", "FlatPlate",
-    "Wedge", "HalfAirfoil", "rasterise", "from_dict", "to_dict", "save_shape", "load_shape",
+    "Wedge", "HalfAirfoil", "NacaAirfoil", "rasterise", "from_dict", "to_dict",
 ]

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import importlib
 from abc import ABC, abstractmethod
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -54,10 +55,82 @@ def physical_density_deviation(config: FlowConfig) -> float:
     return min(0.9, max(DENSITY_DEVIATION, 2.0 * config.mach_limit))
 
 
+@runtime_checkable
+class FlowSolver(Protocol):
+    """What the app needs of a flow, whoever runs it: every backend (`Solver`) and the app's
+    driver (app/sessions/driver.py `SessionSolver`) implement it, member by member
+    (tests/test_solver_interface.py checks the signatures). Lattice units."""
+
+    config: FlowConfig       # the flow's configuration (grid, Mach limit, collision)
+    name: str                # the backend's registry name
+    time: int                # steps done
+    speed_capped: bool       # the last body motion or inflow was reduced to config.max_speed
+
+    @property
+    def gl_context(self) -> Any:
+        """The moderngl.Context the flow runs on, or None (a CPU backend)."""
+        ...
+
+    def step(self, n: int = 1) -> None:
+        """Advance n steps; raise SolverDiverged when the flow blows up."""
+        ...
+
+    def forces(self) -> dict[str, tuple[float, float]]:
+        """Mean force per enabled model over the last `step(n)` call."""
+        ...
+
+    def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
+        """Place the body (a `shapes` shape at its pose, or None) moving at `velocity`."""
+        ...
+
+    def enable_force_models(self, names) -> None:
+        """Compute only these force models (solver/forces)."""
+        ...
+
+    def set_inflow_speed(self, speed: float) -> None:
+        """The inlet's speed from the next step on (capped at config.max_speed)."""
+        ...
+
+    def macroscopic(self):
+        """(rho, ux, uy), each (ny, nx) float64."""
+        ...
+
+    def distributions(self) -> np.ndarray:
+        """Full post-collision populations (9, ny, nx) float64."""
+        ...
+
+    def inlet_reference(self) -> np.ndarray | None:
+        """The quiet inlet's reference (ny,), or None without a quiet inlet."""
+        ...
+
+    def field_rgba(self) -> np.ndarray:
+        """(ny, nx, 4) float32: rho, ux, uy, vorticity, for drawing on the CPU side."""
+        ...
+
+    def field_texture(self, vorticity: bool = True) -> Any:
+        """The same field as a texture on `gl_context` (computed on the GPU), or None where the
+        flow has no texture (draw `field_rgba` instead)."""
+        ...
+
+    def check_physical(self) -> None:
+        """Raise SolverDiverged when the flow has left the physical range."""
+        ...
+
+    def total_mass(self) -> float:
+        """sum f over the grid (a run's check that the flow is still finite)."""
+        ...
+
+    def close(self) -> None:
+        """Release what the flow holds; unusable after."""
+        ...
+
+
 class Solver(ABC):
-    """A D2Q9 lattice with at most one rigid body (docs/science/algorithm.md)."""
+    """A D2Q9 lattice with at most one rigid body (docs/science/algorithm.md); a `FlowSolver`."""
 
     name: str = "abstract"
+    config: FlowConfig    # set in __init__, validated
+    time: int             # steps done
     #: True when the last set_body motion (or the inflow) was reduced to config.max_speed
     speed_capped: bool = False
 
@@ -71,6 +144,11 @@ class Solver(ABC):
         self.body = None      # solver.body.BodyState of the body, or None
         self._models = {}     # enabled force models by name
         self._forces: dict[str, tuple[float, float]] = {}  # their means over the last step(n)
+
+    @property
+    def gl_context(self):
+        """The moderngl.Context the backend draws on (None: it runs on the CPU)."""
+        return None
 
     # --- inflow ---------------------------------------------------------------
     def set_inflow_speed(self, speed: float) -> None:
@@ -135,6 +213,11 @@ class Solver(ABC):
         """Mean force per model over the last `step(n)` call, lattice units."""
         return dict(self._forces)
 
+    @property
+    def force_models(self) -> dict:
+        """The enabled force models (solver/forces instances) by name."""
+        return dict(self._models)
+
     # --- fields ---------------------------------------------------------------
     @abstractmethod
     def shifted_distributions(self) -> np.ndarray:
@@ -184,6 +267,19 @@ class Solver(ABC):
         per = self.config.velocity_divisor(rho)
         return rho, jx / per, jy / per
 
+    def field_rgba(self) -> np.ndarray:
+        """(ny, nx, 4) float32: rho, ux, uy and the vorticity d uy/dx - d ux/dy (central
+        differences), from `macroscopic`."""
+        rho, ux, uy = self.macroscopic()
+        out = np.empty(rho.shape + (4,), np.float32)
+        out[..., 0], out[..., 1], out[..., 2] = rho, ux, uy
+        out[..., 3] = np.gradient(uy, axis=1) - np.gradient(ux, axis=0)
+        return out
+
+    def field_texture(self, vorticity: bool = True):
+        """No texture on a CPU backend: draw `field_rgba` (the gl backend returns its texture)."""
+        return None
+
     def total_mass(self) -> float:
         """sum f over the grid, accumulated in float64 on the shifted storage."""
         from feelflow.solver.lattice import RHO0
@@ -217,10 +313,21 @@ class Solver(ABC):
         """Release resources (GL objects); the solver is unusable after."""
 
 
-def create_solver(backend: str, config: FlowConfig, **kwargs) -> Solver:
-    """Instantiate a backend by name; `gl` needs `ctx=` (a moderngl.Context)."""
+#: the backends that draw on a GL context handed to them (`create_solver`'s `ctx`)
+GL_CONTEXT_BACKENDS = frozenset({"gl"})
+
+
+def needs_gl_context(backend: str) -> bool:
+    """Whether `backend` runs on a moderngl.Context the caller hands to `create_solver`."""
+    return backend in GL_CONTEXT_BACKENDS
+
+
+def create_solver(backend: str, config: FlowConfig, ctx=None) -> Solver:
+    """Instantiate a backend by name. Every caller passes the GL context it has (or None) the
+    same way: a backend that draws on one (`needs_gl_context`) gets it and refuses None, the
+    others ignore it."""
     if backend not in BACKENDS:
         raise BackendError(f"unknown backend {backend!r}; choose one of {sorted(BACKENDS)}")
     module_name, cls_name = BACKENDS[backend].split(":")
     cls = getattr(importlib.import_module(module_name), cls_name)
-    return cls(config, **kwargs)
+    return cls(config, ctx=ctx) if needs_gl_context(backend) else cls(config)

@@ -87,7 +87,7 @@ class FlowConfig:
             need(isinstance(v, int) and 8 <= v <= 8192, key, f"must be an integer in 8..8192, got {v!r}")
         need(math.isfinite(self.nu) and self.nu > 0, "nu", f"must be a positive number, got {self.nu!r}")
         need(self.tau > 0.5 + 1e-6, "nu", "too small: tau = 3 nu + 1/2 must exceed 1/2")
-        need(self.tau < 10, "nu", f"too large (tau = {self.tau:.2f} > 10): lower the viscosity or raise the resolution")
+        need(self.tau < 10, "nu", f"too large (tau = {self.tau:.4g} > 10): lower the viscosity or raise the resolution")
         need(self.collision in COLLISIONS, "collision", f"must be one of {COLLISIONS}, got {self.collision!r}")
         need(self.equilibrium in EQUILIBRIA, "equilibrium", f"must be one of {EQUILIBRIA}, got {self.equilibrium!r}")
         need(math.isfinite(self.smagorinsky) and 0.0 <= self.smagorinsky <= 0.5, "smagorinsky",
@@ -101,7 +101,7 @@ class FlowConfig:
         need(self.inflow_profile in PROFILES, "inflow_profile", f"must be one of {PROFILES}, got {self.inflow_profile!r}")
         need(0 < self.mach_limit <= 0.5, "mach_limit", f"must be in (0, 0.5], got {self.mach_limit!r}")
         need(math.isfinite(self.inflow_speed) and abs(self.inflow_speed) <= self.max_speed, "inflow_speed",
-             f"{self.inflow_speed!r} exceeds the Mach limit: |U| <= {self.max_speed:.4f} (Ma {self.mach_limit})")
+             f"{self.inflow_speed:.6g} exceeds the Mach limit: |U| <= {self.max_speed:.4f} (Ma {self.mach_limit})")
         need(isinstance(self.inflow_ramp_steps, int) and self.inflow_ramp_steps >= 0, "inflow_ramp_steps",
              "must be a non-negative integer")
         need(isinstance(self.sponge_cells, int) and 0 <= self.sponge_cells < self.nx // 2, "sponge_cells",

@@ -566,6 +566,11 @@ class GLSolver(Solver):
                      body_force=tuple(float(v) for v in self.config.body_force))
         return prog, tex, fbo, vao
 
+    @property
+    def gl_context(self):
+        """The moderngl.Context handed in (Solver.gl_context)."""
+        return self.ctx
+
     def close(self) -> None:
         for obj in [*(o for pair in self._vaos.values() for o in pair), *self._objects, *self._programs.values()]:
             obj.release()

@@ -24,11 +24,14 @@ CS2 = 1.0 / 3.0
 RHO0 = 1.0
 
 
-def equilibrium(rho, ux, uy, incompressible: bool = False):
+def equilibrium(rho, ux, uy, incompressible: bool = False, order: int = 2):
     """Second-order equilibrium f_i^eq (seed eq. 9), shape (9, *rho.shape).
 
     f_i^eq = w_i rho (1 + 3 c.u + 9/2 (c.u)^2 - 3/2 u.u); with `incompressible` He & Luo's
     (1997) f_i^eq = w_i (rho + RHO0 (3 c.u + 9/2 (c.u)^2 - 3/2 u.u)) (docs/science/algorithm.md, step 3).
+    `order` 3 adds the third-order Hermite terms D2Q9 holds, the equilibrium of the
+    recursive-regularised operator (solver/regularised.py; Malaspinas 2015, eq. 11):
+    + w_i 27/2 rho (H_xxy ux^2 uy + H_xyy ux uy^2), H_xxy = c_x^2 c_y - c_y / 3, H_xyy = c_x c_y^2 - c_x / 3.
     """
     rho = np.asarray(rho)
     ux = np.asarray(ux)
@@ -38,9 +41,14 @@ def equilibrium(rho, ux, uy, incompressible: bool = False):
     cx, cy, w = C[:, 0].reshape(lead), C[:, 1].reshape(lead), W.reshape(lead)  # as c_i, w_i alone
     usq = 1.5 * (ux * ux + uy * uy)
     cu = 3.0 * (cx * ux + cy * uy)
+    third = 0.0
+    if order == 3:
+        third = 13.5 * ux * uy * ((cx * cx - 1.0 / 3.0) * cy * ux + (cy * cy - 1.0 / 3.0) * cx * uy)
+    elif order != 2:
+        raise ValueError(f"equilibrium order {order!r}: 2 or 3")
     if incompressible:
-        return (w * (rho + RHO0 * (cu + 0.5 * cu * cu - usq))).astype(dtype, copy=False)
-    return (w * rho * (1.0 + cu + 0.5 * cu * cu - usq)).astype(dtype, copy=False)
+        return (w * (rho + RHO0 * (cu + 0.5 * cu * cu - usq + third))).astype(dtype, copy=False)
+    return (w * rho * (1.0 + cu + 0.5 * cu * cu - usq + third)).astype(dtype, copy=False)
 
 
 def glsl_constants() -> str:

@@ -2,16 +2,33 @@
 
 Regularisation (Latt & Chopard, Math. Comput. Simul. 72 (2006) 165) replaces the
 non-equilibrium part n_i = f_i - f^eq_i by its projection on the Hermite polynomials up to
-second order before it is relaxed; the recursive variant (Malaspinas, arXiv:1505.06900 (2015);
-Coreixas et al., Phys. Rev. E 96 (2017) 033306) adds the third-order terms the D2Q9 lattice
-holds, built from the second-order ones: a_xxy = 2 u_x a_xy + u_y a_xx, a_xyy = 2 u_y a_xy + u_x a_yy.
+second order before it is relaxed; the recursive variant (Malaspinas, arXiv:1505.06900 (2015),
+eqs. 11-13 and 31; Coreixas et al., Phys. Rev. E 96 (2017) 033306, sec. III and Appendix A)
+keeps every Hermite polynomial the D2Q9 lattice holds up to third order, H_xxy and H_xyy
+(H_xxx = c_x^3 - c_x vanishes on D2Q9), in the equilibrium and in the non-equilibrium part:
+
+* the equilibrium is the third-order Hermite expansion of the Maxwellian (Malaspinas eq. 11 with
+  a^(3)eq = rho u u u):
+      f^eq_i = w_i [rho + 3 rho c.u + 9/2 rho (H_xx ux^2 + H_yy uy^2 + 2 H_xy ux uy)
+                    + 27/2 rho (H_xxy ux^2 uy + H_xyy ux uy^2)];
+  the third-order terms cancel the ux^2 uy and ux uy^2 errors of the D2Q9 momentum flux's
+  divergence, so a shear wave advected across the grid decays at the viscosity (Galilean
+  invariance; tests/test_collision_rr.py) and the uniform flow stays linearly stable to faster
+  winds (solver/validation/linear_stability.py);
+* the third-order non-equilibrium coefficients come recursively from the second-order ones
+  (Malaspinas eq. 31): a_xxy = 2 u_x a_xy + u_y a_xx, a_xyy = 2 u_y a_xy + u_x a_yy.
+
 With H_xx = c_x^2 - 1/3, H_xy = c_x c_y, H_xxy = c_x^2 c_y - c_y / 3 (and symmetric ones):
     n_i^reg = w_i [a0 + 3 c.a1 + 9/2 (H_xx a_xx + H_yy a_yy + 2 H_xy a_xy) + 27/2 (H_xxy a_xxy + H_xyy a_xyy)]
     f*_i = f^eq_i + (1 - omega) n_i^reg + (1 - omega / 2) S_i        (Guo, Zheng & Shi 2002)
+The third-order equilibrium leaves the moments up to second order unchanged (H_xxy is orthogonal
+to every lower Hermite polynomial under the D2Q9 weights), so a0, a1 and a2 are read from f as
+for the second-order equilibrium.
 The moments up to second order relax exactly as BGK's (a0, a1 are kept: they are non-zero only
 in the sponge's absorbing layer and by the Guo half-force shift), so the hydrodynamics is BGK's;
 the ghost moments, which carry the instability near tau = 1/2, are set from the hydrodynamic ones.
-The equilibrium is the one of solver/collision.py (compressible, or He & Luo's incompressible).
+Up to second order the equilibrium is the one of solver/collision.py (compressible, or He &
+Luo's incompressible, where the velocity terms take RHO0 in place of rho).
 
 Smagorinsky (Hou et al., J. Comput. Phys. 118 (1995) 329; Malaspinas & Sagaut, J. Fluid Mech.
 700 (2012) 514): the node's relaxation time grows with the non-equilibrium stress |Pi| =
@@ -66,7 +83,7 @@ class RegularisedCollider:
 
     def _block(self, f, target) -> float:
         """The moments of n come from those of f: sum f^eq = deq, sum c f^eq = rho u,
-        sum c c f^eq = deq / 3 I + rho u u (the second-order equilibrium on D2Q9)."""
+        sum c c f^eq = deq / 3 I + rho u u (the third-order terms add nothing to these)."""
         f0, f1, f2, f3, f4, f5, f6, f7, f8 = f
         drho = f0 + f1 + f2 + f3 + f4 + f5 + f6 + f7 + f8
         rho = RHO0 if self.incompressible else drho + RHO0
@@ -110,15 +127,24 @@ class RegularisedCollider:
         # the direction-independent parts: w_i [deq - rho usq + (1 - omega)(a0 - 3/2 (a_xx + a_yy))] / w_i
         base = deq - rho * usq
         reg0 = a0 - 1.5 * (axx + ayy)
+        # third order: the equilibrium's rho ux^2 uy, rho ux uy^2 and the recursive non-equilibrium
+        # a_xxy, a_xyy share the Hermite polynomials H_xxy, H_xyy
+        rho_uxy = rho * ux * uy
+        eq_xxy = rho_uxy * ux
+        eq_xyy = rho_uxy * uy
         for i in range(9):
             cx, cy = float(C[i, 0]), float(C[i, 1])
             cu = 3.0 * (cx * ux + cy * uy) if (cx or cy) else None
             feq = base if cu is None else base + rho * (cu + 0.5 * cu * cu)
             reg = reg0
             if cx:
-                reg = reg + 3.0 * cx * a1x + 4.5 * axx + 13.5 * (cy * cy - 1.0 / 3.0) * cx * axyy
+                hxyy = 13.5 * (cy * cy - 1.0 / 3.0) * cx      # 27/2 H_xyy
+                feq = feq + hxyy * eq_xyy
+                reg = reg + 3.0 * cx * a1x + 4.5 * axx + hxyy * axyy
             if cy:
-                reg = reg + 3.0 * cy * a1y + 4.5 * ayy + 13.5 * (cx * cx - 1.0 / 3.0) * cy * axxy
+                hxxy = 13.5 * (cx * cx - 1.0 / 3.0) * cy      # 27/2 H_xxy
+                feq = feq + hxxy * eq_xxy
+                reg = reg + 3.0 * cy * a1y + 4.5 * ayy + hxxy * axxy
             if cx and cy:
                 reg = reg + 9.0 * cx * cy * pxy
             out = W[i] * (feq + keep_neq * reg)

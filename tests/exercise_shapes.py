@@ -10,7 +10,8 @@ TINY = "tests/data/exercises/tiny.toml"
 def make_class(folder, n: int = 30) -> list:
     """`n` distinct valid shapes for the tiny exercise (6-cell frontal height): wedges of
     several lengths both ways round, cylinders, and polygons with a blunt or pointed nose."""
-    from feelflow.shapes import Cylinder, Polygon, Wedge, save_shape
+    from feelflow.app.shape_files import save_shape
+    from feelflow.shapes import Cylinder, Polygon, Wedge
 
     folder.mkdir(parents=True, exist_ok=True)
     shapes = []
@@ -34,7 +35,8 @@ def make_class(folder, n: int = 30) -> list:
 
 def make_broken(folder) -> dict:
     """Broken files: name -> a fragment of the reason the grading must give."""
-    from feelflow.shapes import Cylinder, FlatPlate, save_shape
+    from feelflow.app.shape_files import save_shape
+    from feelflow.shapes import Cylinder, FlatPlate
 
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "not_json.json").write_text("{ this is not json")

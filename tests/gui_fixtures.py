@@ -44,7 +44,7 @@ def window(qtbot, tmp_path):
 
 def solid_mask(sim):
     """The solver's solid-node mask now (a copy)."""
-    return sim.solver.body.solid.copy()
+    return sim.solver.solver.body.solid.copy()
 
 
 def wheel(window, notches: int):

@@ -45,7 +45,7 @@ def test_power_law_fit_recovers_the_exponent():
 
 
 def test_history_drag_and_lift_are_along_and_across_the_relative_wind():
-    from feelflow.app.model.simulation import History
+    from feelflow.app.model.force_history import History
 
     h = History()
     h.add(1, (0.0, 0.0), (0.05, 0.0), {"m": (2.0, 1.0)})

@@ -8,12 +8,25 @@ import json
 import pytest
 
 from feelflow.app.cli.main import main as cli_main
-from feelflow.app.model.backend_choice import (JsonFileStore, MemoryStore, choice_key, choose_backend,
+from feelflow.app.model.backend_choice import (JsonFileStore, choice_key, choose_backend,
                                                time_backend)
 from feelflow.solver.backend import create_solver
 from feelflow.solver.config import FlowConfig
 
 CFG = FlowConfig(nx=64, ny=32, nu=0.02, dtype="float32", inflow_ramp_steps=20)
+
+
+class MemoryStore:
+    """A ChoiceStore (app/model/backend_choice.py) in a dict."""
+
+    def __init__(self):
+        self.values: dict[str, str] = {}
+
+    def get(self, key: str) -> str | None:
+        return self.values.get(key)
+
+    def set(self, key: str, value: str) -> None:
+        self.values[key] = value
 
 
 class Counting:

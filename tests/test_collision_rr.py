@@ -7,7 +7,13 @@ backend without the operator refuses it with a ConfigError).
 - the Smagorinsky eddy viscosity adds C^2 |S| to it (the closure's own formula), nothing at C -> 0;
 - gl equals numpy to float32 rounding in a tunnel with the sponge, its absorbing layer and a
   moving, spinning body (the moving-wall and refill terms), and in a forced periodic box;
-- at U / nu = 50 the hard case TRT cannot hold (the shaken cylinder) stays bounded with rr.
+- at U / nu = 50 the hard case TRT cannot hold (the shaken cylinder) stays bounded with rr;
+- what makes rr rr, on every backend: one collision of a uniform non-equilibrium state equals the
+  Hermite definition written independently here (third-order equilibrium rho ux^2 uy, rho ux uy^2
+  and the recursive non-equilibrium a_xxy, a_xyy); a shear wave advected at U = 0.15 decays at
+  the viscosity (Galilean invariance, which the third-order equilibrium buys); the linear
+  stability limit of the uniform flow is the published one (Coreixas et al. 2017).
+  Deleting the third-order equilibrium fails all three; deleting the recursive terms fails the first.
 """
 from __future__ import annotations
 
@@ -22,6 +28,8 @@ from feelflow.shapes import Cylinder
 from feelflow.solver.config import ConfigError, FlowConfig
 from feelflow.solver.lattice import equilibrium
 from feelflow.solver.validation import stability
+
+from solver_backends import BACKENDS as ALL_BACKENDS
 
 BACKENDS = ["numpy", pytest.param("gl", marks=pytest.mark.gl)]
 
@@ -146,3 +154,110 @@ def test_the_chooser_takes_trt_where_it_holds_rr_beyond_and_keeps_a_named_one():
     assert choose(0.05, 0.0001, 20).collision == "rr"                  # beyond both: the most stable
     for c in (low, high):
         assert "\n" not in c.reason and c.reason.startswith(("TRT", "regularised BGK"))
+
+
+# --- what is specific to rr: the third-order Hermite terms, on every backend -------------------
+
+def _hermite_rr(f, nu, third_order_equilibrium=True, recursive=True):
+    """One recursive-regularised collision of the populations f (9,), written from the Hermite
+    tensors (Malaspinas 2015 eqs. 11, 31; Coreixas et al. 2017 sec. III), independently of
+    solver/regularised.py: H^(n) as full tensors, f^eq to third order, n^reg from a^(2)neq and
+    a^(3)neq_abc = u_a a_bc + u_b a_ac + u_c a_ab. The flags drop the rr-specific terms (to show
+    the test sees them)."""
+    from feelflow.solver.lattice import C, W
+
+    c = C.astype(float)
+    cs2 = 1.0 / 3.0
+    d = np.eye(2)
+    h2 = np.einsum("ia,ib->iab", c, c) - cs2 * d
+    h3 = (np.einsum("ia,ib,ic->iabc", c, c, c) - cs2 * (np.einsum("ia,bc->iabc", c, d)
+          + np.einsum("ib,ac->iabc", c, d) + np.einsum("ic,ab->iabc", c, d)))
+    rho = f.sum()
+    u = c.T @ f / rho
+    a2eq = rho * np.einsum("a,b->ab", u, u)
+    a3eq = rho * np.einsum("a,b,c->abc", u, u, u) * third_order_equilibrium
+    feq = W * (rho + c @ (rho * u) / cs2 + np.einsum("iab,ab->i", h2, a2eq) / (2 * cs2 ** 2)
+               + np.einsum("iabc,abc->i", h3, a3eq) / (6 * cs2 ** 3))
+    a2 = np.einsum("iab,i->ab", h2, f - feq)
+    a3 = np.einsum("a,bc->abc", u, a2) + np.einsum("b,ac->abc", u, a2) + np.einsum("c,ab->abc", u, a2)
+    a3 = a3 * recursive
+    nreg = W * (np.einsum("iab,ab->i", h2, a2) / (2 * cs2 ** 2) + np.einsum("iabc,abc->i", h3, a3) / (6 * cs2 ** 3))
+    omega = 1.0 / (3.0 * nu + 0.5)
+    return feq + (1.0 - omega) * nreg
+
+
+@pytest.mark.parametrize("backend", ALL_BACKENDS)
+def test_one_collision_is_the_third_order_hermite_definition(backend, request):
+    """A uniform state in a periodic box streams onto itself, so one step is one collision: every
+    node must hold _hermite_rr(f). The state moves fast (u = (0.09, -0.07)) and is far from
+    equilibrium, so dropping the third-order equilibrium or the recursive terms moves f* by over
+    a hundred times the tolerance (asserted)."""
+    from feelflow.solver.lattice import W
+
+    nu, tol = 0.01, 2e-6
+    rng = np.random.default_rng(7)
+    f0 = equilibrium(np.array(1.02), np.array(0.09), np.array(-0.07)) + 0.05 * W * rng.standard_normal(9)
+    expected = _hermite_rr(f0, nu)
+    cfg = FlowConfig(nx=8, ny=8, nu=nu, collision="rr", dtype="float32", x_boundary="periodic",
+                     y_boundary="periodic", inflow_speed=0.0).validate()
+    s = make_solver(backend, cfg, request)
+    s.set_distributions(np.broadcast_to(f0[:, None, None], (9, 8, 8)).copy())
+    s.step(1)
+    got = s.distributions().astype(np.float64)
+    s.close()
+    scale = np.abs(expected).max()
+    err = float(np.abs(got - expected[:, None, None]).max() / scale)
+    without_eq3 = float(np.abs(_hermite_rr(f0, nu, third_order_equilibrium=False) - expected).max() / scale)
+    without_rec = float(np.abs(_hermite_rr(f0, nu, recursive=False) - expected).max() / scale)
+    print(f"\n  {backend}: max |f* - Hermite| / max f* = {err:.1e}; without the third-order "
+          f"equilibrium {without_eq3:.1e}, without the recursive terms {without_rec:.1e}", end="")
+    assert min(without_eq3, without_rec) > 100 * tol
+    assert err < tol
+
+
+def _advected_shear_wave(backend, request, speed, nu=0.01, n=32, steps=600, settle=100, amp=0.005):
+    """nu_eff of u_y = amp sin(k x) carried along x at `speed` through a periodic box: the
+    modulus of the mode's complex amplitude decays as exp(-nu k^2 t) whatever the speed
+    (Galilean invariance of the Navier-Stokes equations)."""
+    cfg = FlowConfig(nx=n, ny=8, nu=nu, collision="rr", dtype="float64", x_boundary="periodic",
+                     y_boundary="periodic", inflow_speed=0.0).validate()
+    s = make_solver(backend, cfg, request)
+    k = 2 * math.pi / n
+    x = np.ones((8, 1)) * np.arange(n, dtype=float)[None, :]
+    s.set_distributions(equilibrium(np.ones_like(x), np.full_like(x, speed), amp * np.sin(k * x), order=3))
+    mode = np.exp(-1j * k * x)
+
+    def amplitude():
+        return abs(complex((s.macroscopic()[2] * mode).sum()))
+
+    s.step(settle)
+    a0 = amplitude()
+    s.step(steps)
+    a1 = amplitude()
+    s.close()
+    return -math.log(a1 / a0) / (k * k * steps)
+
+
+@pytest.mark.parametrize("backend", ALL_BACKENDS)
+def test_a_shear_wave_advected_fast_decays_at_the_viscosity(backend, request):
+    """At U = 0.15 (Ma 0.26) D2Q9's second-order equilibrium misses rho ux^2 uy in the momentum
+    flux's divergence and the wave decays at about nu (1 - 3 U^2 / (...)); the third-order
+    equilibrium restores nu (measured: docs/science/collision-operators.md)."""
+    nu = 0.01
+    rest = _advected_shear_wave(backend, request, 0.0, nu)
+    fast = _advected_shear_wave(backend, request, 0.15, nu)
+    print(f"\n  {backend}: nu_eff at rest {rest:.6f}, at U 0.15 {fast:.6f} (nu {nu})", end="")
+    assert rest == pytest.approx(nu, rel=0.01)
+    assert fast == pytest.approx(nu, rel=0.01)
+
+
+def test_linear_stability_limit_is_the_third_order_one():
+    """The fastest uniform flow (along the diagonal, the weakest direction) in which no disturbance
+    grows, from the Jacobian of the numpy reference operator (solver/validation/linear_stability.py):
+    0.272 at nu 0.001 with the third-order equilibrium, 0.172 with the second-order one
+    (Coreixas et al. 2017, Fig. 5 region for D2Q9 rr with the full equilibrium)."""
+    from feelflow.solver.validation.linear_stability import max_stable_speed
+
+    u = max_stable_speed("rr", 0.001, 45.0, tol=4e-3, k_points=32)
+    print(f"\n  rr nu 0.001, 45 deg: max stable |u| {u:.3f}", end="")
+    assert 0.25 < u < 0.30

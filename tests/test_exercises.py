@@ -256,7 +256,7 @@ def test_same_shape_scores_the_same_digits_twice(tiny):
 
 
 def test_reference_reaches_its_recorded_score(tiny):
-    from feelflow.shapes.io import load_shape
+    from feelflow.app.shape_files import load_shape
 
     ref = tiny.references[0]
     r = scoring.score_shape(tiny, load_shape(ref.path))

@@ -138,7 +138,7 @@ KILL_CHILD = r"""
 import sys, pathlib
 from feelflow.app.files import write_bytes_atomic
 from feelflow.shapes.cylinder import Cylinder
-from feelflow.shapes.io import save_shape
+from feelflow.app.shape_files import save_shape
 folder = pathlib.Path(sys.argv[1])
 k = 0
 print("ready", flush=True)
@@ -154,7 +154,7 @@ def test_kill_9_during_writes_leaves_old_or_new_file_and_the_next_start_removes_
     """A writer killed with SIGKILL at random moments (seeded): each file is always whole (one
     write's bytes throughout; a shape file that loads), and the next write in that folder
     removes what the killed one left."""
-    from feelflow.shapes.io import load_shape
+    from feelflow.app.shape_files import load_shape
 
     rng = random.Random(34)
     killed_mid_write = 0
@@ -240,7 +240,7 @@ def test_a_named_pipe_as_input_is_refused_at_once(tmp_path, argv):
     fifo = tmp_path / "pipe.toml"
     os.mkfifo(fifo)
     if argv[0] == "gui":   # the shape loader: the window's path, without a window
-        code = ("import sys\nfrom feelflow.shapes.io import load_shape\nfrom feelflow.shapes.base import ShapeError\n"
+        code = ("import sys\nfrom feelflow.app.shape_files import load_shape\nfrom feelflow.shapes.base import ShapeError\n"
                 "try:\n    load_shape(sys.argv[1])\nexcept ShapeError as e:\n    print(e, file=sys.stderr); sys.exit(2)\n")
         cmd = [sys.executable, "-c", code, str(fifo)]
     else:

@@ -55,7 +55,7 @@ def test_cpu_colouring_matches_the_display_shader(gl_context, mode):
     import moderngl
 
     from feelflow.app.gui import cpu_field
-    from feelflow.app.gui.viewport import DISPLAY_MODES, load_shader
+    from feelflow.app.gui.viewport import DISPLAY_MODES, display_program
 
     ctx = gl_context
     nx, ny = 64, 32
@@ -69,7 +69,7 @@ def test_cpu_colouring_matches_the_display_shader(gl_context, mode):
     scale, rho_ref = 1 / 0.05, 1.01
     colours = cpu_field.lut(m.colormap)
 
-    prog = ctx.program(vertex_shader=load_shader("display_vertex.glsl"), fragment_shader=load_shader("display.glsl"))
+    prog = display_program(ctx)
     tex = ctx.texture((nx, ny), 4, field.tobytes(), dtype="f4")
     tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
     lut_tex = ctx.texture((256, 1), 4, np.concatenate([colours, np.full((256, 1), 255, np.uint8)], 1).tobytes())

@@ -86,7 +86,7 @@ def test_fuzz_scenes(first, scratch, capsys):
 @pytest.mark.parametrize("first", seeds(2, 4, 40))
 def test_fuzz_shapes(first, scratch):
     from feelflow.shapes.base import Shape, ShapeError
-    from feelflow.shapes.io import load_shape
+    from feelflow.app.shape_files import load_shape
 
     for seed in range(first, first + BLOCK):
         rng = random.Random(seed)

@@ -52,7 +52,7 @@ def test_auto_measures_runs_the_fastest_and_remembers_it(qtbot, tmp_path):
 def test_the_menus_choice_waits_for_the_next_start(qtbot, tmp_path):
     from PySide6.QtCore import QSettings
 
-    from feelflow.app.gui.window.backend import requested_backend
+    from feelflow.app.gui.window.backend_controller import requested_backend
 
     settings = QSettings(str(tmp_path / "settings.ini"), QSettings.IniFormat)
     w = started_window(qtbot, settings, "gl")

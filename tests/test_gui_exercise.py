@@ -23,7 +23,7 @@ def test_edit_violate_fix_score_and_list_the_attempt(window, qtbot, tmp_path, mo
     from PySide6.QtWidgets import QMessageBox
 
     from feelflow.app.exercises import grading
-    from feelflow.shapes.io import save_shape
+    from feelflow.app.shape_files import save_shape
 
     warnings = []
     monkeypatch.setattr(QMessageBox, "warning", lambda *a, **k: warnings.append(a[2]))
@@ -106,3 +106,47 @@ def test_bad_exercise_file_is_a_dialog(window, tmp_path, monkeypatch):
     bad.write_text(TINY.read_text().replace("kind = \"least_cd\"", "kind = \"fastest\""))
     assert not window.exercises.open(bad)
     assert len(shown) == 1 and "objective.kind" in shown[0]
+
+
+def test_plot_overlay_exercise_panel_and_csv_agree_on_one_frame(window, qtbot, tmp_path):
+    """One definition of C_D and C_L (app/model/readouts.py): with an exercise open, the force
+    plot's readout, the exercise panel's live line, the overlay's arrows and the exported CSV use
+    the exercise's reference length and show the same coefficients for the same frame."""
+    import csv
+    import math
+
+    from feelflow.app.model import readouts
+
+    ex = window.exercises
+    ex.work_folder = tmp_path / "work"
+    assert ex.open(TINY)
+    length = ex.exercise.scene.reference_length
+    sim, plot = window.sim, window.plot
+    qtbot.waitUntil(lambda: len(sim.history) > readouts.READOUT_SAMPLES + 5, timeout=30000)
+    window.loop.set_paused(True)                              # hold one frame
+    plot.refresh(force=True)
+    ex.refresh_live()
+    r = plot.readout()
+    assert r.length.cells == length and r.length.name == readouts.EXERCISE_LENGTH
+    assert math.isfinite(r.cd) and r.cd > 0
+    assert f"L = {length:g} cells" in plot.reference_label.text()
+    shown = readouts.format_coefficient(r.cd)
+    assert f"= {shown}" in plot.readout_label.text() and f"C<sub>D</sub> {shown}," in ex.panel.live.text()
+    assert r.reference_text() in ex.panel.live.text()
+
+    path = tmp_path / "forces.csv"
+    plot.export_csv(path)
+    rows = list(csv.DictReader(path.open()))
+    model = sim.params.force_model
+    tail = [float(row[f"{model}_cd"]) for row in rows[-readouts.READOUT_SAMPLES:]]
+    assert sum(tail) / len(tail) == pytest.approx(r.cd, rel=1e-4)   # the body holds still: U is the same each row
+    assert rows[-1]["ref_length_cells"] == f"{length:g}"
+
+    # the arrows of the last frame: length = |coefficient| x half the reference length
+    window.loop.update_arrows({model: sim.history.forces[model][-1]})
+    arrows = window.viewport.arrow_forces
+    ref = sim.reference_length()
+    assert readouts.arrow_coefficient(arrows["drag"], ref) == pytest.approx(abs(float(rows[-1][f"{model}_cd"])), rel=1e-4)
+    assert readouts.arrow_coefficient(arrows["lift"], ref) == pytest.approx(abs(float(rows[-1][f"{model}_cl"])), rel=1e-4)
+    ex.close()
+    assert sim.reference_length().name == readouts.BODY_SIZE

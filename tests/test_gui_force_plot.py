@@ -15,7 +15,7 @@ pytestmark = [pytest.mark.gui,
 
 
 def test_time_view_force_axis_leaves_out_the_start_pulse(window, qtbot):
-    from feelflow.app.gui.force_plot import start_pulse_steps
+    from feelflow.app.model.readouts import start_pulse_steps
 
     sim, plot = window.sim, window.plot
     settle = start_pulse_steps(sim.params.size)
@@ -100,4 +100,5 @@ def test_the_window_fits_a_1024_pixel_wide_screen(window, qtbot):
     window.resize(1024, 700)
     qtbot.waitUntil(lambda: window.width() <= 1024, timeout=5000)
     qtbot.wait(100)
-    assert plot.readout.width() >= plot.readout.sizeHint().width()
+    assert plot.readout_label.width() >= plot.readout_label.sizeHint().width()
+    assert plot.reference_label.width() >= plot.reference_label.sizeHint().width()

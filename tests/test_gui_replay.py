@@ -168,7 +168,7 @@ def test_gl_window_replays_in_its_own_context(qtbot, tmp_path, monkeypatch):
     live_texture = w.sim.solver.field_texture()
     assert w.replays.start(str(path))
     replay = w.replays.replay
-    assert replay.solver.name == "gl" and replay.solver.ctx is w.viewport.ctx
+    assert replay.solver.name == "gl" and replay.solver.gl_context is w.viewport.ctx
     split_ends = []   # the session steps at which a row run in parts (longer than a frame) ended
     driver, step_part = replay.solver, replay.solver.step_part
 

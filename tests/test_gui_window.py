@@ -204,7 +204,7 @@ def test_nan_pauses_says_so_and_resets(window, qtbot, monkeypatch):
     monkeypatch.setattr(QMessageBox, "question", lambda *a, **k: asked.append(a[2]) or QMessageBox.Reset)
     f = window.sim.solver.distributions()
     f[:, 10:20, 60:70] = np.nan
-    window.sim.solver.set_distributions(f)
+    window.sim.solver.solver.set_distributions(f)
     qtbot.waitUntil(lambda: bool(asked), timeout=10000)
     assert "unstable" in asked[0]
     qtbot.waitUntil(lambda: window.sim.solver.time > 5, timeout=10000)
@@ -335,7 +335,7 @@ def test_gl_backend_runs_in_the_widgets_own_context(qtbot, tmp_path):
     qtbot.addWidget(w)
     w.show()
     qtbot.waitUntil(lambda: w.sim is not None and w.sim.solver.time > 20, timeout=30000)
-    assert w.sim.solver.name == "gl" and w.sim.solver.ctx is w.viewport.ctx
+    assert w.sim.solver.name == "gl" and w.sim.solver.gl_context is w.viewport.ctx
     assert w.viewport.field_texture is w.sim.solver.field_texture()
     ok, why = field_is_alive(w)
     assert ok, why

@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from feelflow.haptics.coupling import TunnelMap, VirtualCoupling
+from feelflow.haptics.virtual_coupling import TunnelMap, VirtualCoupling
 from feelflow.haptics.shaping import ForceInterpolator, ForceScale
 from feelflow.haptics.timing import Ticker
 

@@ -20,7 +20,8 @@ from feelflow.app.errors import UserError
 from feelflow.app.model.scene import load_scene, scene_from_dict
 from feelflow.app.sessions import SessionError, load_session
 from feelflow.shapes.base import ShapeError
-from feelflow.shapes.io import from_dict, load_shape
+from feelflow.shapes.io import from_dict
+from feelflow.app.shape_files import load_shape
 
 from test_file_policy import SCENE, one_error_line
 
@@ -68,7 +69,7 @@ def test_deep_nesting_and_huge_integers_are_one_line(tmp_path):
     cases = [
         (tmp_path / "a.toml", f"x = {deep}\n", load_scene, UserError, "nested"),
         (tmp_path / "b.toml", "[grid]\nnx = " + "9" * 5000 + "\n", load_scene, UserError, "too large"),
-        (tmp_path / "c.json", '{"a": ' + deep + "}", load_shape, ShapeError, "deeply"),
+        (tmp_path / "c.json", '{"a": ' + deep + "}", load_shape, ShapeError, "deep"),
         (tmp_path / "d.json", wrap({"kind": "cylinder", "diameter": int("9" * 20)}), load_shape, ShapeError, "large"),
     ]
     for path, text, load, error, words in cases:
@@ -206,6 +207,38 @@ def test_bad_sessions_are_refused_fast_in_one_line(good, tmp_path):
             load_session(path)
         assert time.perf_counter() - t0 < 5, name
         assert words in str(info.value) and "\n" not in str(info.value), (name, info.value)
+
+
+def malformed_header_npz(name: str) -> bytes:
+    """An .npz whose entry's .npy header is cut off inside a bracket (numpy's header parser
+    raises tokenize.TokenError on it)."""
+    head = b"{'descr': '<f8', 'fortran_order': False, 'shape': (3,"
+    head += b" " * (64 - 10 - len(head) - 1) + b"\n"
+    out = io.BytesIO()
+    with zipfile.ZipFile(out, "w") as zf:
+        zf.writestr(name + ".npy", b"\x93NUMPY\x01\x00" + len(head).to_bytes(2, "little") + head + bytes(24))
+    return out.getvalue()
+
+
+def test_session_leftovers_are_one_line(good, tmp_path, capsys):
+    """A malformed .npy header (`session info`), a recorded rebuild to 8192 x 8192 (`session
+    replay`) and `run /proc/self/mem`: one line and exit 2 each."""
+    bad_header = write_session(tmp_path / "header.ffsession", {**good, "forces.npz": malformed_header_npz("values")})
+    params = json.loads(good["parameters.json"])
+    manifest = json.loads(good["manifest.json"])
+    config = dict(manifest["scene"]["config"], nx=8192, ny=8192)
+    params.append({"seq": 10 ** 6, "step": 0, "name": "rebuild", "value": {"config": config, "keep_flow": False}})
+    manifest["counts"]["parameters"] = len(params)
+    rebuild = write_session(tmp_path / "rebuild.ffsession", {**good, "parameters.json": json.dumps(params).encode(),
+                                                             "manifest.json": json.dumps(manifest).encode()})
+    for argv, words in [(["session", "info", str(bad_header)], "not a readable .npz"),
+                        (["session", "replay", str(rebuild)], "more than 4194304"),
+                        (["run", "/proc/self/mem", "--out", str(tmp_path / "f.csv")], "cannot be read")]:
+        t0 = time.perf_counter()
+        assert cli_main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert time.perf_counter() - t0 < 10
+        assert err.count("\n") == 1 and words in err and "Traceback" not in err, (argv, err)
 
 
 def test_a_zip_bomb_is_refused_before_it_inflates(good, tmp_path):

@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from feelflow.app.model.simulation import History
+from feelflow.app.model.force_history import History
 
 
 def test_a_sample_is_settled_once_the_wind_has_held_for_settle_steps():

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from feelflow.shapes import Cylinder, FlatPlate, HalfAirfoil, Polygon, Wedge, rasterise
+from feelflow.shapes import Cylinder, FlatPlate, HalfAirfoil, NacaAirfoil, Polygon, Wedge, rasterise
 from feelflow.shapes.raster import LINKS
 from feelflow.solver.lattice import C, OPP
 
@@ -29,6 +29,7 @@ SHAPES = [
     Wedge(12.0, math.radians(50), "upstream", x=20.1, y=18.4, angle=0.2),
     Wedge(12.0, math.radians(50), "downstream", x=20.1, y=18.4),
     HalfAirfoil(24.0, 4.0, x=20.4, y=18.3, angle=0.15),
+    NacaAirfoil(24.0, 0.12, 0.04, 0.4, x=20.4, y=18.3, angle=-0.2),
     Polygon([[2.0, 3.0], [3.0, 3.0], [3.0, 4.0], [2.0, 4.0]], x=16.0, y=14.0),  # integer-aligned edges
     FlatPlate(10.0, 2.0, x=20.0, y=18.0, angle=math.pi / 2),                   # nodes on edges and corners
     Polygon([[0, 0], [10, 0], [10, 4], [4, 4], [4, 10], [0, 10]], x=15.0, y=12.0),  # concave, on nodes

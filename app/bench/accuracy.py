@@ -49,7 +49,7 @@ def _factory(backend: str, dtype: str, ctx):
 
     def make(config):
         config = dataclasses.replace(config, dtype=dtype)
-        return create_solver(backend, config, **({"ctx": ctx} if backend == "gl" else {}))
+        return create_solver(backend, config, ctx=ctx)
     return make
 
 

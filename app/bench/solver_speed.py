@@ -195,7 +195,7 @@ def run_bench(quick: bool, seconds: float | None, rounds: int | None = None, gri
                 if backend == "gl" and ctx is None:
                     row["error"] = gl_error
                     continue
-                solver = create_solver(backend, scene_config(scene, nx, ny), **({"ctx": ctx} if backend == "gl" else {}))
+                solver = create_solver(backend, scene_config(scene, nx, ny), ctx=ctx)
                 runs[backend] = SceneRun(scene, solver)
                 runs[backend].advance(warmup_steps(scene, solver.config, quick))
                 samples[backend] = []

@@ -22,6 +22,7 @@ COMMANDS = {
     "report": "reports: the seed's experiments (Markdown), how steady the lessons and example scenes are",
     "session": "inspect, replay or export a recorded session file",
     "exercise": "shape-editing exercises: score a class's shapes, check an exercise file",
+    "polar": "an angle-of-attack sweep: C_L and C_D against alpha (CSV and image), C_p along the surface",
 }
 
 
@@ -82,10 +83,24 @@ def main(argv=None) -> int:
     try:
         return int(args._module.main(args) or 0)
     except UserError as exc:
-        print(f"feelflow: {exc}", file=sys.stderr)
+        print(f"feelflow: {one_line(str(exc))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         return 130
+    except MemoryError:   # the bounds are checked before the work; this is the last net
+        print("feelflow: not enough memory for this command (lower the grid, --scale or --workers)",
+              file=sys.stderr)
+        return 2
+
+
+#: longest error line printed (a refusal is one short line; the values in it are cut already)
+MAX_LINE = 400
+
+
+def one_line(text: str) -> str:
+    """An error message as one line of at most MAX_LINE characters."""
+    text = " ".join(text.split("\n"))
+    return text if len(text) <= MAX_LINE else text[:MAX_LINE - 3] + "..."
 
 
 if __name__ == "__main__":

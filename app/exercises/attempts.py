@@ -8,12 +8,12 @@ loaded back; `best()` is the best scored attempt for the exercise's objective.
 """
 from __future__ import annotations
 
-import json
+import os
 from dataclasses import asdict, dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
-from feelflow.app.errors import UserError
+from feelflow.app.errors import UserError, shown, shown_path
 from feelflow.app.files import write_json_atomic
 
 FORMAT = "feelflow-attempts"
@@ -39,6 +39,13 @@ class Attempt:
         return from_dict(self.shape)
 
 
+def _finite(v):
+    """A number kept in the file, or None for no number (NaN and inf are not JSON)."""
+    import math
+
+    return None if v is None or not math.isfinite(v) else float(v)
+
+
 def attempts_path(exercise, folder) -> Path:
     stem = exercise.path.stem if exercise.path else "exercise"
     return Path(folder) / f"{stem}.attempts.json"
@@ -51,15 +58,15 @@ class Attempts:
         self.exercise = exercise
         self.path = attempts_path(exercise, folder)
         self.items: list[Attempt] = []
-        if self.path.exists():
+        if os.path.lexists(self.path):   # a link that cannot be followed is read (and refused)
             self.items = _read(self.path)
 
     def add(self, shape, result) -> Attempt:
         """Record a scoring result (scoring.Result) for `shape` and save the file."""
         attempt = Attempt(number=len(self.items) + 1,
                           time=datetime.now(timezone.utc).isoformat(timespec="seconds"),
-                          shape=shape.to_dict(), status=result.status, score=result.score, cd=result.cd,
-                          cl=result.cl, steps=result.steps, seconds=round(result.seconds, 2), reason=result.reason)
+                          shape=shape.to_dict(), status=result.status, score=_finite(result.score),
+                          cd=_finite(result.cd), cl=_finite(result.cl), steps=result.steps, seconds=round(result.seconds, 2), reason=result.reason)
         self.items.append(attempt)
         self.save()
         return attempt
@@ -77,24 +84,57 @@ class Attempts:
         return min(scored, key=lambda a: (a.score if lower else -a.score, a.number))
 
 
-def _read(path: Path) -> list[Attempt]:
+#: most attempts one file may hold (a student scoring every minute for a week of lessons)
+MAX_ATTEMPTS = 10_000
+#: largest attempts file read, bytes (an attempt with a 48-vertex polygon is about 2 KB)
+MAX_FILE_BYTES = 32 << 20
+_FIELDS = {"number": int, "time": str, "shape": dict, "status": str, "score": (float, type(None)),
+           "cd": (float, type(None)), "cl": (float, type(None)), "steps": int, "seconds": float, "reason": str}
+
+
+def _attempt(item, where: str) -> Attempt:
+    """One attempt record with every field of its type (numbers finite, the shape a valid
+    shape dictionary); UserError naming the field otherwise."""
+    import math
+
+    from feelflow.shapes.base import ShapeError
+    from feelflow.shapes.io import from_dict
+
+    if not isinstance(item, dict) or set(item) != set(_FIELDS):
+        raise UserError(f"{where} is not an attempt record (fields: {', '.join(_FIELDS)})")
+    values = {}
+    for key, kind in _FIELDS.items():
+        v = item[key]
+        if kind in (float, (float, type(None))) and isinstance(v, int) and not isinstance(v, bool):
+            v = float(v)
+        if isinstance(v, bool) or not isinstance(v, kind) or (isinstance(v, float) and not math.isfinite(v)):
+            raise UserError(f"{where}.{key} has the wrong type or is not finite: {shown(v)}")
+        if isinstance(v, str) and len(v) > 1000:
+            raise UserError(f"{where}.{key} is longer than 1000 characters")
+        values[key] = v
+    if values["number"] < 1 or values["steps"] < 0 or values["seconds"] < 0:
+        raise UserError(f"{where}: number, steps and seconds must not be negative")
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UserError(f"{path}: cannot read the attempts file ({getattr(exc, 'strerror', None) or exc})") from None
-    except json.JSONDecodeError as exc:
-        raise UserError(f"{path}: not valid JSON (line {exc.lineno}: {exc.msg})") from None
+        from_dict(values["shape"])
+    except ShapeError as exc:
+        raise UserError(f"{where}.shape: {exc}") from None
+    return Attempt(**values)
+
+
+def _read(path: Path) -> list[Attempt]:
+    """The attempts of a file, through the one reader (app/inputs.py: a regular file, bounded,
+    strict JSON); UserError (one line) naming what is wrong."""
+    from feelflow.app.inputs import load_json
+
+    src = shown_path(path)
+    doc = load_json(path, "attempts file", MAX_FILE_BYTES)
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
-        raise UserError(f"{path}: not a FeelFlow attempts file (expected \"format\": \"{FORMAT}\")")
-    if doc.get("version") != VERSION:
-        raise UserError(f"{path}: unsupported attempts file version {doc.get('version')!r}")
+        raise UserError(f"{src}: not a FeelFlow attempts file (expected \"format\": \"{FORMAT}\")")
+    if isinstance(doc.get("version"), bool) or doc.get("version") != VERSION:
+        raise UserError(f"{src}: unsupported attempts file version {shown(doc.get('version'))}")
     items = doc.get("attempts")
     if not isinstance(items, list):
-        raise UserError(f"{path}: \"attempts\" must be a list")
-    out = []
-    for i, item in enumerate(items):
-        try:
-            out.append(Attempt(**item))
-        except TypeError:
-            raise UserError(f"{path}: attempts[{i}] is not an attempt record") from None
-    return out
+        raise UserError(f"{src}: \"attempts\" must be a list")
+    if len(items) > MAX_ATTEMPTS:
+        raise UserError(f"{src}: {len(items)} attempts, more than a file may hold ({MAX_ATTEMPTS})")
+    return [_attempt(item, f"{src}: attempts[{i}]") for i, item in enumerate(items)]

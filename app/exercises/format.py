@@ -8,11 +8,11 @@ do (app/model/scene.py, whose table reader this module shares).
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from feelflow.app.errors import UserError
+from feelflow.app.errors import UserError, shown, shown_path
+from feelflow.app.inputs import MAX_STEPS, check_memory, check_work
 from feelflow.app.model.scene import MISSING, _Reader, _show, _Table
 from feelflow.solver import units
 from feelflow.solver.config import ConfigError, FlowConfig
@@ -26,7 +26,7 @@ OBJECTIVES = {
     "target_cl": ("|C_L - target|", "lower"),
 }
 #: shape kinds a student may edit (shapes/io.py KINDS)
-EDIT_KINDS = ("polygon", "cylinder", "plate", "wedge", "half_airfoil")
+EDIT_KINDS = ("polygon", "cylinder", "plate", "wedge", "half_airfoil", "naca")
 WALLS = ("free_slip", "no_slip")
 DOC = "docs/reference/exercise-format.md"
 
@@ -170,25 +170,19 @@ class Exercise:
     def folder(self) -> Path:
         return self.path.parent if self.path else Path(".")
 
+    def input_files(self) -> tuple[Path, ...]:
+        """Every shape file the exercise names (start, references, check shapes)."""
+        return (self.start, *(r.path for r in self.references), *self.check_shapes)
+
 
 def load_exercise(path) -> Exercise:
-    """Read and validate an exercise file; UserError (one line) on any problem."""
+    """Read and validate an exercise file through the one reader (app/inputs.py: a regular file
+    of at most 1 MiB, bounded depth and numbers); UserError (one line) on any problem."""
+    from feelflow.app.inputs import load_toml
+
     path = Path(path)
-    source = str(path)
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise UserError(f"{source}: no such exercise file") from None
-    except IsADirectoryError:
-        raise UserError(f"{source}: is a directory, not an exercise file") from None
-    except PermissionError:
-        raise UserError(f"{source}: cannot be read (permission denied)") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise UserError(f"{source}: not valid TOML: {str(exc).splitlines()[0]}") from None
-    except UnicodeDecodeError:
-        raise UserError(f"{source}: not valid TOML: not UTF-8 text") from None
-    return exercise_from_dict(data, source, path)
+    data = load_toml(path, "exercise file")
+    return exercise_from_dict(data, shown_path(path), path)
 
 
 def exercise_from_dict(data: dict, source: str = "exercise", path: Path | None = None) -> Exercise:
@@ -209,13 +203,23 @@ def exercise_from_dict(data: dict, source: str = "exercise", path: Path | None =
     walls = s.choice("walls", WALLS, "free_slip")
     body_x, body_y = s.pair("body_position")
     reference_length = s.number("reference_length", positive=True)
-    steps = s.integer("steps", lo=100)
+    steps = s.integer("steps", lo=100, hi=MAX_STEPS)
     average_steps = s.integer("average_steps", lo=10)
     sample_interval = s.integer("sample_interval", 10, lo=1)
     settle = s.number("settle_tolerance", 0.005, positive=True)
-    sponge = s.integer("sponge_cells", nx // 8, lo=0)
+    sponge = s.integer("sponge_cells", nx // 8, lo=0, hi=nx // 2)
     why = s.text("why")
     s.done()
+    try:   # the work one scoring run asks for, before anything is run (app/inputs.py)
+        check_work(nx, ny, steps, source, "scene.steps")
+        check_memory(nx, ny, source, "scene.nx, scene.ny")
+    except UserError as exc:
+        raise UserError(str(exc)) from None
+    if reference_length > max(nx, ny):
+        reader.fail("scene.reference_length", f"must be at most the grid's size ({max(nx, ny)} cells), "
+                                              f"got {shown(reference_length)}")
+    if settle > 1:
+        reader.fail("scene.settle_tolerance", f"must be at most 1 (a fraction of the score), got {shown(settle)}")
     if average_steps > steps:
         reader.fail("scene.average_steps", f"must not exceed scene.steps ({steps}), got {average_steps}")
     if average_steps % sample_interval:
@@ -294,10 +298,34 @@ def exercise_from_dict(data: dict, source: str = "exercise", path: Path | None =
 
 
 def _file(reader, key: str, name: str, folder: Path) -> Path:
+    """A shape file the exercise names, relative to the exercise file's folder. With every link
+    followed it must lie inside that folder or the shipped exercises' folder (a file may not
+    reach out to `../../etc/passwd`), and be a regular file of at most a shape file's size."""
+    import os
+
+    from feelflow import EXERCISE_DIR
+    from feelflow.app.inputs import check_regular_file
+    from feelflow.app.shape_files import MAX_FILE_BYTES
+
+    if len(name) > 4096 or "\x00" in name:
+        reader.fail(key, f"not a usable file name: {shown(name)!r}")
     p = Path(name)
     p = p if p.is_absolute() else folder / p
-    if not p.is_file():
-        reader.fail(key, f"no such shape file {name!r} (relative to the exercise file's folder)")
+    try:
+        real = Path(os.path.realpath(p))
+        roots = [Path(os.path.realpath(r)) for r in (folder, EXERCISE_DIR)]
+    except (OSError, ValueError) as exc:
+        reader.fail(key, f"cannot follow {shown(name)!r} ({getattr(exc, 'strerror', None) or exc})")
+    if not any(real == root or real.is_relative_to(root) for root in roots):
+        reader.fail(key, f"{shown(name)!r} lies outside the exercise file's folder; an exercise may only "
+                         f"name shape files in its own folder (or below it)")
+    try:
+        check_regular_file(p, "shape file", MAX_FILE_BYTES)
+    except UserError as exc:
+        message = str(exc)
+        if "no such shape file" in message:
+            message = f"no such shape file {shown(name)!r} (relative to the exercise file's folder)"
+        reader.fail(key, message)
     return p
 
 
@@ -306,7 +334,7 @@ def _check_shapes(reader, exercise: Exercise) -> None:
     solution must be a valid shape file that meets the constraints."""
     from feelflow.app.exercises.constraints import check_shape
     from feelflow.shapes.base import ShapeError
-    from feelflow.shapes.io import load_shape
+    from feelflow.app.shape_files import load_shape
 
     for key, p, must_pass in [("edit.start", exercise.start, False)] + [
             (f"reference[{i}].file", r.path, True) for i, r in enumerate(exercise.references)]:

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
-from feelflow.app.errors import UserError
+from feelflow.app.errors import UserError, shown, shown_path
 from feelflow.app.exercises import scoring
 
 #: row status besides scoring's SCORED / NOT_SETTLED
@@ -42,19 +42,40 @@ class Row:
         return self.status == scoring.SCORED
 
 
+#: most shape files one grading may score (a class folder of 30 is usual)
+MAX_FILES = 10_000
+
+
 def shape_files(paths) -> list[Path]:
-    """The shape files named: files as given, folders' *.json files (sorted); UserError for a
-    path that does not exist or when nothing is left."""
+    """The shape files named: files as given, folders' *.json entries (sorted; one that is not a
+    regular file gets its row saying so); UserError (one line) for a path that does not exist,
+    more than MAX_FILES files, or when nothing is left."""
+    import os
+
+    from feelflow.app.inputs import is_folder
+
     out = []
     for p in map(Path, paths):
-        if p.is_dir():
-            out += sorted(q for q in p.iterdir() if q.suffix.lower() == ".json" and q.is_file())
-        elif p.exists():
+        if is_folder(p):
+            try:
+                with os.scandir(p) as it:
+                    names = []
+                    for entry in it:
+                        if entry.name.lower().endswith(".json"):
+                            names.append(entry.name)
+                            if len(names) > MAX_FILES:
+                                break
+            except OSError as exc:
+                raise UserError(f"{shown_path(p)}: cannot list the folder ({exc.strerror or exc})") from None
+            out += [p / name for name in sorted(names)]
+        elif os.path.lexists(p):   # a link that cannot be followed gets its row saying why
             out.append(p)
         else:
-            raise UserError(f"{p}: no such shape file or folder")
+            raise UserError(f"{shown_path(p)}: no such shape file or folder")
+        if len(out) > MAX_FILES:
+            raise UserError(f"{shown_path(p)}: more than {MAX_FILES} shape files to score")
     if not out:
-        raise UserError("no shape files (*.json) among " + ", ".join(map(str, paths)))
+        raise UserError("no shape files (*.json) among " + shown(", ".join(map(str, paths)), 200))
     return out
 
 
@@ -69,14 +90,15 @@ def score_file(exercise, path, scale: int = 1) -> Row:
     """One shape file's row (never raises for a bad shape file or a broken constraint)."""
     from feelflow.app.exercises.constraints import check_shape
     from feelflow.shapes.base import ShapeError
-    from feelflow.shapes.io import load_shape
+    from feelflow.app.shape_files import load_shape
 
     name = str(path)
     try:
         shape = load_shape(path)
     except ShapeError as exc:
-        text = str(exc).splitlines()[0]
-        return Row(name, INVALID, verdict="-", reason=text[len(name) + 2:] if text.startswith(name + ": ") else text,
+        text, shown_name = str(exc).splitlines()[0], shown_path(path)
+        reason = text[len(shown_name) + 2:] if text.startswith(shown_name + ": ") else text
+        return Row(name, INVALID, verdict="-", reason=reason,
                    scale=scale)
     problems = check_shape(exercise, shape)
     if problems:
@@ -119,7 +141,8 @@ def grade(exercise, paths, workers: int | None = None, scales=(1,), progress=Non
 
 
 def ranked(exercise, rows: list[Row]) -> list[Row]:
-    """Best first (scoring.rank_key); not settled, broken and invalid last; ties by file name."""
+    """Best first (by score, in the objective's direction); not settled, broken and invalid last;
+    ties by file name."""
     order = {scoring.SCORED: 0, scoring.NOT_SETTLED: 1, BREAKS: 2, INVALID: 3}
 
     def key(r: Row):

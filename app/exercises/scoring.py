@@ -4,7 +4,7 @@ the objective's score.
 
 Averaging (docs/reference/exercise-format.md, [scene]): the force coefficients
 C_D = 2 F_x / (rho_0 U^2 L), C_L = 2 F_y / (rho_0 U^2 L) (L = scene.reference_length, U the
-inflow speed, solver/units.py) are sampled as means over `sample_interval` steps; the score uses
+inflow speed; app/model/readouts.py, the definition the window shows) are sampled as means over `sample_interval` steps; the score uses
 the last `average_steps` steps of the run (the window).
 - Steady flow: the mean over the window; *settled* when the means of the window's two halves
   differ by at most `settle_tolerance` |C_D| in C_D and in C_L.
@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from feelflow.solver import units
+from feelflow.app.model import readouts
 
 FORCE_MODEL = "momentum_exchange"
 SCORED, NOT_SETTLED, BROKEN = "scored", "not settled", "broken"
@@ -150,6 +150,7 @@ def score_shape(exercise, shape, scale: int = 1, progress=None, cancelled=None) 
         solver.enable_force_models([FORCE_MODEL])
         solver.set_body(body)
         n = s.steps // s.sample_interval
+        reference = readouts.ReferenceLength(s.reference_length, readouts.EXERCISE_LENGTH)
         with np.errstate(all="ignore"):
             for k in range(n):
                 if cancelled is not None and cancelled():
@@ -163,8 +164,9 @@ def score_shape(exercise, shape, scale: int = 1, progress=None, cancelled=None) 
                 if not (math.isfinite(fx) and math.isfinite(fy)):
                     return Result(NOT_SETTLED, steps=solver.time, seconds=time.perf_counter() - start,
                                   reason="the flow diverged (NaN)", scale=scale)
-                cd.append(units.force_coefficient(fx, s.inflow_speed, s.reference_length))
-                cl.append(units.force_coefficient(fy, s.inflow_speed, s.reference_length))
+                c_d, c_l = readouts.coefficients(fx, fy, s.inflow_speed, reference, min_speed=0.0)   # flow along +x
+                cd.append(c_d)
+                cl.append(c_l)
                 if progress is not None:
                     progress((k + 1) / n)
     finally:
@@ -179,10 +181,3 @@ def score_shape(exercise, shape, scale: int = 1, progress=None, cancelled=None) 
     score, hit = objective_score(exercise.objective, avg.cd, avg.cl)
     return Result(SCORED, score=score, cd=avg.cd, cl=avg.cl, steps=s.steps, seconds=seconds,
                   averaging=avg.how, hit=hit, scale=scale, cpu_seconds=cpu)
-
-
-def rank_key(objective, result: Result):
-    """Sort key: scored shapes best first (by score, then C_D), then not settled, then broken."""
-    if not result.ok:
-        return (1 if result.status == NOT_SETTLED else 2, 0.0)
-    return (0, result.score if objective.better == "lower" else -result.score)

@@ -18,7 +18,9 @@ from PySide6.QtWidgets import QDockWidget, QFileDialog, QMessageBox
 from feelflow import EXERCISE_DIR
 from feelflow.app.errors import UserError
 from feelflow.app.exercises import scoring
-from feelflow.app.gui.exercise_panel import PARAMETERS, ExercisePanel
+from feelflow.app.gui.exercise_panel import PARAMETERS, PANEL_WIDTH, ExercisePanel, ScrollingPanel
+from feelflow.app.model import readouts
+from feelflow.app.model.readouts import EXERCISE_LENGTH, ReferenceLength
 from feelflow.shapes.base import ShapeError
 
 BROKEN_EDGE = QColor(230, 40, 40)
@@ -72,6 +74,7 @@ class ExerciseController(QObject):
         self.timer = QTimer(self)
         self.timer.setInterval(CHECK_INTERVAL_MS)
         self.timer.timeout.connect(self.refresh_constraints)
+        self.timer.timeout.connect(self.refresh_live)
 
     # --- menus -------------------------------------------------------------------------------
     def build_menu(self, bar, presets_menu=None):
@@ -129,7 +132,7 @@ class ExerciseController(QObject):
         show its panel; a dialog (one line) for a bad file."""
         from feelflow.app.exercises.format import load_exercise
         from feelflow.app.model.scene import scene_from_dict
-        from feelflow.shapes.io import load_shape
+        from feelflow.app.shape_files import load_shape
 
         w = self.window
         if w.sim is None or w.replays.refuse("exercises run in the live tunnel"):
@@ -154,11 +157,14 @@ class ExerciseController(QObject):
             w.flow.refuse_dialog("This exercise cannot be opened", exc)
             return False
         self.exercise = exercise
+        # the live readouts use the length the score uses (app/model/readouts.py)
+        w.sim.reference_override = ReferenceLength(s.reference_length, EXERCISE_LENGTH)
         w.undo.clear()
         w.bodies.set_hold_still(True)
         self._ensure_panel()
         self.panel.show_exercise(exercise)
         self.dock.show()
+        self.dock.raise_()
         self.install_shape(start)
         self._load_attempts()
         self.close_action.setEnabled(True)
@@ -168,7 +174,24 @@ class ExerciseController(QObject):
         self.timer.start()
         self.refresh_constraints()
         w.statusBar().showMessage(f"Exercise: {exercise.title}", 10000)
+        QTimer.singleShot(0, self.fit_tunnel)   # once the docks have their new sizes
         return True
+
+    def fit_tunnel(self):
+        """Give the viewport the exercise tunnel's shape: the forces plot below takes the height
+        a wide, low tunnel leaves empty, so the tunnel fills the viewport's width and height."""
+        w = self.window
+        vp, plot_dock = w.viewport, w.plot.parentWidget()
+        if self.exercise is None or w.sim is None or not isinstance(plot_dock, QDockWidget):
+            return
+        self.dock.raise_()
+        from feelflow.app.gui.display_modes import COLOUR_BAR_MARGIN
+
+        nx, ny = w.sim.config.nx, w.sim.config.ny
+        wanted = max(vp.minimumHeight(), int(math.ceil((vp.width() - COLOUR_BAR_MARGIN) * ny / nx)) + 8)
+        spare = vp.height() - wanted
+        if spare > 0:
+            w.resizeDocks([plot_dock], [plot_dock.height() + spare], Qt.Vertical)
 
     def _ensure_panel(self):
         if self.panel is not None:
@@ -178,12 +201,29 @@ class ExerciseController(QObject):
         self.panel.cancelRequested.connect(self.cancel)
         self.panel.attemptChosen.connect(self.load_attempt)
         self.panel.parametersChanged.connect(self._parameters_changed)
-        self.dock = QDockWidget("Exercise", self.window)
+        w = self.window
+        self.panel.editToggled.connect(w.bodies.set_editing)
+        w.panel.edit.toggled.connect(self._show_editing)
+        self.dock = QDockWidget("Exercise", w)
         self.dock.setObjectName("exercise_dock")
-        self.dock.setWidget(self.panel)
+        self.dock.setWidget(ScrollingPanel(self.panel))
         self.dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetClosable)
-        self.window.addDockWidget(Qt.LeftDockWidgetArea, self.dock)
-        self.window.resizeDocks([self.dock], [340], Qt.Horizontal)
+        # a tab beside the Controls (one column of panels: the tunnel keeps the window's width),
+        # the column full height (the forces plot below grows when the tunnel is wide and low)
+        w.setCorner(Qt.BottomRightCorner, Qt.RightDockWidgetArea)
+        w.setCorner(Qt.TopRightCorner, Qt.RightDockWidgetArea)
+        controls = w.panel.parentWidget()
+        if isinstance(controls, QDockWidget) and w.dockWidgetArea(controls) != Qt.NoDockWidgetArea:
+            w.tabifyDockWidget(controls, self.dock)
+        else:
+            w.addDockWidget(Qt.RightDockWidgetArea, self.dock)
+        w.resizeDocks([self.dock], [PANEL_WIDTH], Qt.Horizontal)
+
+    def _show_editing(self, on: bool):
+        """The Controls panel's Edit vertices button and the exercise panel's show the same."""
+        self.panel.edit.blockSignals(True)
+        self.panel.edit.setChecked(on)
+        self.panel.edit.blockSignals(False)
 
     def _load_attempts(self):
         from feelflow.app.exercises.attempts import Attempts
@@ -207,6 +247,8 @@ class ExerciseController(QObject):
             self.cancel()
         self.timer.stop()
         self.exercise = None
+        if self.window.sim is not None:
+            self.window.sim.reference_override = None
         self.window.viewport.body_edge = None
         if self.dock is not None:
             self.dock.hide()
@@ -282,6 +324,13 @@ class ExerciseController(QObject):
             self.window.viewport.body_edge = edge
             self.window.viewport.update()
 
+    def refresh_live(self):
+        """The panel's line of the live tunnel's coefficients, as the plot shows them."""
+        sim = self.window.sim
+        if self.exercise is None or self.panel is None or sim is None:
+            return
+        self.panel.show_live(readouts.readout(sim.history, sim.params.force_model, sim.reference_length()))
+
     # --- scoring -------------------------------------------------------------------------------
     def score(self, _=False) -> bool:
         """Score the current shape in a worker thread; refused (with the reasons) while a
@@ -322,7 +371,9 @@ class ExerciseController(QObject):
         ex = self.exercise
         if result.ok:
             o = ex.objective
-            lines = [f"<b>Score {result.score:.4f}</b> ({o.quantity}; C_D {result.cd:.4f}, C_L {result.cl:.4f}; "
+            s = ex.scene
+            lines = [f"<b>Score {result.score:.4f}</b> ({o.quantity}; C_D {result.cd:.4f}, C_L {result.cl:.4f} "
+                     f"with L = {s.reference_length:g} cells ({EXERCISE_LENGTH}), U = {s.inflow_speed:.3f}; "
                      f"{result.steps} steps, {result.seconds:.1f} s)"]
             if result.hit is not None:
                 lines.append("A hit: within the tolerance." if result.hit else "Not a hit yet: outside the tolerance.")

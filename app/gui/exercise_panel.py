@@ -10,7 +10,10 @@ import math
 from PySide6.QtCore import QPointF, QSize, Qt, Signal
 from PySide6.QtGui import QColor, QIcon, QPainter, QPen, QPixmap, QPolygonF
 from PySide6.QtWidgets import (QComboBox, QDoubleSpinBox, QFormLayout, QGroupBox, QHBoxLayout, QLabel, QListWidget,
-                               QListWidgetItem, QProgressBar, QPushButton, QTextBrowser, QVBoxLayout, QWidget)
+                               QListWidgetItem, QProgressBar, QPushButton, QScrollArea, QTextBrowser,
+                               QVBoxLayout, QWidget)
+
+from feelflow.app.model import readouts
 
 #: parametric kinds: parameter -> (label, minimum, maximum, step); angles in degrees
 PARAMETERS = {
@@ -18,8 +21,12 @@ PARAMETERS = {
     "plate": {"length": ("Length (cells)", 2.0, 60.0, 0.5), "thickness": ("Thickness (cells)", 0.5, 20.0, 0.5)},
     "wedge": {"length": ("Length (cells)", 2.0, 60.0, 0.5), "apex_angle": ("Apex angle (degrees)", 5.0, 170.0, 1.0)},
     "half_airfoil": {"chord": ("Chord (cells)", 4.0, 60.0, 0.5), "thickness": ("Thickness (cells)", 0.5, 20.0, 0.25)},
+    "naca": {"chord": ("Chord (cells)", 8.0, 120.0, 1.0), "thickness": ("Thickness (x chord)", 0.04, 0.3, 0.01),
+             "camber": ("Camber (x chord)", 0.0, 0.09, 0.01), "camber_position": ("Camber at (x chord)", 0.1, 0.9, 0.1)},
 }
 THUMB = QSize(72, 44)
+#: the panel's width in the window (logical pixels): the goal, references and attempts lines wrap to it
+PANEL_WIDTH = 340
 BAD = "#d03030"
 GOOD = "#208040"
 
@@ -47,11 +54,44 @@ def thumbnail(outline, best: bool = False) -> QIcon:
     return QIcon(pix)
 
 
+def reflow(text: str) -> str:
+    """An exercise's text as paragraphs: the file's line breaks inside a paragraph become
+    spaces (the panel wraps to its own width), blank lines stay paragraph breaks."""
+    paragraphs = [" ".join(line.strip() for line in block.splitlines() if line.strip())
+                  for block in text.strip().split("\n\n")]
+    return "\n\n".join(p for p in paragraphs if p)
+
+
+def breakable_path(path: str) -> str:
+    """A file path that a word-wrapped label may break after each separator (a zero-width
+    space there), with the home folder written as ~."""
+    from pathlib import Path
+
+    home = str(Path.home())
+    if home not in ("", "/") and path.startswith(home):
+        path = "~" + path[len(home):]
+    return path.replace("/", "/\u200b").replace("\\", "\\\u200b")
+
+
+class ScrollingPanel(QScrollArea):
+    """The exercise panel in a vertical scroll area: on a short screen it scrolls instead of
+    squeezing its wrapped lines over each other."""
+
+    def __init__(self, panel: "ExercisePanel"):
+        super().__init__()
+        self.setObjectName("exercise_scroll")
+        self.setWidget(panel)
+        self.setWidgetResizable(True)
+        self.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
+        self.setMinimumWidth(PANEL_WIDTH)
+
+
 class ExercisePanel(QWidget):
     scoreRequested = Signal()
     cancelRequested = Signal()
     attemptChosen = Signal(int)      # index into the attempts list
     parametersChanged = Signal()
+    editToggled = Signal(bool)
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -61,11 +101,22 @@ class ExercisePanel(QWidget):
         self.title.setStyleSheet("font-weight: bold; font-size: 14px")
         layout.addWidget(self.title)
         self.instructions = QTextBrowser()
-        self.instructions.setMinimumHeight(140)
+        self.instructions.setMinimumHeight(150)
         layout.addWidget(self.instructions, 2)
         self.goal = QLabel()
         self.goal.setWordWrap(True)
+        self.goal.setObjectName("exercise_goal")
         layout.addWidget(self.goal)
+        self.references = QLabel()
+        self.references.setWordWrap(True)
+        self.references.setObjectName("exercise_references")
+        layout.addWidget(self.references)
+        self.edit = QPushButton("Edit vertices")
+        self.edit.setCheckable(True)
+        self.edit.setToolTip("Drag the yellow handles; double-click an edge to add a vertex; right-click a handle "
+                             "to delete it (the same as the Controls panel's Edit vertices)")
+        self.edit.toggled.connect(self.editToggled)
+        layout.addWidget(self.edit)
 
         self.shape_box = QGroupBox("Your shape")
         form = QFormLayout(self.shape_box)
@@ -125,13 +176,19 @@ class ExercisePanel(QWidget):
         self.result.setWordWrap(True)
         self.result.setTextFormat(Qt.RichText)
         layout.addWidget(self.result)
+        #: the live tunnel's coefficients, as the force plot shows them (same reference length)
+        self.live = QLabel()
+        self.live.setWordWrap(True)
+        self.live.setTextFormat(Qt.RichText)
+        layout.addWidget(self.live)
 
         self.attempts_label = QLabel("Attempts")
         self.attempts_label.setWordWrap(True)
+        self.attempts_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
         layout.addWidget(self.attempts_label)
         self.attempts = QListWidget()
         self.attempts.setIconSize(THUMB)
-        self.attempts.setMinimumHeight(150)
+        self.attempts.setMinimumHeight(120)
         self.attempts.itemDoubleClicked.connect(lambda item: self.attemptChosen.emit(self.attempts.row(item)))
         layout.addWidget(self.attempts, 2)
         self.load_button = QPushButton("Load this attempt into the editor")
@@ -141,13 +198,15 @@ class ExercisePanel(QWidget):
     # --- filling in ---------------------------------------------------------------------------
     def show_exercise(self, exercise):
         self.title.setText(exercise.title)
-        self.instructions.setPlainText(exercise.instructions)
+        self.instructions.setPlainText(reflow(exercise.instructions))
         o = exercise.objective
         goal = f"Goal: {o.kind.replace('_', ' ')}; score = {o.quantity}, {o.better} is better"
         if o.target is not None:
             goal += f" (a hit is within {o.tolerance:g} of {o.target:g})"
+        self.goal.setText(goal + ".")
         refs = "; ".join(f"{r.label}: {r.score:.4f}" for r in exercise.references)
-        self.goal.setText(f"{goal}.\nReference solution{'s' if len(exercise.references) > 1 else ''}: {refs}.")
+        self.references.setText(f"Reference solution{'s' if len(exercise.references) > 1 else ''}: {refs}.")
+        self.edit.setVisible("polygon" in exercise.kinds)
         parametric = [k for k in exercise.kinds if k in PARAMETERS]
         self.shape_box.setVisible(bool(parametric))
         self.kind.blockSignals(True)
@@ -200,6 +259,12 @@ class ExercisePanel(QWidget):
             d["pointing"] = self.pointing.currentData()
         return d
 
+    def show_live(self, readout):
+        """The live tunnel's C_D and C_L (an app.model.readouts.Readout) with their reference."""
+        fmt = readouts.format_coefficient
+        self.live.setText(f"In the tunnel now: C<sub>D</sub> {fmt(readout.cd)}, C<sub>L</sub> {fmt(readout.cl)} "
+                          f"<small>({readout.reference_text()}; the window's flow, float32)</small>")
+
     def set_problems(self, problems: list[str]):
         if problems:
             items = "".join(f"<li>{p}</li>" for p in problems)
@@ -220,7 +285,8 @@ class ExercisePanel(QWidget):
         self.progress.setValue(int(round(1000 * fraction)))
 
     def set_attempts(self, attempts, best, where: str):
-        self.attempts_label.setText(f"Attempts (saved in {where}); the best is framed in gold:")
+        self.attempts_label.setText(f"Attempts, the best framed in gold; saved in {breakable_path(where)}")
+        self.attempts_label.setToolTip(where)
         self.attempts.clear()
         for a in attempts:
             shape = a.load_shape()

@@ -4,8 +4,6 @@ fitted exponent (the U^2 lesson: at low Re, C_D falls as Re grows, so drag grows
 """
 from __future__ import annotations
 
-import csv
-import io
 import math
 
 import numpy as np
@@ -16,19 +14,11 @@ from PySide6.QtWidgets import (QCheckBox, QComboBox, QHBoxLayout, QLabel, QPushB
 
 from feelflow.app.files import atomic_path, write_text_atomic
 from feelflow.app.model.power_law import fit_power_law
-from feelflow.app.model.simulation import FORCE_MODELS, History, drag_direction
+from feelflow.app.model import readouts
+from feelflow.app.model.readouts import start_pulse_steps
+from feelflow.app.model.force_history import History
+from feelflow.app.model.simulation import FORCE_MODELS
 from feelflow.app.model.tunnel import TunnelModel
-from feelflow.solver.lattice import CS2
-
-#: the impulsive start's pressure pulse (the flow begins at full speed around a body that was not
-#: there) has passed once it crossed the body twice at the speed of sound: 2 D / c_s steps
-START_PULSE_CROSSINGS = 2.0
-
-
-def start_pulse_steps(size_cells: float) -> float:
-    """Solver steps after the flow (re)starts during which the forces show the start pulse, a
-    spike tens of times the steady drag; the time plot's force range leaves them out."""
-    return START_PULSE_CROSSINGS * size_cells / math.sqrt(CS2)
 
 MODEL_COLOURS = {"momentum_exchange": ((220, 40, 40), (40, 110, 240)),
                  "macroscopic": ((230, 140, 20), (20, 170, 190)),
@@ -50,19 +40,31 @@ class ForcePlot(QWidget):
         self.clear_button = QPushButton("Clear")
         self.csv_button = QPushButton("Export CSV\u2026")
         self.png_button = QPushButton("Export PNG\u2026")
-        self.readout = QLabel("C<sub>D</sub> = \u2013   C<sub>L</sub> = \u2013")
-        self.readout.setTextFormat(Qt.RichText)
-        font = self.readout.font()
+        self.readout_label = QLabel("C<sub>D</sub> = \u2013   C<sub>L</sub> = \u2013")
+        self.readout_label.setTextFormat(Qt.RichText)
+        font = self.readout_label.font()
         font.setPointSizeF(font.pointSizeF() * 1.35)
         font.setBold(True)
-        self.readout.setFont(font)
+        self.readout_label.setFont(font)
+        # what the coefficients are made dimensionless with, next to them (app/model/readouts.py)
+        self.reference_label = QLabel("")
+        small = self.reference_label.font()
+        small.setPointSizeF(small.pointSizeF() * 0.85)
+        self.reference_label.setFont(small)
+        self.reference_label.setToolTip("C = 2 F / (\u03c1 U\u00b2 L): U the relative wind's speed, "
+                                        "L the reference length")
         bar = QHBoxLayout()
         for w in (self.view, self.pause_box, self.clear_button, self.csv_button, self.png_button):
             bar.addWidget(w)
         # the widest readout keeps its place: the bar does not shift as the signs change
-        self.readout.setMinimumWidth(self.readout.fontMetrics().horizontalAdvance("CD = -00.00   CL = -00.00"))
+        self.readout_label.setMinimumWidth(
+            self.readout_label.fontMetrics().horizontalAdvance("CD = -00.00   CL = -00.00"))
         bar.addStretch(1)
-        bar.addWidget(self.readout)
+        readout_column = QVBoxLayout()
+        readout_column.setSpacing(0)
+        readout_column.addWidget(self.readout_label)
+        readout_column.addWidget(self.reference_label)
+        bar.addLayout(readout_column)
 
         pg.setConfigOptions(antialias=True, background="w", foreground="k")
         self.plot = pg.PlotWidget()
@@ -152,30 +154,22 @@ class ForcePlot(QWidget):
         else:
             self._draw_time_view()
 
-    def coefficients(self, model=None, last: int = 30):
-        """(C_D, C_L) of the last `last` samples: F / (1/2 rho0 U_rel^2 A), A = frontal width."""
+    def readout(self, model=None) -> readouts.Readout:
+        """The mean drag, lift and coefficients of the last samples, with the reference they use
+        (app/model/readouts.py)."""
         sim = self.sim
-        model = model or sim.params.force_model
-        t, drag, lift = sim.history.drag_lift(model)
-        if len(t) == 0:
-            return math.nan, math.nan
-        w = np.asarray(sim.history.wind[-last:], float)
-        u = float(np.hypot(w[:, 0], w[:, 1]).mean())
-        if u < 0.005 or sim.shape is None:
-            return math.nan, math.nan
-        area = sim.shape.frontal_area(tuple(drag_direction(w[-1])[0]))
-        q = 0.5 * u * u * area
-        d, l_ = drag[-last:], lift[-last:]
-        if not np.isfinite(d).any():
-            return math.nan, math.nan
-        return float(np.nanmean(d) / q), float(np.nanmean(l_) / q)
+        return readouts.readout(sim.history, model or sim.params.force_model, sim.reference_length())
+
+    def coefficients(self, model=None):
+        """(C_D, C_L) shown in the readout (app/model/readouts.py's definition)."""
+        r = self.readout(model)
+        return r.cd, r.cl
 
     def _update_readout(self):
-        cd, cl = self.coefficients()
-
-        def fmt(v):
-            return "\u2013" if not math.isfinite(v) else f"{v + 0.0:.2f}".replace("-0.00", "0.00")
-        self.readout.setText(f"C<sub>D</sub> = {fmt(cd)} &nbsp; C<sub>L</sub> = {fmt(cl)}")
+        r = self.readout()
+        fmt = readouts.format_coefficient
+        self.readout_label.setText(f"C<sub>D</sub> = {fmt(r.cd)} &nbsp; C<sub>L</sub> = {fmt(r.cl)}")
+        self.reference_label.setText(r.reference_text())
 
     def _curve(self, key, pen, name):
         if key not in self.curves:
@@ -274,26 +268,9 @@ class ForcePlot(QWidget):
 
     # --- export ---------------------------------------------------------------------------
     def csv_text(self) -> str:
+        """The forces CSV (app/model/readouts.py `forces_csv`)."""
         sim = self.sim
-        h = sim.history
-        models = [m for m in FORCE_MODELS if m in h.forces]
-        out = io.StringIO()
-        w = csv.writer(out)
-        w.writerow(["step", "body_vx", "body_vy", "wind_x", "wind_y"]
-                   + [f"{m}_{q}" for m in models for q in ("fx", "fy", "drag", "lift")])
-        cols = []
-        for m in models:
-            _, drag, lift = h.drag_lift(m)
-            f = np.full((len(h), 2), np.nan)
-            s = np.asarray(h.forces[m], float)
-            f[len(h) - len(s):] = s
-            cols.append(np.c_[f, drag, lift])
-        for i in range(len(h)):
-            row = [h.time[i], *h.body_velocity[i], *h.wind[i]]
-            for c in cols:
-                row += [f"{v:.8g}" for v in c[i]]
-            w.writerow(row)
-        return out.getvalue()
+        return readouts.forces_csv(sim.history, FORCE_MODELS, sim.reference_length())
 
     def export_csv(self, path):
         write_text_atomic(path, self.csv_text())

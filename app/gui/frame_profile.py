@@ -76,8 +76,7 @@ class FrameProfile:
         return wrapper
 
     def _wrap(self, obj, name: str, part: str, only=None):
-        if obj is None or not hasattr(obj, name):
-            return
+        """Time `obj.name` (public names only: a rename fails here, loudly, not a silent skip)."""
         had = name in getattr(obj, "__dict__", {})
         old = obj.__dict__[name] if had else None
         setattr(obj, name, self._timed(part, getattr(obj, name), only))
@@ -97,15 +96,15 @@ class FrameProfile:
         session = sim.solver                  # the SessionSolver
         backend = session.solver              # the backend it drives
         self._wrap(backend, "step", "steps")
-        for model in getattr(backend, "_models", {}).values():
+        for model in backend.force_models.values():
             self._wrap(model, "compute", "forces")
         self._wrap(backend, "check_physical", "check")
-        self._wrap(sim, "_move_body", "moves")
+        self._wrap(session, "set_body", "moves")
         self._wrap_slot(loop.timer.timeout, loop.tick, "loop")
         self._wrap_slot(loop.slow_timer.timeout, loop.refresh_readouts, "readouts")
         self._wrap(loop, "upload_field", "field")
         self._wrap(loop, "refresh_readouts", "readouts")
-        self._wrap(vp, "_field_image", "draw")
+        self._wrap(vp, "field_image", "draw")
         self._wrap(vp.overlay, "paint", "overlay")
         self._wrap(plot, "refresh", "plot_data")
         self._wrap(plot.plot, "paintEvent", "plot_paint")

@@ -5,12 +5,14 @@ app/gui/window/, one module per concept, each an object holding the window (`sel
     window.store    settings.py    WindowSettings: remembered parameters, polygon, mode, geometry
     window.actions  menus.py       the menus, shortcuts and replay toolbar (`build_menus`)
     window.loop     frame_loop.py  FrameLoop: adaptive stepping, pause, display mode, readouts
-    window.replays  replay.py      ReplayController: recording, and replaying a session
-    window.inputs   inputs.py      InputController: mouse or haptic device; body input to the model
+    window.replays  replay_controller.py  ReplayController: recording, and replaying a session
+    window.inputs   input_controller.py   InputController: mouse or haptic device; body input to the model
     window.bodies   bodies.py      BodyController: shape, polygon editor (undo), turning the body
     window.flow     flow.py        FlowController: wind, viscosity, walls, grid, models, reset
     window.exports  exports.py     ExportController: CSV, plot PNG, screenshot, shape files
     window.lessons  lessons.py     LessonController: the Presets menu's lessons
+    window.backends backend_controller.py  BackendController: which solver backend runs, its menu
+    window.exercises  app/gui/exercise_controller.py  ExerciseController: the Exercises menu and panel
 
 The model behind the view is a `TunnelModel` (app/model/tunnel.py): `window.shown` is the one
 drawn (the live `window.sim`, or a replay), and every body input reaches it as a `BodyInput`
@@ -38,15 +40,15 @@ from feelflow.app.gui.force_plot import ForcePlot  # noqa: E402
 from feelflow.app.gui.side_panel import SidePanel  # noqa: E402
 from feelflow.app.gui.display_modes import DISPLAY_MODES  # noqa: E402
 from feelflow.app.gui.viewport import MOUSE_HINT, Viewport  # noqa: E402
-from feelflow.app.gui.window.backend import BackendController  # noqa: E402
+from feelflow.app.gui.window.backend_controller import BackendController  # noqa: E402
 from feelflow.app.gui.window.bodies import BodyController  # noqa: E402
 from feelflow.app.gui.window.exports import ExportController  # noqa: E402
 from feelflow.app.gui.window.flow import FlowController  # noqa: E402
 from feelflow.app.gui.window.frame_loop import FrameLoop  # noqa: E402
-from feelflow.app.gui.window.inputs import InputController  # noqa: E402
+from feelflow.app.gui.window.input_controller import InputController  # noqa: E402
 from feelflow.app.gui.window.lessons import LessonController  # noqa: E402
 from feelflow.app.gui.window.menus import build_menus  # noqa: E402
-from feelflow.app.gui.window.replay import ReplayController  # noqa: E402
+from feelflow.app.gui.window.replay_controller import ReplayController  # noqa: E402
 from feelflow.app.gui.window.settings import WindowSettings  # noqa: E402
 from feelflow.app.model.simulation import Params, Simulation  # noqa: E402
 from feelflow.app.model.tunnel import TunnelModel  # noqa: E402

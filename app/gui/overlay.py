@@ -114,24 +114,14 @@ class Overlay:
         p.drawText(at, text)
 
     def _paint_arrows(self, p: QPainter):
-        """Drag (along the relative wind) and lift (across it), length = coefficient x size / 2."""
+        """Drag (along the relative wind) and lift (across it), as app/model/readouts.py `arrows`
+        sized them (coefficient x half the reference length, in cells)."""
         v = self.view
-        sim = v.sim
-        centre = v.to_widget(*sim.pos)
-        px_per_cell = v.lattice_rect().width() / sim.config.nx
-        u = max(sim.params.wind, sim.config.max_speed / 2)
-        ref = 0.5 * u * u * sim.params.size
-        cap = 2.5 * sim.params.size
+        centre = v.to_widget(*v.sim.pos)
+        px_per_cell = v.lattice_rect().width() / v.sim.config.nx
         for key, colour in (("drag", DRAG_COLOUR), ("lift", LIFT_COLOUR)):
-            fx, fy = v.arrow_forces[key]
-            coeff_len = math.hypot(fx, fy) / ref * sim.params.size * 0.5
-            if coeff_len > cap:
-                fx, fy = fx * cap / coeff_len, fy * cap / coeff_len
-                coeff_len = cap
-            if not math.isfinite(coeff_len):
-                continue
-            vec = (fx / ref * sim.params.size * 0.5 * px_per_cell, -fy / ref * sim.params.size * 0.5 * px_per_cell)
-            self._arrow(p, centre, vec, colour, key)
+            x, y = v.arrow_forces[key]
+            self._arrow(p, centre, (x * px_per_cell, -y * px_per_cell), colour, key)
 
     def _paint_colour_bar(self, p: QPainter):
         """The colour bar, drawn once per mode and size into a pixmap, then blitted each frame."""
@@ -205,7 +195,7 @@ class Overlay:
             notes.append((f"scripted motion: {words} (phase {k + 1} of {count})", QColor(255, 255, 255)))
         stage = sim.sweep_stage()
         if stage is not None:
-            notes.append((f"wind {sim.params.wind:.3f} (speed {stage + 1} of {len(sim.sweep[0])})", QColor(255, 255, 255)))
+            notes.append((f"wind {sim.params.wind:.3f} (speed {stage + 1} of {len(sim.sweep.speeds)})", QColor(255, 255, 255)))
         for i, (text, colour) in enumerate(notes):
             self._label(p, QPointF(r.left() + 10, r.top() + 24 + 20 * i), text, colour, size=15)
 

@@ -25,7 +25,6 @@ from PySide6.QtCore import QEvent, QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QImage, QOffscreenSurface, QOpenGLContext, QPainter, QPolygonF
 from PySide6.QtWidgets import QToolTip, QWidget
 
-from feelflow import SHADER_DIR
 from feelflow.app.gui import turn_handle
 from feelflow.app.gui.cpu_field import BACKGROUND
 from feelflow.app.gui.first_start import required_gl
@@ -33,7 +32,7 @@ from feelflow.app.gui.display_modes import COLOUR_BAR_MARGIN, DISPLAY_MODES
 from feelflow.app.gui.overlay import Overlay
 from feelflow.app.model.tunnel import TunnelModel
 from feelflow.solver import units
-from feelflow.solver.lattice import glsl_constants
+from feelflow.solver.gl_programs import create_program
 
 LITTLE_ENDIAN = sys.byteorder == "little"
 WHEEL_DEG_PER_NOTCH = 2.0  # one notch of the mouse wheel (120 eighths of a degree) turns the body this far
@@ -42,9 +41,11 @@ MOUSE_HINT = ("Drag the body to move it; drag its round handle or turn the mouse
 HANDLE_HINT = "Drag to rotate the body about its reference point (Shift: 15\u00b0 steps); the mouse wheel rotates it too."
 
 
-def load_shader(name: str) -> str:
-    """A GLSL file from shaders/, with the lattice constants injected where `// @LATTICE` stands."""
-    return (SHADER_DIR / name).read_text().replace("// @LATTICE", glsl_constants())
+def display_program(ctx):
+    """The display program (shaders/display_vertex.glsl + display.glsl) on `ctx`, loaded as
+    every shader is (solver/gl_programs.py: the lattice constants injected, the driver's line
+    numbers kept, a compile error a ShaderError naming the file and line)."""
+    return create_program(ctx, "display_vertex.glsl", "display.glsl")
 
 
 class Viewport(QWidget):
@@ -71,7 +72,7 @@ class Viewport(QWidget):
         self.show_arrows = True
         self.editing = False
         self.body_edge = None    # a QColor for the body's outline instead of the usual, or None
-        self.arrow_forces = None       # {"drag": (fx, fy), "lift": (fx, fy)} lattice units
+        self.arrow_forces = None       # {"drag": (x, y), "lift": (x, y)} cells (app/model/readouts.py arrows)
         self.tracers = None
         self.frames = 0
         self.field_texture = None
@@ -131,8 +132,7 @@ class Viewport(QWidget):
             self._gl.makeCurrent(self._surface)
 
     def _init_programs(self):
-        self.program = self.ctx.program(vertex_shader=load_shader("display_vertex.glsl"),
-                                        fragment_shader=load_shader("display.glsl"))
+        self.program = display_program(self.ctx)
         self.vao = self.ctx.vertex_array(self.program, [])
         self._sampler = self.ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False)
         self._lut = None
@@ -196,7 +196,7 @@ class Viewport(QWidget):
         if self.ctx is None:       # not yet shown, or no OpenGL 3.3: a cpu_field.CpuCanvas paints over it
             painter.end()
             return
-        field = self._field_image()
+        field = self.field_image()
         if field is not None:
             image, where = field
             painter.setRenderHint(QPainter.SmoothPixmapTransform)
@@ -209,7 +209,7 @@ class Viewport(QWidget):
         """What the viewport shows (the field and its overlay), for screenshots."""
         return self.grab().toImage()
 
-    def _field_image(self):
+    def field_image(self):
         """(image, where): the field coloured by display.glsl into a QImage (top row first), at
         the lattice's own size or the lattice rectangle's size in device pixels, whichever is
         smaller, read back; `where` is the rectangle (logical pixels) to draw it in. The window

@@ -60,19 +60,6 @@ class Choice:
                 + ", ".join(t.describe() for t in self.timings))
 
 
-class MemoryStore:
-    """A ChoiceStore in a dict (tests; a window without settings)."""
-
-    def __init__(self):
-        self.values: dict[str, str] = {}
-
-    def get(self, key: str) -> str | None:
-        return self.values.get(key)
-
-    def set(self, key: str, value: str) -> None:
-        self.values[key] = value
-
-
 class JsonFileStore:
     """A ChoiceStore in a small JSON file (the command line's), written atomically; a missing or
     unreadable file is an empty store."""

@@ -12,8 +12,10 @@ import math
 from pathlib import Path
 
 from feelflow.app.model.body_input import BodyInput
+from feelflow.app.model.readouts import ReferenceLength
 from feelflow.app.sessions import SessionPlayer
-from feelflow.app.model.simulation import FORCE_MODELS, History, Params, field_rgba, shape_hit
+from feelflow.app.model.force_history import History
+from feelflow.app.model.simulation import FORCE_MODELS, Params, shape_hit
 from feelflow.solver import units
 
 
@@ -129,6 +131,10 @@ class ReplaySimulation:
         vx, vy = self.player.velocity
         return (self.player.inflow_speed - vx, -vy)
 
+    def reference_length(self) -> ReferenceLength:
+        """The body's size, the coefficients' reference length (app/model/readouts.py)."""
+        return ReferenceLength(self.params.size)
+
     def reynolds(self) -> float:
         p = self.params
         return units.reynolds(p.wind, p.size, p.nu)
@@ -144,7 +150,7 @@ class ReplaySimulation:
         return f"{NAMES.get(c, c)}: as recorded"
 
     def field_rgba(self):
-        return field_rgba(self.solver)
+        return self.solver.field_rgba()
 
     def script_phase(self):
         return None

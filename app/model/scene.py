@@ -10,7 +10,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from feelflow.app.errors import UserError
+from feelflow.app.errors import UserError, shown
 from feelflow.app.inputs import MAX_STEPS, check_work
 from feelflow.solver.motion import MOVES, MotionScript, Phase, phase_velocity
 from feelflow.solver import units
@@ -153,7 +153,7 @@ class _Reader:
         self.source = source
 
     def fail(self, key: str, message: str):
-        raise UserError(f"{self.source}: {key}: {message}")
+        raise UserError(f"{self.source}: {shown(key)}: {message}")
 
 
 def _show(value) -> str:
@@ -294,6 +294,8 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
 
 #: shape parameters that are angles: radians in `shapes`, degrees in scene files
 ANGLE_KEYS = ("angle", "apex_angle")
+#: body parameters that may be zero (a NACA section without camber)
+NONNEGATIVE_KEYS = ("camber",)
 
 
 def _body(reader: _Reader, table: _Table, nx: int, ny: int):
@@ -316,6 +318,8 @@ def _body(reader: _Reader, table: _Table, nx: int, ny: int):
             description[key] = table.choice(key, _string_choices(kind, key), optional[key])
         elif key in ANGLE_KEYS:
             description[key] = math.radians(table.number(key, optional.get(key, MISSING), positive=True))
+        elif key in NONNEGATIVE_KEYS:
+            description[key] = table.number(key, optional.get(key, MISSING), nonnegative=True)
         else:
             description[key] = table.number(key, optional.get(key, MISSING), positive=True)
     table.done()

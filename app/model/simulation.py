@@ -5,11 +5,14 @@ force history the plot and readouts show. Lattice units (docs/science/algorithm.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from feelflow.app.model import readouts
 from feelflow.app.model.body_input import BodyInput
+from feelflow.app.model.force_history import History
+from feelflow.app.model.wind_sweep import SLEW_STEPS, WindSweep
 from feelflow.app.model.coupling import AngleSpring, SpringDamper
 from feelflow.solver import units
 from feelflow.app.sessions import SessionSolver
@@ -79,84 +82,6 @@ class Params:
     compare_all: bool = False
 
 
-@dataclass
-class History:
-    """One sample per frame: step, body velocity, relative wind, force of each model in use, and
-    whether the sample is *settled*: the relative wind has stayed within `WIND_TOLERANCE` of its
-    value for at least `SETTLE_STEPS` steps. Only settled samples are steady drag; the
-    drag-against-speed view fits those (app/gui/force_plot.py). SETTLE_STEPS was chosen from a probe
-    of the 'Drag grows with speed' lesson (not a command: indicative only): 750
-    steps after a wind change had finished, the drag's 250-step means stayed within 5 % of the
-    hold's end value at every wind of the sweep, while the first few hundred steps carry the
-    acceleration's added-mass force and the flow's rearrangement (up to +60 %). What the choice
-    gives is measured by `feelflow report lessons` (docs/science/validation.md 'Calm tunnels': the fitted exponent)."""
-
-    time: list = field(default_factory=list)
-    body_velocity: list = field(default_factory=list)
-    wind: list = field(default_factory=list)
-    forces: dict = field(default_factory=dict)  # model -> list of (Fx, Fy)
-    settled: list = field(default_factory=list)
-    _wind_ref: tuple = (math.nan, math.nan)      # relative wind when it last changed, and when
-    _since: float = 0.0
-
-    MAX = 20000
-    SETTLE_STEPS = 1000
-    WIND_TOLERANCE = 0.02
-
-    def add(self, time, body_velocity, wind, forces):
-        self.time.append(time)
-        self.body_velocity.append(body_velocity)
-        self.wind.append(wind)
-        self.settled.append(self._settled(time, wind))
-        for name, f in forces.items():
-            series = self.forces.setdefault(name, [])
-            series.extend([(math.nan, math.nan)] * (len(self.time) - 1 - len(series)))
-            series.append(f)
-        if len(self.time) > self.MAX:
-            cut = len(self.time) - self.MAX
-            del self.time[:cut], self.body_velocity[:cut], self.wind[:cut], self.settled[:cut]
-            for series in self.forces.values():
-                del series[:max(0, len(series) - self.MAX)]
-
-    def _settled(self, time, wind) -> bool:
-        ref = self._wind_ref
-        scale = max(math.hypot(*ref), math.hypot(*wind), 1e-9) if all(map(math.isfinite, ref)) else 0.0
-        if not scale or math.hypot(wind[0] - ref[0], wind[1] - ref[1]) > self.WIND_TOLERANCE * scale:
-            self._wind_ref, self._since = tuple(wind), time
-        return time - self._since >= self.SETTLE_STEPS
-
-    def clear(self):
-        self.time.clear(), self.body_velocity.clear(), self.wind.clear(), self.forces.clear()
-        self.settled.clear()
-        self._wind_ref, self._since = (math.nan, math.nan), 0.0
-
-    def __len__(self):
-        return len(self.time)
-
-    def drag_lift(self, model: str):
-        """(t, drag, lift) arrays: force along and across the relative wind (NaN where absent)."""
-        n = len(self.time)
-        series = self.forces.get(model, [])
-        f = np.full((n, 2), np.nan)
-        if series:
-            f[n - len(series):] = np.asarray(series[-n:], float)
-        w = np.asarray(self.wind, float).reshape(n, 2)
-        along = drag_direction(w)
-        drag = (f * along).sum(axis=1)
-        lift = f[:, 1] * along[:, 0] - f[:, 0] * along[:, 1]
-        return np.asarray(self.time, float), drag, lift
-
-
-def drag_direction(wind):
-    """Unit vectors along the relative wind (+x where the relative wind is ~0)."""
-    w = np.atleast_2d(np.asarray(wind, float))
-    s = np.hypot(w[:, 0], w[:, 1])
-    out = np.tile([1.0, 0.0], (len(w), 1))
-    ok = s > 1e-9
-    out[ok] = w[ok] / s[ok, None]
-    return out
-
-
 def wrap_degrees(degrees: float) -> float:
     """An angle in [-180, 180): what the panel's angle box shows for any number of turns."""
     return (degrees + 180.0) % 360.0 - 180.0
@@ -187,18 +112,20 @@ def stable_params(params: Params, collision: str) -> tuple[Params, str | None]:
 
 
 class Simulation:
-    """Owns the solver and the body; `advance(n)` runs n steps and records one force sample.
-    The wind and viscosity it is given stay inside the measured stable region (`stable_params`);
-    `guard_note` says what the last change had to adjust (None when nothing).
+    """The running tunnel: owns the solver (a `SessionSolver`), the body and its pose, and runs
+    `advance(n)`: n steps and one force sample. Its parts, each set up here:
+    - the panel's parameters (`params`) kept inside the measured stable region (`stable_params`;
+      `guard_note` says what the last change had to adjust, None when nothing), and the
+      collision operator chosen for them (`operator_for`, solver/operator_choice.py);
+    - the body's pose and its input: the mouse's spring-damper (`coupling`) and the angle spring
+      (app/model/coupling.py), through `drive(BodyInput)`;
+    - a motion script (`runner`, solver/motion.py) or a wind sweep (`sweep`,
+      app/model/wind_sweep.py) when one runs;
+    - the force history (`history`, app/model/force_history.py), the reporter the plot reads.
+    """
 
-    A wind sweep (`start_sweep`, the 'Drag grows with speed' lesson) spreads each change of wind
-    over `SWEEP_SLEW_STEPS`: a sudden change sends a pressure pulse (rho c_s dU) through the
-    tunnel that rings between the walls, across the stream, where the outlet's absorbing layer
-    cannot take it out; 500 steps is a little more than that ringing's period at the lessons'
-    128 rows (2 ny / c_s = 443 steps). Measured (`feelflow report lessons --compare`, docs/science/validation.md
-    'Calm tunnels'): the drag's scatter over the second half of each hold falls severalfold."""
-
-    SWEEP_SLEW_STEPS = 500
+    #: a sweep's change of wind is spread over this many steps (app/model/wind_sweep.py)
+    SWEEP_SLEW_STEPS = SLEW_STEPS
 
     def __init__(self, params: Params | None = None, backend: str = "numpy", ctx=None, shape_factory=None,
                  base_config: FlowConfig | None = None):
@@ -211,20 +138,36 @@ class Simulation:
         self.polygon = None          # vertices of the custom polygon (body frame), or None
         self.history = History()
         self.hold_still = False
-        self._target = None          # where an input pulls the body (`drive`), or None
-        self.angle_target = math.radians(self.params.angle_deg)
         self._asked = (None, None)   # (degrees, radians) of the last turn_to: see target_degrees
         self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
+        self.sweep: WindSweep | None = None       # a wind-speed sweep (a lesson), or None
+        self.sweep_slew_steps = self.SWEEP_SLEW_STEPS   # for the next sweep (0: changes at once)
         self.base_config = base_config or default_base_config(self.params.grid)
         self._wind_starts_everywhere = base_config is None   # default tunnel: no ramp, see below
         # the collision operator: a given base configuration names it; else chosen per flow
         self.operator_named = None if base_config is None else base_config.collision
         self.params, self.guard_note = stable_params(self.params, self.guard_operator)
-        self.sweep = None            # (wind speeds, steps each, first step): a wind-speed sweep
-        self.sweep_slew_steps = self.SWEEP_SLEW_STEPS
         self.capped = False          # the Mach cap limited the body's speed in the last frame
-        self.solver = None
-        self._build(keep_flow=False)
+        #: the coefficients' reference length when it is not the body's size (an exercise's)
+        self.reference_override: readouts.ReferenceLength | None = None
+        self.config = self.flow_config()
+        # one SessionSolver for the life of the window (app/sessions/): rebuilt, never replaced
+        self.solver = SessionSolver(create_solver(self.backend, self.config, ctx=ctx))
+        self.coupling = SpringDamper(max_speed=self.config.max_speed)
+        # the body's pose: reference point (cells), velocity (cells per step), angle and its rate
+        self.pos, self.vel = self.start_position(self.config), (0.0, 0.0)
+        self.angle, self.rate = math.radians(self.params.angle_deg), 0.0
+        self.angle_target = self.angle
+        self._target = None          # where an input pulls the body (`drive`), or None
+        self._clamped_x = self._clamped_y = False   # the last _clamp_pose pushed the body back in x, y
+        self.shape = self.make_shape(self.params, self.polygon, *self.pos, self.angle).validate(
+            self.config.nx, self.config.ny)
+        self._place_body()
+
+    @staticmethod
+    def start_position(config: FlowConfig) -> tuple[float, float]:
+        """Where a new tunnel puts the body: a third of the way down, on the centre line."""
+        return (config.nx * 0.3, config.ny * 0.5)
 
     # --- construction --------------------------------------------------------------------
     @property
@@ -252,16 +195,14 @@ class Simulation:
                        sponge_cells=min(base.sponge_cells, nx // 4), **extra).validate()
 
     def _build(self, keep_flow: bool):
+        """The flow for the parameters now, from the old one where `keep_flow` and the grid is the
+        same (recorded as a rebuild when a session is being recorded); else from rest, with the
+        body back at its start and the history cleared."""
         config = self.flow_config()
-        same_grid = self.solver is not None and (self.solver.config.nx, self.solver.config.ny) == (config.nx, config.ny)
-        if self.solver is None:   # one SessionSolver for the life of the window (app/sessions/)
-            backend = create_solver(self.backend, config, **({"ctx": self.ctx} if self.backend == "gl" else {}))
-            self.solver = SessionSolver(backend)
-        else:                     # recorded as a rebuild when a session is being recorded
-            self.solver.rebuild(config, keep_flow=keep_flow and same_grid)
+        same_grid = (self.config.nx, self.config.ny) == (config.nx, config.ny)
+        self.solver.rebuild(config, keep_flow=keep_flow and same_grid)
         if not (keep_flow and same_grid):
-            nx, ny = config.nx, config.ny
-            self.pos, self.vel = (nx * 0.3, ny * 0.5), (0.0, 0.0)
+            self.pos, self.vel = self.start_position(config), (0.0, 0.0)
             self.angle, self.rate = math.radians(self.params.angle_deg), 0.0
             self.angle_target = self.angle
             self._target = None
@@ -270,8 +211,12 @@ class Simulation:
             self.runner = None
         self.config = config
         self.coupling = SpringDamper(max_speed=config.max_speed)
-        if not keep_flow or not hasattr(self, "shape"):
+        if not keep_flow:
             self.shape = self.make_shape(self.params, self.polygon, *self.pos, self.angle).validate(config.nx, config.ny)
+        self._place_body()
+
+    def _place_body(self):
+        """The body inside the margins, the force models enabled, the body placed in the flow."""
         self._clamp_pose()
         self._enable_models()
         self.solver.set_body(self.shape, self.vel, 0.0)
@@ -307,7 +252,7 @@ class Simulation:
         only_wind = ((params.nu, params.wall) == (self.params.nu, self.params.wall)
                      and new.collision == self.config.collision)
         self.params = params
-        if only_wind and hasattr(self.solver, "set_inflow_speed"):
+        if only_wind:
             self.solver.set_inflow_speed(params.wind)   # live, no rebuild
         else:
             self._build(keep_flow=True)
@@ -335,34 +280,16 @@ class Simulation:
         """Hold each wind speed `hold_steps` steps in turn (the 'drag grows with speed' lesson);
         the first one from the end of the inlet's start-up ramp, if it is still rising."""
         start = max(self.solver.time, self.config.inflow_ramp_steps)
-        self.sweep = (tuple(speeds), int(hold_steps), start)
+        self.sweep = WindSweep(tuple(speeds), int(hold_steps), start, self.sweep_slew_steps)
         self.set_flow(wind=speeds[0])
 
     def sweep_end(self):
         """The step at which the sweep ends (None without a sweep)."""
-        if self.sweep is None:
-            return None
-        speeds, hold, start = self.sweep
-        return start + len(speeds) * hold
+        return None if self.sweep is None else self.sweep.end
 
     def sweep_stage(self):
-        if self.sweep is None:
-            return None
-        speeds, hold, start = self.sweep
-        k = max(0, self.solver.time - start) // hold
-        return k if k < len(speeds) else None
-
-    def sweep_wind(self):
-        """The sweep's wind now: each step to the next speed is spread over `SWEEP_SLEW_STEPS`
-        (linear), not made at once; None when the sweep is over."""
-        k = self.sweep_stage()
-        if k is None:
-            return None
-        speeds, hold, start = self.sweep
-        if k == 0 or self.sweep_slew_steps <= 0:
-            return speeds[k]
-        frac = min(1.0, (self.solver.time - start - k * hold) / self.sweep_slew_steps)
-        return speeds[k - 1] + frac * (speeds[k] - speeds[k - 1])
+        """Which speed of the sweep holds now, or None."""
+        return None if self.sweep is None else self.sweep.stage(self.solver.time)
 
     def start_script(self, script):
         """Drive the body through a solver.motion.MotionScript (mouse and hold-still ignored)."""
@@ -459,7 +386,7 @@ class Simulation:
         """Run n steps, moving the body in chunks of at most half a cell; record a sample."""
         n = max(1, int(n))
         if self.sweep is not None:
-            wind = self.sweep_wind()
+            wind = self.sweep.wind(self.solver.time)
             if wind is None:
                 self.sweep = None
             elif wind != self.params.wind:
@@ -481,7 +408,7 @@ class Simulation:
             chunk = n - done if speed < 1e-9 else max(1, min(n - done, int(0.5 / speed)))
             self._move_body(chunk)
             self.solver.step(chunk)   # raises solver.backend.SolverDiverged when the flow blows up
-            self.capped |= bool(getattr(self.solver, "speed_capped", False))
+            self.capped |= self.solver.speed_capped
             for name, (fx, fy) in self.solver.forces().items():
                 ax, ay = acc.get(name, (0.0, 0.0))
                 acc[name] = (ax + fx * chunk, ay + fy * chunk)
@@ -522,6 +449,11 @@ class Simulation:
         return False
 
     # --- what the window shows -----------------------------------------------------------
+    def reference_length(self) -> readouts.ReferenceLength:
+        """The length the force coefficients use (app/model/readouts.py): the body's size, or
+        the one an exercise sets (`reference_override`)."""
+        return self.reference_override or readouts.ReferenceLength(self.params.size)
+
     def reynolds(self) -> float:
         """Re of the wind over the body size (solver/units.py)."""
         return units.reynolds(self.params.wind, self.params.size, self.params.nu)
@@ -534,7 +466,7 @@ class Simulation:
         return self.operator_for().reason
 
     def field_rgba(self) -> np.ndarray:
-        return field_rgba(self.solver)
+        return self.solver.field_rgba()
 
 
 def shape_hit(shape, x: float, y: float, tolerance: float = 2.0) -> bool:
@@ -545,13 +477,3 @@ def shape_hit(shape, x: float, y: float, tolerance: float = 2.0) -> bool:
     px = x + np.array([0, -1, 1, 0, 0]) * tolerance
     py = y + np.array([0, 0, 0, -1, 1]) * tolerance
     return bool(np.any(shape.contains(px, py)))
-
-
-def field_rgba(solver) -> np.ndarray:
-    """(ny, nx, 4) float32: rho, ux, uy, vorticity of `solver`'s flow (numpy path; the gl
-    backend has a texture)."""
-    rho, ux, uy = solver.macroscopic()
-    out = np.empty(rho.shape + (4,), np.float32)
-    out[..., 0], out[..., 1], out[..., 2] = rho, ux, uy
-    out[..., 3] = np.gradient(uy, axis=1) - np.gradient(ux, axis=0)
-    return out

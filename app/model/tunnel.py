@@ -10,9 +10,21 @@ go to the live `Simulation` only, which a replay never replaces. Lattice units t
 """
 from __future__ import annotations
 
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
+
+import numpy as np
 
 from feelflow.app.model.body_input import BodyInput
+from feelflow.app.model.readouts import ReferenceLength
+from feelflow.app.model.wind_sweep import WindSweep
+from feelflow.app.sessions import SessionSolver
+from feelflow.shapes.base import Shape
+from feelflow.solver.config import FlowConfig
+from feelflow.solver.motion import MotionRunner
+
+if TYPE_CHECKING:   # simulation.py defines them and implements this interface
+    from feelflow.app.model.force_history import History
+    from feelflow.app.model.simulation import Params
 
 
 @runtime_checkable
@@ -20,20 +32,20 @@ class TunnelModel(Protocol):
     """What the window drives: one frame at a time (`advance`), body input through one way in
     (`drive`), and what is drawn and read out."""
 
-    config: Any          # solver.config.FlowConfig: grid size, Mach cap, sponge
-    params: Any          # simulation.Params: what the side panel shows
-    history: Any         # simulation.History: one force sample per frame, for the plot
-    solver: Any          # the backend behind the field (numpy arrays or the gl field texture)
-    shape: Any           # the body (shapes.base.Shape) where the flow feels it, or None
+    config: FlowConfig   # grid size, Mach cap, sponge
+    params: "Params"     # what the side panel shows
+    history: "History"   # one force sample per frame, for the plot
+    solver: SessionSolver   # the flow (a solver.backend.FlowSolver): its field, range check, recording
+    shape: Shape | None  # the body where the flow feels it, or None
     pos: tuple[float, float]    # the body's reference point (cells)
     angle: float         # the body's angle (radians)
     vel: tuple[float, float]    # the body's velocity (cells per step)
     target: tuple[float, float] | None   # where an input pulls the body, or None
     hold_still: bool     # the body ignores pulls and turns (the polygon editor, some lessons)
-    polygon: Any         # the custom polygon's vertices (body frame), or None
+    polygon: list | None   # the custom polygon's vertices (body frame), or None
     capped: bool         # the Mach cap limited the body's speed in the last frame
-    sweep: Any           # a lesson's wind sweep (speeds, steps each, first step), or None
-    runner: Any          # a motion script driving the pose (solver.motion.MotionRunner), or None
+    sweep: WindSweep | None   # a lesson's wind sweep, or None
+    runner: MotionRunner | None   # a motion script driving the pose, or None
 
     def advance(self, n: int) -> dict:
         """Run about n steps; {force model: (Fx, Fy)} averaged over them."""
@@ -55,6 +67,10 @@ class TunnelModel(Protocol):
         """The wind the body meets: the inflow less the body's velocity."""
         ...
 
+    def reference_length(self) -> ReferenceLength:
+        """The length the force coefficients are made dimensionless with (app/model/readouts.py)."""
+        ...
+
     def reynolds(self) -> float:
         ...
 
@@ -65,7 +81,7 @@ class TunnelModel(Protocol):
         """Which collision operator runs and why, in one line (solver/operator_choice.py)."""
         ...
 
-    def field_rgba(self) -> Any:
+    def field_rgba(self) -> np.ndarray:
         """(ny, nx, 4) float32: rho, ux, uy, vorticity (the numpy path's field)."""
         ...
 

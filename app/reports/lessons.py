@@ -37,12 +37,13 @@ def run_lesson(key: str, backend: str = "numpy", plain: bool = False, make_ctx=N
     from feelflow.app.model.presets import PRESETS
     from feelflow.app.model.scene import load_scene
     from feelflow.app.model.simulation import Simulation
+    from feelflow.solver.backend import needs_gl_context
 
     lesson = PRESETS[key]
     scene = load_scene(lesson.path)
     if plain:
         scene = plain_scene(scene)
-    sim = Simulation(backend=backend, **({"ctx": make_ctx()} if backend == "gl" else {}))
+    sim = Simulation(backend=backend, ctx=make_ctx() if needs_gl_context(backend) else None)
     try:
         sim.load_scene(scene)
         sim.hold_still = lesson.hold_still and sim.runner is None
@@ -51,7 +52,7 @@ def run_lesson(key: str, backend: str = "numpy", plain: bool = False, make_ctx=N
         if lesson.wind_sweep:
             sim.start_sweep(lesson.wind_sweep, lesson.hold_steps)
             steps = sim.sweep_end()
-            first = sim.sweep[2]
+            first = sim.sweep.start
         else:
             steps = scene.steps
         start = time.perf_counter()

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import io
 import math
+import tokenize
 import zipfile
 import zlib
 
@@ -94,7 +95,9 @@ def _entries(raw: bytes, member: str):
                     shape, _, dtype = read(fh, max_header_size=4096)
                     out.append((name, shape, dtype, info.file_size - fh.tell()))
     except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, NotImplementedError,
-            RuntimeError) as exc:
+            RuntimeError, SyntaxError, tokenize.TokenError, MemoryError) as exc:
+        # numpy's .npy header parser tokenizes the header text: a malformed one raises
+        # tokenize.TokenError or SyntaxError
         text = str(exc).splitlines()[0][:80] if str(exc) else type(exc).__name__
         return f"{member} is not a readable .npz archive ({text})"
     return out

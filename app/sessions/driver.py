@@ -29,16 +29,16 @@ def _geometry(shape):
 class SessionSolver:
     """The solver as the app drives it: a backend plus the commands a session records.
 
-    Drive it like a `feelflow.solver.backend.Solver` (set_body, set_inflow_speed, enable_force_models,
-    step, forces, distributions, time, ...: anything else is passed to the wrapped backend) plus
-    the session-level commands `set_viscosity`, `reset`, `rebuild`, `pause`, `resume`. While it
+    Drive it like a backend: it is a `feelflow.solver.backend.FlowSolver` (set_body,
+    set_inflow_speed, enable_force_models, step, forces, the field, the range check), plus the
+    session-level commands `set_viscosity`, `reset`, `rebuild`, `pause`, `resume`. While it
     has a `recorder`, every command is recorded; `replay` feeds a recording back through these
     same methods, which is why a replay reproduces the run. Keep one SessionSolver for the whole
     life of the flow (it remembers the last placement); `start_recording` can then begin at
     any moment between two `step` calls.
 
     `set_viscosity`, `reset` and `rebuild` build a new backend with `factory(config)`
-    (default: the same backend by name, handing on the wrapped solver's `.ctx` if it has one).
+    (default: the same backend by name, on the wrapped solver's GL context if it has one).
 
     The flow's physical range (`check_physical`) is checked after each `step` call (each force
     row), or, with `check_every` = N > 1, only once at least N solver steps have run since the
@@ -69,12 +69,47 @@ class SessionSolver:
         """The backend being driven (it changes on reset, rebuild and viscosity changes)."""
         return self._solver
 
-    def __getattr__(self, name):
-        return getattr(self._solver, name)
+    # --- the flow, as the backend has it (solver.backend.FlowSolver) ----------------------
+    @property
+    def config(self) -> FlowConfig:
+        return self._solver.config
+
+    @property
+    def name(self) -> str:
+        return self._solver.name
 
     @property
     def time(self) -> int:
         return self._solver.time
+
+    @property
+    def speed_capped(self) -> bool:
+        return self._solver.speed_capped
+
+    @property
+    def gl_context(self):
+        return self._solver.gl_context
+
+    def forces(self) -> dict[str, tuple[float, float]]:
+        return self._solver.forces()
+
+    def macroscopic(self):
+        return self._solver.macroscopic()
+
+    def distributions(self) -> np.ndarray:
+        return self._solver.distributions()
+
+    def inlet_reference(self) -> np.ndarray | None:
+        return self._solver.inlet_reference()
+
+    def field_rgba(self) -> np.ndarray:
+        return self._solver.field_rgba()
+
+    def field_texture(self, vorticity: bool = True):
+        return self._solver.field_texture(vorticity=vorticity)
+
+    def total_mass(self) -> float:
+        return self._solver.total_mass()
 
     # --- recording ------------------------------------------------------------
     def start_recording(self, **recorder_kwargs) -> SessionRecorder:
@@ -98,7 +133,7 @@ class SessionSolver:
         return rec
 
     # --- solver commands ------------------------------------------------------
-    def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, **kwargs) -> None:
+    def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
         rec = self.recorder
         if shape is None:
             if rec is not None:
@@ -112,13 +147,11 @@ class SessionSolver:
             if _geometry(shape) != _geometry(self.geometry_shape):
                 rec.record_parameter("body", shape.to_dict())
             rec.record_input(shape.x, shape.y, shape.angle, velocity[0], velocity[1], omega)
-        self._solver.set_body(shape, velocity=velocity, omega=omega, **kwargs)
+        self._solver.set_body(shape, velocity=velocity, omega=omega)
         self.geometry_shape = self.shape = shape
         self.velocity, self.omega = velocity, omega
 
     def set_inflow_speed(self, speed: float) -> None:
-        if not hasattr(self._solver, "set_inflow_speed"):
-            raise SessionError(f"the {self._solver.name} backend cannot change the inflow speed")
         if self.recorder is not None:
             self.recorder.record_parameter("inflow_speed", float(speed))
         self._solver.set_inflow_speed(float(speed))
@@ -279,8 +312,7 @@ class SessionSolver:
 
 def _same_backend_factory(solver):
     def factory(config):
-        ctx = getattr(solver, "ctx", None)
-        return create_solver(solver.name, config, **({"ctx": ctx} if ctx is not None else {}))
+        return create_solver(solver.name, config, ctx=solver.gl_context)
     return factory
 
 

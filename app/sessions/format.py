@@ -23,12 +23,15 @@ from pathlib import Path
 
 import numpy as np
 
+from feelflow.app.errors import shown
+from feelflow.app.sessions import versions
 from feelflow.app.sessions.bounds import MAX_FILE_BYTES, MAX_JSON_BYTES, check_npz, member_limits
 from feelflow.solver.config import ConfigError, FlowConfig
 
 FORMAT = "feelflow-session"
-#: bumped whenever a version-1 reader would misread a file (docs/reference/session-format.md, "Versioning")
-VERSION = 1
+#: the format version written; bumped whenever an older reader would misread a file, with a
+#: loader for the new version (app/sessions/versions.py; docs/reference/session-format.md, "Versioning")
+VERSION = versions.VERSION
 SUFFIX = ".ffsession"
 
 MANIFEST = "manifest.json"
@@ -73,12 +76,9 @@ class SessionError(ValueError):
 # --- the scene as the session stores it -------------------------------------------------------
 
 def config_to_dict(config: FlowConfig) -> dict:
-    """FlowConfig -> JSON-ready dict (tuples become lists; `extra` is kept if JSON-able)."""
-    d = {}
-    for f in dataclasses.fields(config):
-        v = getattr(config, f.name)
-        d[f.name] = list(v) if isinstance(v, tuple) else v
-    return d
+    """FlowConfig -> the current version's JSON-ready dict (app/sessions/versions.py's schema;
+    tuples become lists; `extra` is kept if JSON-able)."""
+    return versions.config_to_dict(config)
 
 
 def config_from_dict(d) -> FlowConfig:
@@ -88,7 +88,7 @@ def config_from_dict(d) -> FlowConfig:
     names = {f.name for f in dataclasses.fields(FlowConfig)}
     unknown = sorted(set(d) - names)
     if unknown:
-        raise SessionError(f"scene.config has unknown key {unknown[0]!r}")
+        raise SessionError(f"scene.config has unknown key {shown(unknown[0])!r}")
     kwargs = {}
     for key, v in d.items():
         if key in ("body_force", "initial_velocity"):
@@ -97,11 +97,19 @@ def config_from_dict(d) -> FlowConfig:
             v = (float(v[0]), float(v[1]))
         kwargs[key] = v
     try:
-        return FlowConfig(**kwargs).validate()
+        config = FlowConfig(**kwargs).validate()
     except ConfigError as exc:
         raise SessionError(f"scene.config.{exc}") from None
     except TypeError as exc:  # a missing nx/ny, or a value of the wrong type
         raise SessionError(f"scene.config: {str(exc).splitlines()[0]}") from None
+    from feelflow.app.errors import UserError
+    from feelflow.app.inputs import check_work
+
+    try:   # the scene files' grid bound (MAX_NODES), also for a recorded rebuild
+        check_work(config.nx, config.ny, 0, "scene.config", "grid")
+    except UserError as exc:
+        raise SessionError(str(exc)) from None
+    return config
 
 
 def is_number(v) -> bool:
@@ -198,25 +206,15 @@ def _fmt(v) -> str:
 # --- files ------------------------------------------------------------------------------------
 
 def atomic_write_bytes(path, data: bytes, what: str = "file") -> Path:
-    """Write `data` through `feelflow.app.files.atomic_path` (temp file beside, fsync, os.replace): never
-    half a file. SessionError naming the path if it cannot (the old file is left as it was)."""
-    from feelflow.app.files import atomic_path, rescue_path
+    """Write `data` through the app's one writer (app/files.py: temp file beside, fsync,
+    os.replace; on failure a rescue copy in the temp folder). SessionError naming the path if it
+    cannot (the old file is left as it was)."""
+    from feelflow.app.files import OutputError, save_bytes
 
-    path = Path(path)
-    if path.is_dir():
-        raise SessionError(f"{path}: is a directory")
     try:
-        with atomic_path(path, suffix=".tmp") as tmp:
-            tmp.write_bytes(data)
-    except OSError as exc:
-        try:   # the work is not lost: it goes to a new file in the temp folder
-            saved = rescue_path(path)
-            saved.write_bytes(data)
-            where = f"it was saved to {saved} instead"
-        except OSError:
-            where = "no rescue copy could be written either"
-        raise SessionError(f"{path}: cannot write {what} ({exc.strerror or exc}); {where}") from None
-    return path
+        return save_bytes(path, data, what)
+    except OutputError as exc:
+        raise SessionError(str(exc)) from None
 
 
 def _npz_bytes(arrays: dict) -> bytes:
@@ -376,14 +374,10 @@ def _optional_array(raw: bytes, member: str, name: str, fail):
 def _validate(manifest, parameters, inputs, forces, src, state=None, inlet_reference=None) -> Session:
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         raise SessionError(f"{MANIFEST}: not a FeelFlow session (expected \"format\": \"{FORMAT}\")")
-    version = manifest.get("version")
-    if isinstance(version, bool) or not isinstance(version, int):
-        raise SessionError(f"{MANIFEST}: version must be an integer, got {version!r}")
-    if version > VERSION:
-        raise SessionError(f"session format version {version} was written by a newer FeelFlow "
-                           f"(this one reads version {VERSION})")
-    if version != VERSION:
-        raise SessionError(f"unsupported session format version {version} (this FeelFlow reads {VERSION})")
+    try:   # one loader per format version: the file in the current version's form
+        manifest, parameters = versions.loader_for(manifest.get("version")).upgrade(manifest, parameters)
+    except versions.SessionFormatError as exc:
+        raise SessionError(f"{MANIFEST}: {exc}") from None
     for key, kind in (("feelflow_version", str), ("created", str), ("backend", str), ("renderer", str),
                       ("scene", dict), ("forces", dict), ("counts", dict)):
         if not isinstance(manifest.get(key), kind):

@@ -51,8 +51,7 @@ class SessionPlayer:
         self.session = session
         self.backend = backend or session.backend
         if factory is None:
-            kwargs = {"ctx": ctx} if ctx is not None else {}
-            factory = lambda config: create_solver(self.backend, config, **kwargs)  # noqa: E731
+            factory = lambda config: create_solver(self.backend, config, ctx=ctx)  # noqa: E731
         start = session.start
         placed = session.body if start is not None and start["body_placed"] else None
         try:

@@ -111,10 +111,6 @@ class FrameParser:
         self.unexpected = 0
         self.good = 0
 
-    @property
-    def dropped_frames(self) -> int:
-        return self.bad_crc + self.bad_version + self.malformed + self.unexpected
-
     def feed(self, data: bytes) -> list:
         self._buf += data
         out = []

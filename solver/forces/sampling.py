@@ -1,8 +1,8 @@
 """Reading the fluid state of a `BodyWindow` at points that are not nodes.
 
 Two ways, one per need:
-- `bilinear`: plain bilinear interpolation of a node field (the macroscopic model samples the
-  velocity on a contour a few cells off the wall, where every stencil node is fluid).
+- `bilinear_stencil`: plain bilinear interpolation of a node field (the macroscopic model samples
+  the velocity on a contour a few cells off the wall, where every stencil node is fluid).
 - `fluid_extrapolate`: a weighted least-squares linear fit to the *fluid* nodes around a point,
   evaluated at the point (the pressure model needs the density on the wall itself, where a
   bilinear stencil would mix in solid nodes, which hold rho_0 and not the fluid's density).
@@ -76,12 +76,6 @@ def bilinear_stencil(window, px, py) -> Stencil:
     idx = np.stack([j0 * w + i0, j0 * w + i0 + 1, (j0 + 1) * w + i0, (j0 + 1) * w + i0 + 1], axis=1)
     coef = np.stack([(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty], axis=1) * valid[:, None]
     return Stencil(idx, coef, valid)
-
-
-def bilinear(window, fields, px, py):
-    """Bilinear interpolation of node fields (each (h, w)) at points (px, py); list of (k,) arrays."""
-    st = bilinear_stencil(window, px, py)
-    return [st.apply(np.asarray(a).ravel()) for a in fields]
 
 
 def fluid_fit_stencil(window, px, py, radius: float = 2.5) -> Stencil:

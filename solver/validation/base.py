@@ -28,12 +28,6 @@ class Check:
     def describe(self) -> str:
         return f"{self.low:.6g} .. {self.high:.6g}"
 
-    @classmethod
-    def around(cls, quantity: str, reference: float, rel: float, source: str = "") -> "Check":
-        """reference +- rel * |reference|."""
-        d = abs(reference) * rel
-        return cls(quantity, reference - d, reference + d, source)
-
 
 @dataclass
 class CaseResult:

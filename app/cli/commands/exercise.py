@@ -10,7 +10,6 @@ Format: docs/reference/exercise-format.md. Bad input is one line on stderr and e
 """
 from __future__ import annotations
 
-import csv
 import sys
 import time
 from pathlib import Path
@@ -26,10 +25,16 @@ def add_arguments(parser):
     p = sub.add_parser("score", help="score shape files (or folders of them) and rank them")
     p.add_argument("exercise", metavar="EXERCISE.toml")
     p.add_argument("shapes", metavar="SHAPES", nargs="+", help="shape JSON files or folders of them")
-    p.add_argument("--out", default="scores.csv", metavar="PATH", help="CSV file to write (default: scores.csv)")
+    p.add_argument("--out", default="scores.csv", metavar="PATH",
+                   help="CSV file to write (default: scores.csv); an existing file is refused before "
+                        "scoring starts unless --force is given")
+    p.add_argument("--force", action="store_true",
+                   help="replace --out if it exists (never the exercise file or a shape being scored)")
     p.add_argument("--workers", default=None, metavar="N", help="processes (default: every core)")
     p.add_argument("--scale", default=None, metavar="N",
-                   help="score at N times the exercise's resolution (default 1; 2 to confirm a close ranking)")
+                   help="score at N times the exercise's resolution (1..8; default 1; 2 to confirm a close "
+                        "ranking); refused before scoring when the grid, the steps or the memory it "
+                        "needs are beyond the bounds")
     p = sub.add_parser("check", help="validate an exercise file and score its reference solutions")
     p.add_argument("exercise", metavar="EXERCISE.toml")
     p.add_argument("--convergence", action="store_true",
@@ -46,8 +51,54 @@ def _positive(name, text):
     return positive_int_option(name, text)
 
 
+#: largest --scale (a scaled run must also fit the grid, steps and memory bounds: app/inputs.py)
+MAX_SCALE = 8
+#: most --workers processes
+MAX_WORKERS = 256
+
+
 def _workers(text):
-    return None if text is None else _positive("--workers", text)
+    if text is None:
+        return None
+    n = _positive("--workers", text)
+    if n > MAX_WORKERS:
+        raise UserError(f"--workers: at most {MAX_WORKERS}, got {n}")
+    return n
+
+
+def _scale(text) -> int:
+    if text is None:
+        return 1
+    n = _positive("--scale", text)
+    if n > MAX_SCALE:
+        raise UserError(f"--scale: must be in 1..{MAX_SCALE}, got {n}")
+    return n
+
+
+def _fit(exercise, scales, workers: int, jobs: int, option: str) -> int:
+    """Check the work and memory of scoring at `scales` before any run (grid, steps and memory
+    bounds of app/inputs.py); returns the processes that fit in memory (at most `workers`)."""
+    from feelflow.app.inputs import available_memory, check_memory, check_work, run_bytes
+    from feelflow.solver.config import ConfigError
+
+    for scale in scales:
+        s = exercise.scene.scaled(scale)
+        where = f"{option} {scale}" if option else exercise.source
+        check_work(s.nx, s.ny, s.steps, where, "scene.steps at this scale")
+        check_memory(s.nx, s.ny, where, "the scaled grid")
+        try:
+            s.flow_config()
+        except ConfigError as exc:
+            raise UserError(f"{where}: the scaled scene: {exc}") from None
+    need = max(run_bytes(exercise.scene.scaled(sc).nx, exercise.scene.scaled(sc).ny) for sc in scales)
+    limit = available_memory()
+    processes = max(1, min(workers, jobs))
+    if limit is not None and need * processes > limit:
+        fitting = max(1, int(limit // need))
+        print(f"memory: each run needs about {need / 2 ** 30:.2f} GiB and {limit / 2 ** 30:.2f} GiB "
+              f"can be used: {fitting} processes instead of {processes}", file=sys.stderr)
+        return fitting
+    return workers
 
 
 class ProgressBar:
@@ -103,26 +154,23 @@ def _list() -> int:
 
 def _score(exercise, args) -> int:
     from feelflow.app.exercises import grading
-    from feelflow.app.files import atomic_path
+    from feelflow.app.files import check_output, save_csv
 
-    out = Path(args.out)
-    if out.is_dir():
-        raise UserError(f"--out: {args.out!r} is a directory")
-    if not (out.parent if str(out.parent) else Path(".")).is_dir():
-        raise UserError(f"--out: directory {str(out.parent)!r} does not exist")
     files = grading.shape_files(args.shapes)
+    # the output is checked before any scoring: never an input, never a device, never an
+    # existing file without --force (app/files.py)
+    out = check_output(args.out, "--out", inputs=[exercise.path, *exercise.input_files(), *files],
+                       force=args.force)
     workers = _workers(args.workers) or grading.default_workers()
-    scale = 1 if args.scale is None else _positive("--scale", args.scale)
+    scale = _scale(args.scale)
+    workers = _fit(exercise, (scale,), workers, len(files), "--scale" if args.scale is not None else "")
     s = exercise.scene.scaled(scale)
     print(_machine_line())
     print(f"{exercise.title}: scoring {len(files)} shape files on {min(workers, len(files))} processes "
           f"(numpy float64, {s.nx} x {s.ny}, {s.steps} steps each)", flush=True)
     rows, wall = grading.grade(exercise, files, workers, scales=(scale,), progress=ProgressBar("shapes"))
     rows = grading.ranked(exercise, rows)
-    with atomic_path(out, suffix=".tmp") as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(grading.CSV_HEADER)
-        writer.writerows(grading.csv_rows(rows))
+    save_csv(out, grading.CSV_HEADER, grading.csv_rows(rows), "--out")
     o = exercise.objective
     print(f"\nobjective: {o.kind} (score = {o.quantity}, {o.better} is better"
           + (f"; hit within {o.tolerance:g} of {o.target:g}" if o.target is not None else "") + ")")
@@ -142,6 +190,9 @@ def _check(exercise, args) -> int:
     from feelflow.app.exercises import grading
 
     workers = _workers(args.workers) or grading.default_workers()
+    scales = (1, 2) if args.convergence else (1,)
+    workers = _fit(exercise, scales, workers, len(exercise.references) + len(exercise.check_shapes),
+                   "--convergence at scale" if args.convergence else "")
     print(_machine_line())
     s = exercise.scene
     print(f"{exercise.source}: valid. {exercise.title}: {s.nx} x {s.ny}, Re {s.reynolds:g}, "
@@ -149,7 +200,6 @@ def _check(exercise, args) -> int:
           f"{exercise.objective.kind}", flush=True)
     refs = [r.path for r in exercise.references]
     paths = refs + (list(exercise.check_shapes) if args.convergence else [])
-    scales = (1, 2) if args.convergence else (1,)
     rows, wall = grading.grade(exercise, paths, workers, scales, progress=ProgressBar("runs"))
     by = {(r.file, r.scale): r for r in rows}
     failed = False

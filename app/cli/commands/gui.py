@@ -47,7 +47,7 @@ def set_surface_format():
 
 def replay_when_ready(window, path) -> None:
     """Replay the session at `path` once, when the window's live simulation first runs
-    (`ReplayController.start`, app/gui/window/replay.py, needs it; a bad file is its one-line dialog)."""
+    (`ReplayController.start`, app/gui/window/replay_controller.py, needs it; a bad file is its one-line dialog)."""
     def start():
         window.simulationReady.disconnect(start)
         window.replays.start(path)
@@ -60,6 +60,20 @@ def open_exercise_when_ready(window, path) -> None:
         window.simulationReady.disconnect(start)
         window.exercises.open(path)
     window.simulationReady.connect(start)
+
+
+def what_opens_first(window, settings, session=None, exercise=None, offer: bool = True) -> None:
+    """Once the tunnel runs: replay `session`, or open `exercise`; otherwise (`offer`, and on a
+    first start) the lesson chooser. A session or an exercise named on the command line is what
+    the user asked for: no chooser covers it (the Presets menu still has it)."""
+    if session is not None:
+        replay_when_ready(window, session)
+    if offer:
+        from feelflow.app.gui.first_start import offer_lessons
+
+        offer_lessons(window, settings, first_start=session is None and exercise is None)
+    if exercise is not None:
+        open_exercise_when_ready(window, exercise)
 
 
 def main(args) -> int:
@@ -98,19 +112,12 @@ def main(args) -> int:
                              QSettings.IniFormat)
     else:
         settings = QSettings()
-    from feelflow.app.gui.window.backend import requested_backend
+    from feelflow.app.gui.window.backend_controller import requested_backend
 
     if not selftest:   # the self-test checks the shader path unless --backend says otherwise
         backend = requested_backend(getattr(args, "backend", None), settings)
     window = MainWindow(backend=backend, settings=settings)
-    if session is not None:
-        replay_when_ready(window, session)
-    if not selftest:
-        from feelflow.app.gui.first_start import offer_lessons
-
-        offer_lessons(window, settings, first_start=session is None)   # the lesson chooser
-    if exercise is not None:
-        open_exercise_when_ready(window, exercise)
+    what_opens_first(window, settings, session, exercise, offer=not selftest)
     if selftest:
         from feelflow.app.gui.selftest import SelfTest
 

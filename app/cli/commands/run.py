@@ -6,7 +6,6 @@ during the last step, forces averaged over the interval. The file is written ato
 """
 from __future__ import annotations
 
-import csv
 import math
 import sys
 import time
@@ -34,26 +33,17 @@ def add_arguments(parser):
 
 def positive_int_option(name: str, text):
     """An option that must be a positive integer; UserError (one line) otherwise."""
+    from feelflow.app.errors import shown
+
     try:
+        if len(str(text).strip()) > 18:
+            raise ValueError("too many digits")
         value = int(text)
     except (TypeError, ValueError):
-        raise UserError(f"{name}: must be a positive integer, got {text!r}") from None
+        raise UserError(f"{name}: must be a positive integer of at most 18 digits, got {shown(text)!r}") from None
     if value < 1:
         raise UserError(f"{name}: must be a positive integer, got {value}")
     return value
-
-
-def write_csv_atomic(path: Path, header, rows, option: str = "--out") -> Path:
-    """Write a CSV next to its destination, then rename it into place (never half a file); if
-    that fails, the rows go to a rescue file and OutputError (one line) says where."""
-    from feelflow.app.files import atomic_path, write_or_rescue
-
-    def write(target):
-        with atomic_path(target, suffix=".tmp") as tmp, open(tmp, "w", newline="") as fh:
-            writer = csv.writer(fh)
-            writer.writerow(header)
-            writer.writerows(rows)
-    return write_or_rescue(path, write, option)
 
 
 def _fmt(v: float) -> str:
@@ -64,8 +54,8 @@ def main(args) -> int:
     from feelflow.app.headless import make_solver, resolve_backend
     from feelflow.app.model.scene import load_scene
 
-    from feelflow.app.files import check_output
-    from feelflow.app.inputs import check_work
+    from feelflow.app.files import check_output, save_csv
+    from feelflow.app.inputs import check_memory, check_work
     from feelflow.app.model.scene import check_path_inside
 
     scene = load_scene(args.scene)
@@ -82,6 +72,7 @@ def main(args) -> int:
     out = check_output(args.out, "--out", inputs=[args.scene], force=args.force)
     if args.record:
         check_output(args.record, "--record", inputs=[args.scene], others=[args.out], force=args.force)
+    check_memory(scene.config.nx, scene.config.ny, args.scene, "grid.nx, grid.ny")
     warn_outside_stable_region(scene, args.scene)
 
     backend = resolve_backend(backend, scene.config)
@@ -103,7 +94,7 @@ def main(args) -> int:
 
     csv_error = None
     try:
-        write_csv_atomic(out, header, rows)
+        save_csv(out, header, rows, "--out")
     except UserError as exc:   # the rows went to a rescue file; the session is still saved
         csv_error = exc
     if recorder is not None:

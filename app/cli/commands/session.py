@@ -91,6 +91,18 @@ def info(args) -> int:
     return 0
 
 
+def check_replay_memory(session, source) -> None:
+    """UserError before the replay when the largest grid the session uses (its scene or a
+    recorded rebuild) needs more memory than can be used here (app/inputs.py)."""
+    from feelflow.app.inputs import check_memory
+
+    grids = [(session.config.nx, session.config.ny)] + [
+        (p["value"]["config"]["nx"], p["value"]["config"]["ny"]) for p in session.parameters
+        if p.get("name") == "rebuild"]
+    nx, ny = max(grids, key=lambda g: g[0] * g[1])
+    check_memory(nx, ny, str(source), "the largest grid it uses")
+
+
 def replay(args) -> int:
     from feelflow.app.sessions import SessionError, export_csv, replay as run_replay
 
@@ -103,6 +115,7 @@ def replay(args) -> int:
     if args.out:
         check_output(args.out, "--out", inputs=[args.file], force=args.force)
     s = _load(args.file)
+    check_replay_memory(s, args.file)
     backend = args.backend or s.backend
     factory = _make_factory(backend)
     try:

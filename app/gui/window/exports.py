@@ -63,7 +63,7 @@ class ExportController:
             self.save_shape(path)
 
     def save_shape(self, path):
-        from feelflow.shapes import io as shape_io
+        from feelflow.app import shape_files as shape_io
 
         try:
             shape_io.save_shape(path, self.w.sim.shape)
@@ -77,7 +77,7 @@ class ExportController:
 
     def load_shape(self, path):
         """Read a shape file and make it the body (a polygon as an undoable edit)."""
-        from feelflow.shapes import io as shape_io
+        from feelflow.app import shape_files as shape_io
 
         if self.w.replays.refuse("the body follows the recording"):
             return False

@@ -18,6 +18,8 @@ import numpy as np
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QMessageBox
 
+from feelflow.app.model import readouts
+from feelflow.app.model.tracers import Tracers
 from feelflow.solver.backend import SolverDiverged
 
 if TYPE_CHECKING:
@@ -53,7 +55,7 @@ class FrameLoop:
         self._last_step_s = 0.0
         self._rate_window = [time.perf_counter(), 0, 0]   # start, steps, frames
         self.rates = {"steps_per_s": 0.0, "fps": 0.0, "mlups": 0.0}
-        self.tracer_rng = np.random.default_rng(1)
+        self.tracers = Tracers(N_TRACERS)
         self.timer = QTimer(window)
         self.timer.setInterval(0)
         self.timer.timeout.connect(self.tick)
@@ -102,20 +104,23 @@ class FrameLoop:
         if mode != "tracers":
             w.viewport.tracers = None
         w.panel.show_params(w.params_now(), mode)
-        if w.backend == "gl" and w.shown is not None:   # the field again: vorticity only where shown
+        if w.shown is not None and w.shown.solver.gl_context is not None:   # vorticity only where shown
             w.make_current()
             self.upload_field()
         w.viewport.update()
 
     # --- the field ----------------------------------------------------------------------------
     def upload_field(self):
-        """The shown model's field into the viewport; the numpy path returns its (ny, nx, 4) array."""
+        """The shown model's field into the viewport: the flow's own texture where it has one
+        (the gl backend, on the viewport's context; the vorticity, five nodes a texel, only where
+        it is shown), else its (ny, nx, 4) array, which it returns."""
         w = self.w
         model = w.shown
         if model is None:
             return None
-        if w.backend == "gl":   # the vorticity (five nodes a texel) only where it is shown
-            w.viewport.use_texture(model.solver.field_texture(vorticity=self.display_mode == "vorticity"))
+        texture = model.solver.field_texture(vorticity=self.display_mode == "vorticity")
+        if texture is not None:
+            w.viewport.use_texture(texture)
             return None
         rgba = model.field_rgba()
         w.viewport.makeCurrent()
@@ -193,7 +198,7 @@ class FrameLoop:
             self._advance_tracers(rgba, n)
         if self.display_mode == "pressure" and vp.frames % 5 == 0:
             vp.rho_ref = self._free_stream_density(rgba)
-        self._arrows(forces)
+        self.update_arrows(forces)
         vp.update()
         # adaptive stepping: cost per step and the rest of the frame, smoothed
         self.step_cost = 0.8 * self.step_cost + 0.2 * (t1 - t0) / n
@@ -221,13 +226,8 @@ class FrameLoop:
         return min(SLOWEST_FRAME_S, max(FASTEST_FRAME_S, wanted))
 
     def _free_stream_density(self, rgba) -> float:
-        """Median density of the fluid: the reference of the pressure coefficient (the lattice's
-        mean density drifts by a fraction of a percent, which alone is Cp ~ 1 at U = 0.05)."""
-        if rgba is None:
-            rgba = self._field_array()
-        rho = rgba[::2, ::2, 0]
-        rho = rho[np.isfinite(rho)]
-        return float(np.median(rho)) if rho.size else 1.0
+        """The pressure view's reference density (app/model/readouts.py)."""
+        return readouts.free_stream_density(self._field_array() if rgba is None else rgba)
 
     def _on_nan(self):
         w = self.w
@@ -242,45 +242,18 @@ class FrameLoop:
             w.flow.reset()
             self.set_paused(False)
 
-    def _arrows(self, forces):
-        """Drag along the relative wind and lift across it, for the viewport's arrows."""
-        model, vp = self.w.shown, self.w.viewport
-        f = forces.get(model.params.force_model)
-        if f is None or not all(math.isfinite(v) for v in f):
-            vp.arrow_forces = None
-            return
-        wx, wy = model.relative_wind()
-        s = math.hypot(wx, wy)
-        ax, ay = (wx / s, wy / s) if s > 1e-9 else (1.0, 0.0)
-        drag = f[0] * ax + f[1] * ay
-        lift = -f[0] * ay + f[1] * ax
-        vp.arrow_forces = {"drag": (drag * ax, drag * ay), "lift": (-lift * ay, lift * ax)}
+    def update_arrows(self, forces):
+        """The viewport's drag and lift arrows for this frame's force (app/model/readouts.py)."""
+        model = self.w.shown
+        self.w.viewport.arrow_forces = readouts.arrows(forces.get(model.params.force_model), model.relative_wind(),
+                                                       model.reference_length())
 
     def _advance_tracers(self, rgba, n):
-        """Move the tracers n steps through the field; those that leave or hit the body restart
-        at the inlet."""
+        """Move the viewport's tracers n steps through the field (app/model/tracers.py)."""
         model, vp = self.w.shown, self.w.viewport
-        nx, ny = model.config.nx, model.config.ny
         if rgba is None:
             rgba = self._field_array()
-        rng = self.tracer_rng
-        if vp.tracers is None or len(vp.tracers[0]) != N_TRACERS:
-            pts = np.c_[rng.uniform(0, nx - 1, N_TRACERS), rng.uniform(0, ny - 1, N_TRACERS)]
-        else:
-            pts = vp.tracers[0]
-        ix = np.clip(np.rint(pts[:, 0]).astype(int), 0, nx - 1)
-        iy = np.clip(np.rint(pts[:, 1]).astype(int), 0, ny - 1)
-        u = rgba[iy, ix, 1:3].astype(float)
-        pts = pts + u * n
-        bad = (pts[:, 0] < 0) | (pts[:, 0] > nx - 1) | (pts[:, 1] < 0) | (pts[:, 1] > ny - 1) \
-            | ~np.isfinite(pts).all(axis=1)
-        if model.shape is not None:
-            bad |= model.shape.contains(pts[:, 0], pts[:, 1])
-        k = int(bad.sum())
-        if k:
-            pts[bad] = np.c_[rng.uniform(0, 3, k), rng.uniform(0, ny - 1, k)]
-        tail = pts - u * 30   # a short streak: where the particle was 30 steps ago
-        vp.tracers = (pts, tail)
+        vp.tracers = self.tracers.advance(rgba, n, model.shape, None if vp.tracers is None else vp.tracers[0])
 
     # --- readouts -----------------------------------------------------------------------------
     def refresh_readouts(self):
@@ -297,11 +270,8 @@ class FrameLoop:
         elif live and not panel.angle.hasFocus():   # the wheel or the handle turned the body
             panel.show_angle(p.angle_deg)
         panel.show_numbers(model.reynolds(), model.mach(), model.config.mach_limit)
-        t, drag, lift = model.history.drag_lift(p.force_model)
-        if len(t) and p.force_model in model.history.forces:
-            panel.show_forces(float(np.nanmean(drag[-30:])), float(np.nanmean(lift[-30:])))
-        else:
-            panel.show_forces(None, None)
+        r = readouts.readout(model.history, p.force_model, model.reference_length())
+        panel.show_forces(r.drag, r.lift) if r.has_forces else panel.show_forces(None, None)
         w.plot.refresh()
         r = self.rates
         w.status["steps"].setText(f"{r['steps_per_s']:.0f} steps/s")

@@ -68,7 +68,7 @@ class BackendController:
         def make_solver(name, config):
             from feelflow.solver.backend import create_solver
 
-            return create_solver(name, config, **({"ctx": ctx} if name == "gl" else {}))
+            return create_solver(name, config, ctx=ctx)
 
         config = default_base_config(w.params.grid)
         try:

@@ -96,7 +96,7 @@ class ReplayController:
         session = load_session(path)
         w = self.w
         w.make_current()
-        return ReplaySimulation(session, w.backend, ctx=w.viewport.ctx if w.backend == "gl" else None)
+        return ReplaySimulation(session, w.backend, ctx=w.viewport.ctx)
 
     def stop(self, _=None):
         """Back to the live tunnel exactly as it was when the replay began."""
