@@ -116,12 +116,13 @@ def _collide(f0, f1, f2, f3, f4, f5, f6, f7, f8, op, om, keep, target, trt, inco
 
 
 @numba.njit(inline="always", **_JIT)
-def _rr_pair(cu, cF, even, odd, base, rho, kn, w, src, uF, has_force, K):
+def _rr_pair(cu, cF, even, odd, odd_eq, base, rho, kn, w, src, uF, has_force, K):
     """The regularised pair (i, ib): f*_i = w (feq_i + (1 - omega) reg_i) + Guo's source, with
-    reg_i = even + odd, reg_ib = even - odd (solver/regularised.py)."""
+    reg_i = even + odd, reg_ib = even - odd and odd_eq the equilibrium's third-order part
+    (odd in c_i) (solver/regularised.py)."""
     half, three = K[0], K[2]
     fe = base + half * rho * cu * cu + kn * even
-    fo = rho * cu + kn * odd
+    fo = rho * cu + odd_eq + kn * odd
     ni = w * (fe + fo)
     nb = w * (fe - fo)
     if has_force:
@@ -135,8 +136,8 @@ def _rr_pair(cu, cF, even, odd, base, rho, kn, w, src, uF, has_force, K):
 @numba.njit(inline="always", **_JIT)
 def _collide_rr(f0, f1, f2, f3, f4, f5, f6, f7, f8, omega, keep, target, incomp, has_keep,
                 Fx, Fy, has_force, smag, K):
-    """Recursive-regularised BGK (solver/regularised.py, its moments and Hermite coefficients
-    spelled out per opposite pair), optionally with the Smagorinsky rate (smag = 18 sqrt(2) C^2,
+    """Recursive-regularised BGK with the third-order equilibrium (solver/regularised.py, its
+    moments and Hermite coefficients spelled out per opposite pair), optionally with the Smagorinsky rate (smag = 18 sqrt(2) C^2,
     smag > 0 only in the variant compiled for it); returns (f*0..f*8, drho)."""
     half, one, three, w0, w1, w5, r0 = K[0], K[1], K[2], K[3], K[4], K[5], K[6]
     third, th2, n2, nine, two = K[7], K[8], K[9], K[10], K[11]
@@ -179,14 +180,18 @@ def _collide_rr(f0, f1, f2, f3, f4, f5, f6, f7, f8, omega, keep, target, incomp,
     if has_force:
         n0 -= src * w0 * three * uF
     ed = reg0 + n2 * (axx + ayy)
-    n1, n3 = _rr_pair(three * ux, Fx, reg0 + n2 * axx, three * a1x - n2 * axyy, base, rho, kn, w1, src, uF,
-                      has_force, K)
-    n2_, n4 = _rr_pair(three * uy, Fy, reg0 + n2 * ayy, three * a1y - n2 * axxy, base, rho, kn, w1, src, uF,
-                       has_force, K)
+    # third order: the equilibrium's 27/2 rho (H_xxy ux^2 uy + H_xyy ux uy^2) shares its
+    # Hermite coefficients with the recursive a_xxy, a_xyy
+    eq_xxy = rho * ux * uy * ux
+    eq_xyy = rho * ux * uy * uy
+    n1, n3 = _rr_pair(three * ux, Fx, reg0 + n2 * axx, three * a1x - n2 * axyy, -n2 * eq_xyy, base, rho, kn,
+                      w1, src, uF, has_force, K)
+    n2_, n4 = _rr_pair(three * uy, Fy, reg0 + n2 * ayy, three * a1y - n2 * axxy, -n2 * eq_xxy, base, rho, kn,
+                       w1, src, uF, has_force, K)
     n5, n7 = _rr_pair(three * (ux + uy), Fx + Fy, ed + nine * pxy, three * (a1x + a1y) + nine * (axyy + axxy),
-                      base, rho, kn, w5, src, uF, has_force, K)
+                      nine * (eq_xyy + eq_xxy), base, rho, kn, w5, src, uF, has_force, K)
     n6, n8 = _rr_pair(three * (uy - ux), Fy - Fx, ed - nine * pxy, three * (a1y - a1x) + nine * (axxy - axyy),
-                      base, rho, kn, w5, src, uF, has_force, K)
+                      nine * (eq_xxy - eq_xyy), base, rho, kn, w5, src, uF, has_force, K)
     return n0, n1, n2_, n3, n4, n5, n6, n7, n8, drho
 
 
