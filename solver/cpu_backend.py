@@ -192,7 +192,7 @@ class CpuSolver(NumpySolver):
         else:
             sy, sx, solid_g = _EMPTY_I, _EMPTY_I, self._empty_solid
         dt = self.dtype.type
-        done = self._advance(n, t, cfg.inflow_ramp_steps, self.g, self._gin, self._pre, self._op, self._om,
+        done, finite = self._advance(n, t, cfg.inflow_ramp_steps, self.g, self._gin, self._pre, self._op, self._om,
                              self._keep, self._target, self._xs, self._fx, self._fy, self._smag, self._scratch,
                              self._block_sums, self._tunnel, self._walls_kind, self._periodic_x, profile,
                              wall_profile, dt(rate), dt(CS_OVER_RHO0), self._drho_ref, *links, self._link_force,
@@ -200,5 +200,5 @@ class CpuSolver(NumpySolver):
         if done % 2:
             self.g, self._gin = self._gin, self.g
         self.time = t + done
-        if done < n:
+        if not finite:
             raise SolverDiverged(t + done, "density is no longer finite")

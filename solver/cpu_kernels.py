@@ -424,8 +424,8 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                 li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, force,
                 ry, rx, rbits, sy, sx, solid_g):
         """n steps from time t0, the state in g (post-collision), ping-ponging with out; returns
-        the steps done (fewer than n where the density stopped being finite: the state of that
-        step is kept). After an odd number of steps the state is in out. Each step, in the numpy
+        (steps done, finite): it stops after the first step whose density is not finite (that
+        state is kept). After an odd number of steps done the state is in out. Each step, in the numpy
         backend's order:
         1. rules d (outlet), c (inlet with the ramp r(t) of `ramp_steps`, each link's inflow
            r wall_profile, the quiet inlet's correction once the ramp is over: quiet_rate > 0),
@@ -509,7 +509,7 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                     b_[i, sy[k], sx[k]] = solid_g[i, k]
             a, b_ = b_, a
             if not np.isfinite(total):
-                return step + 1
-        return n
+                return step + 1, False
+        return n, True
 
     return advance
