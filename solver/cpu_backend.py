@@ -90,8 +90,9 @@ class CpuSolver(NumpySolver):
         self._link_arrays = None
 
     def _boundary_nodes(self):
-        """((ny, nx) bits, (iy, ix, bits) of its non-zero nodes): bit i set where a domain
-        boundary rule (c, d, b) writes population i."""
+        """((ny, nx) bits, (iy, ix, bits) of the node pass): bit i set where a domain boundary
+        rule (c, d, b) writes population i; the node pass takes those nodes and every node of
+        the first and last column (solver/cpu_kernels.py advance, step 3)."""
         cfg = self.config
         bits = np.zeros((cfg.ny, cfg.nx), np.int64)
         if cfg.x_boundary == "tunnel":
@@ -100,7 +101,9 @@ class CpuSolver(NumpySolver):
         if cfg.y_boundary != "periodic":
             bits[0, :] |= _bits((2, 5, 6))
             bits[-1, :] |= _bits((4, 7, 8))
-        iy, ix = np.nonzero(bits)
+        listed = bits != 0
+        listed[:, 0] = listed[:, -1] = True  # the seam columns are always collided in the node pass
+        iy, ix = np.nonzero(listed)
         return bits, (iy.astype(np.int64), ix.astype(np.int64), bits[iy, ix])
 
     def _redo_nodes(self):

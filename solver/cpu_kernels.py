@@ -196,17 +196,6 @@ def _collide_rr(f0, f1, f2, f3, f4, f5, f6, f7, f8, omega, keep, target, incomp,
 
 
 @numba.njit(inline="always", **_JIT)
-def _node(f0, f1, f2, f3, f4, f5, f6, f7, f8, op, om, keep, target, kind, incomp, has_keep,
-          Fx, Fy, has_force, smag, K):
-    """One node's collision by the variant's operator: kind 0 BGK, 1 TRT, 2 rr."""
-    if kind == 2:
-        return _collide_rr(f0, f1, f2, f3, f4, f5, f6, f7, f8, op, keep, target, incomp, has_keep,
-                           Fx, Fy, has_force, smag, K)
-    return _collide(f0, f1, f2, f3, f4, f5, f6, f7, f8, op, om, keep, target, kind == 1, incomp, has_keep,
-                    Fx, Fy, has_force, K)
-
-
-@numba.njit(inline="always", **_JIT)
 def _store(out, y, x, r):
     out[0, y, x] = r[0]
     out[1, y, x] = r[1]
@@ -252,27 +241,53 @@ def _gather(g, b, y, ym, yp, x0, n):
 
 
 @numba.njit(inline="always", **_JIT)
-def _chunk(b, o, n, op, om, t, kind, incomp, Fx, Fy, has_force, smag, K):
-    """Collide n gathered nodes b (9, CHUNK) into o with one pair of rates (op, om) for all:
-    written without per-node branches or arrays beside b and o, so LLVM vectorises it.
+def _chunk(b, o, n, op, om, t, trt, incomp, Fx, Fy, has_force, K):
+    """BGK / TRT: collide n gathered nodes b (9, CHUNK) into o with one pair of rates (op, om)
+    for all: written without per-node branches or arrays beside b and o, so LLVM vectorises it.
     Returns sum drho."""
     s = 0.0
     for k in range(n):
-        r = _node(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
-                  op, om, op, t, kind, incomp, False, Fx, Fy, has_force, smag, K)
+        r = _collide(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
+                     op, om, op, t, trt, incomp, False, Fx, Fy, has_force, K)
         _store_k(o, k, r)
         s += r[9]
     return s
 
 
 @numba.njit(inline="always", **_JIT)
-def _chunk_columns(b, o, n, x0, op, om, keep, t, kind, incomp, has_keep, Fx, Fy, has_force, smag, K):
-    """As _chunk with each column's own rates and absorbing layer (the sponge's columns)."""
+def _chunk_rr(b, o, n, op, t, incomp, Fx, Fy, has_force, smag, K):
+    """As _chunk for the recursive-regularised operator."""
     s = 0.0
     for k in range(n):
-        x = x0 + k
-        r = _node(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
-                  op[x], om[x], keep[x], t, kind, incomp, has_keep, Fx, Fy, has_force, smag, K)
+        r = _collide_rr(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
+                        op, op, t, incomp, False, Fx, Fy, has_force, smag, K)
+        _store_k(o, k, r)
+        s += r[9]
+    return s
+
+
+@numba.njit(inline="always", **_JIT)
+def _columns(b, o, n, cols, op, om, keep, t, trt, incomp, has_keep, Fx, Fy, has_force, K):
+    """BGK / TRT: as _chunk with node k in column cols[k] (its own rates and absorbing layer:
+    the sponge's columns; the seam columns; the boundary nodes). Returns sum drho."""
+    s = 0.0
+    for k in range(n):
+        x = cols[k]
+        r = _collide(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
+                     op[x], om[x], keep[x], t, trt, incomp, has_keep, Fx, Fy, has_force, K)
+        _store_k(o, k, r)
+        s += r[9]
+    return s
+
+
+@numba.njit(inline="always", **_JIT)
+def _columns_rr(b, o, n, cols, op, keep, t, incomp, has_keep, Fx, Fy, has_force, smag, K):
+    """As _columns for the recursive-regularised operator."""
+    s = 0.0
+    for k in range(n):
+        x = cols[k]
+        r = _collide_rr(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
+                        op[x], keep[x], t, incomp, has_keep, Fx, Fy, has_force, smag, K)
         _store_k(o, k, r)
         s += r[9]
     return s
@@ -285,14 +300,20 @@ def _pull(g, y, ym, yp, x, xm, xp):
 
 
 @numba.njit(inline="always", **_JIT)
-def _edge(g, out, y, ym, yp, x, op, om, keep, t, Fx, Fy, kind, incomp, has_keep, has_force, smag, K):
-    """One node with periodic neighbours and its own column's rates; returns drho."""
+def _gather_node(g, b, k, y, ym, yp, x):
+    """b[:, k] = the populations pulled to node (y, x), periodic neighbours."""
     nx = g.shape[2]
-    f = _pull(g, y, ym, yp, x, x - 1 if x > 0 else nx - 1, x + 1 if x < nx - 1 else 0)
-    r = _node(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], op[x], om[x], keep[x], t,
-              kind, incomp, has_keep, Fx, Fy, has_force, smag, K)
-    _store(out, y, x, r)
-    return r[9]
+    xm = x - 1 if x > 0 else nx - 1
+    xp = x + 1 if x < nx - 1 else 0
+    b[0, k] = g[0, y, x]
+    b[1, k] = g[1, y, xm]
+    b[2, k] = g[2, ym, x]
+    b[3, k] = g[3, y, xp]
+    b[4, k] = g[4, yp, x]
+    b[5, k] = g[5, ym, xm]
+    b[6, k] = g[6, ym, xp]
+    b[7, k] = g[7, yp, xp]
+    b[8, k] = g[8, yp, xm]
 
 
 @numba.njit(inline="always", **_JIT)
@@ -415,8 +436,9 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
     on-disk cache keys a closure by its variables' pickled bytes, and a compiled function pickles
     with an id that is new in every process, so such a closure would compile again at every start."""
     K = constants(dtype)
-    op_kind = {"bgk": 0, "trt": 1, "rr": 2}[kind]
-    smag_on = bool(smagorinsky) and op_kind == 2
+    rr = kind == "rr"   # the closure's branches on these constants are pruned before inlining,
+    trt = kind == "trt"  # so each variant compiles one operator
+    smag_on = bool(smagorinsky) and rr
 
     @numba.njit(parallel=True, **_JIT)
     def advance(n, t0, ramp_steps, g, out, pre, op, om, keep, target, xs, Fx, Fy, smag, scratch, sums,
@@ -425,26 +447,28 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                 ry, rx, rbits, sy, sx, solid_g):
         """n steps from time t0, the state in g (post-collision), ping-ponging with out; returns
         (steps done, finite): it stops after the first step whose density is not finite (that
-        state is kept). After an odd number of steps done the state is in out. Each step, in the numpy
-        backend's order:
+        state is kept). After an odd number of steps done the state is in out. Each step, in
+        the numpy backend's order:
         1. rules d (outlet), c (inlet with the ramp r(t) of `ramp_steps`, each link's inflow
            r wall_profile, the quiet inlet's correction once the ramp is over: quiet_rate > 0),
            b (walls: 0 periodic, 1 no-slip, 2 free-slip) and a (the body links li..luwy, in grid
            coordinates) into pre, from the post-collision state; the momentum exchange summed
            into force (4,) over the n steps (Galilean fx, fy, classic fx, fy, no impulse);
-        2. pull-stream + collide over the whole grid, blocks of rows in parallel (scratch (B, 2,
-           9, CHUNK): each block's gather and result buffers, nothing allocated in the parallel
-           loop; sums (B,) each block's sum drho): columns 1 .. xs-1 share the rates op[1],
-           om[1]; xs .. nx-2 (the sponge) take their own column's; columns 0 and nx-1 pull across
-           the periodic seam; target (ny,) the absorbing layer's x-velocity r profile;
-        3. each node (ry[k], rx[k]) collided again with population i from pre where bit i of
-           rbits[k] is set;
+        2. pull-stream + collide of columns 1 .. nx-2, blocks of rows in parallel (scratch (B,
+           2, 9, CHUNK): each block's gather and result buffers, nothing allocated in the
+           parallel loop; sums (B,) each block's sum drho): columns 1 .. xs-1 share the rates
+           op[1], om[1]; xs .. nx-2 (the sponge) take their own column's; target (ny,) the
+           absorbing layer's x-velocity r profile;
+        3. the nodes (ry[k], rx[k]), serially: every node of columns 0 and nx-1 (they pull
+           across the periodic seam) and every node that owns a boundary population, pulled and
+           collided with population i from pre where bit i of rbits[k] is set;
         4. the solid nodes (sy, sx) reset to solid_g."""
         ny, nx = g.shape[1], g.shape[2]
         nb = scratch.shape[0]
         per = (ny + nb - 1) // nb
         op0, om0 = op[min(1, nx - 1)], om[min(1, nx - 1)]
         sm = smag if smag_on else 0.0
+        cols = np.arange(nx)
         force[:] = 0.0
         a = g
         b_ = out
@@ -468,42 +492,44 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                     ym = y - 1 if y > 0 else ny - 1
                     yp = y + 1 if y < ny - 1 else 0
                     tg = target[y]
-                    for x0 in range(1, xs, CHUNK):
-                        m = min(CHUNK, xs - x0)
+                    x0 = 1
+                    while x0 < nx - 1:   # chunks end at xs: the sponge starts a chunk
+                        m = min(CHUNK, (xs if x0 < xs else nx - 1) - x0)
                         _gather(a, bb, y, ym, yp, x0, m)
-                        s += _chunk(bb, o, m, op0, om0, tg, op_kind, incomp, Fx, Fy, has_force, sm, K)
+                        if x0 < xs:        # the rates of column 1 for the whole chunk
+                            if rr:
+                                s += _chunk_rr(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm, K)
+                            else:
+                                s += _chunk(bb, o, m, op0, om0, tg, trt, incomp, Fx, Fy, has_force, K)
+                        else:              # each column its own rates (the sponge)
+                            c = cols[x0:x0 + m]
+                            if rr:
+                                s += _columns_rr(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force,
+                                                 sm, K)
+                            else:
+                                s += _columns(bb, o, m, c, op, om, keep, tg, trt, incomp, has_keep, Fx, Fy,
+                                              has_force, K)
                         b_[:, y, x0:x0 + m] = o[:, :m]
-                    for x0 in range(max(xs, 1), nx - 1, CHUNK):
-                        m = min(CHUNK, nx - 1 - x0)
-                        _gather(a, bb, y, ym, yp, x0, m)
-                        s += _chunk_columns(bb, o, m, x0, op, om, keep, tg, op_kind, incomp, has_keep, Fx, Fy,
-                                            has_force, sm, K)
-                        b_[:, y, x0:x0 + m] = o[:, :m]
-                    s += _edge(a, b_, y, ym, yp, 0, op, om, keep, tg, Fx, Fy, op_kind, incomp, has_keep,
-                               has_force, sm, K)
-                    if nx > 1:
-                        s += _edge(a, b_, y, ym, yp, nx - 1, op, om, keep, tg, Fx, Fy, op_kind, incomp, has_keep,
-                                   has_force, sm, K)
+                        x0 += m
                 sums[blk] = s
             total = sums.sum()
+            bb = scratch[0, 0]
+            o = scratch[0, 1]
             for k in range(len(ry)):
                 y, x, bits = ry[k], rx[k], rbits[k]
-                ym = y - 1 if y > 0 else ny - 1
-                yp = y + 1 if y < ny - 1 else 0
-                p = _pull(a, y, ym, yp, x, x - 1 if x > 0 else nx - 1, x + 1 if x < nx - 1 else 0)
-                f0 = pre[0, y, x] if bits & 1 else p[0]
-                f1 = pre[1, y, x] if bits & 2 else p[1]
-                f2 = pre[2, y, x] if bits & 4 else p[2]
-                f3 = pre[3, y, x] if bits & 8 else p[3]
-                f4 = pre[4, y, x] if bits & 16 else p[4]
-                f5 = pre[5, y, x] if bits & 32 else p[5]
-                f6 = pre[6, y, x] if bits & 64 else p[6]
-                f7 = pre[7, y, x] if bits & 128 else p[7]
-                f8 = pre[8, y, x] if bits & 256 else p[8]
-                res = _node(f0, f1, f2, f3, f4, f5, f6, f7, f8, op[x], om[x], keep[x], target[y],
-                            op_kind, incomp, has_keep, Fx, Fy, has_force, sm, K)
-                _store(b_, y, x, res)
-                total += res[9]
+                _gather_node(a, bb, 0, y, y - 1 if y > 0 else ny - 1, y + 1 if y < ny - 1 else 0, x)
+                for i in range(9):
+                    if (bits >> i) & 1:
+                        bb[i, 0] = pre[i, y, x]
+                c = cols[x:x + 1]
+                if rr:
+                    total += _columns_rr(bb, o, 1, c, op, keep, target[y], incomp, has_keep, Fx, Fy, has_force,
+                                         sm, K)
+                else:
+                    total += _columns(bb, o, 1, c, op, om, keep, target[y], trt, incomp, has_keep, Fx, Fy,
+                                      has_force, K)
+                for i in range(9):
+                    b_[i, y, x] = o[i, 0]
             for k in range(len(sy)):
                 for i in range(9):
                     b_[i, sy[k], sx[k]] = solid_g[i, k]

@@ -256,7 +256,7 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
     run = top.table("run")
     default_steps = script.total_steps if script.total_steps > 0 else None
     steps = run.integer("steps", default_steps if default_steps else MISSING, lo=1, hi=MAX_STEPS)
-    backend = run.choice("backend", sorted(BACKENDS), "numpy")
+    backend = run.choice("backend", sorted(BACKENDS) + ["auto"], "auto")
     run.done()
     top.done()
 

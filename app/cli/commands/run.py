@@ -20,7 +20,7 @@ from feelflow.app.errors import UserError
 def add_arguments(parser):
     parser.add_argument("scene", metavar="SCENE.toml", help="the scene file (keys: docs/reference/scenes.md)")
     parser.add_argument("--backend", default=None, metavar="numpy|cpu|gl|auto",
-                        help="solver backend (default: the scene's run.backend, else numpy); auto: the "
+                        help="solver backend (default: the scene's run.backend, else auto); auto: the "
                              "fastest here, timed briefly on the scene's grid and remembered")
     parser.add_argument("--steps", default=None, metavar="N", help="number of steps (default: the scene's)")
     parser.add_argument("--out", default="forces.csv", metavar="PATH", help="CSV file to write (default: forces.csv)")
