@@ -131,6 +131,26 @@ def check_output(path, option: str = "output", *, inputs=(), others=(), force: b
     return path
 
 
+def check_output_folder(path, option: str = "--out") -> pathlib.Path:
+    """Check a folder a command writes its own files into (`report seed --out DIR`) before any
+    work: OutputError (one line) when it is missing, not a folder or not writable. The files in
+    it are written with `atomic_path` and belong to the command, so they are replaced."""
+    path = pathlib.Path(path)
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise OutputError(f"{option}: {shown_path(path)!r} does not exist (create the folder first)") from None
+    except (OSError, ValueError) as exc:
+        raise OutputError(f"{option}: {shown_path(path)!r}: cannot be written "
+                          f"({getattr(exc, 'strerror', None) or exc})") from None
+    if not stat.S_ISDIR(st.st_mode):
+        raise OutputError(f"{option}: {shown_path(path)!r} is not a folder")
+    if not os.access(path, os.W_OK | os.X_OK):
+        raise OutputError(f"{option}: folder {shown_path(path)!r} is not writable")
+    clean_stale_temporaries(path)
+    return path
+
+
 def _temporary(folder: pathlib.Path, suffix: str) -> pathlib.Path:
     suffix = suffix if re.fullmatch(r"\.[A-Za-z0-9]{1,8}", suffix or "") else ".tmp"
     for _ in range(100):

@@ -104,8 +104,8 @@ class ForceLoop:
         self._pose: Pose | None = None
         self._pose_time = None
         self._periods = deque(maxlen=int(cfg.rate_hz))
-        self._ticks = 0
-        self._force = (0.0, 0.0)
+        self.ticks = 0
+        self.force_sent = (0.0, 0.0)
         self._max_cmd = 0.0
         self._disconnect_reason = None
         self._old_switch = None
@@ -194,14 +194,14 @@ class ForceLoop:
         else:
             rate, jitter = 0.0, 0.0
         state, running = self.state_now()
-        return LoopStatus(state, running, self._ticks, rate, jitter, self.ticker.overruns,
+        return LoopStatus(state, running, self.ticks, rate, jitter, self.ticker.overruns,
                           self._samples, self._nan, self.gate.counts["stall"], self.gate.gain,
-                          self._force, self._max_cmd, dict(self.device.counters), self._disconnect_reason,
+                          self.force_sent, self._max_cmd, dict(self.device.counters), self._disconnect_reason,
                           self.scheduling)
 
     # -- the loop -----------------------------------------------------------------------------
     def _zero_device(self) -> None:
-        self._force = (0.0, 0.0)
+        self.force_sent = (0.0, 0.0)
         try:
             self.device.write_force(0.0, 0.0)
         except DeviceError:
@@ -243,7 +243,7 @@ class ForceLoop:
                     self._periods.append(now - prev)
                 dt = self.ticker.period if prev is None else now - prev
                 prev = now
-                self._ticks += 1
+                self.ticks += 1
                 if not self._tick(now, dt, rec):
                     break
         except DeviceDisconnected as exc:
@@ -287,13 +287,13 @@ class ForceLoop:
         fx, fy = self.map.vector_to_device(lx * k, ly * k)
         fx, fy = clamp_force(fx, fy, dev.capabilities.max_force)
         # 4. command
-        self._force = dev.write_force(fx, fy)
-        self._max_cmd = max(self._max_cmd, math.hypot(*self._force))
+        self.force_sent = dev.write_force(fx, fy)
+        self._max_cmd = max(self._max_cmd, math.hypot(*self.force_sent))
         if rec is not None:
             rec["t"].append(now)
             rec["body_x"].append(self._target.x)
             rec["body_y"].append(self._target.y)
-            rec["fx"].append(self._force[0])
-            rec["fy"].append(self._force[1])
+            rec["fx"].append(self.force_sent[0])
+            rec["fy"].append(self.force_sent[1])
             rec["pose_x"].append(p.x if p is not None else math.nan)
         return True

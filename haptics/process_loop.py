@@ -82,8 +82,8 @@ def _publish(mm, loop, seq: list, vals: list, st=None) -> None:
     the last status publish stay as they were."""
     bt = loop.body_target()
     fields = [("x", bt.x), ("y", bt.y), ("vx", bt.vx), ("vy", bt.vy), ("t", bt.t),
-              ("buttons", bt.buttons), ("valid", bt.valid), ("fx", loop._force[0]), ("fy", loop._force[1]),
-              ("ticks", loop._ticks), ("gain", loop.gate.gain)]
+              ("buttons", bt.buttons), ("valid", bt.valid), ("fx", loop.force_sent[0]), ("fy", loop.force_sent[1]),
+              ("ticks", loop.ticks), ("gain", loop.gate.gain)]
     state, running = loop.state_now()
     fields += [("running", running), ("state", _STATES.index(state) if state in _STATES else 0)]
     if st is not None:

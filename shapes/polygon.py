@@ -154,6 +154,12 @@ class PolygonalShape(Shape):
         object.__setattr__(self, "_edges", edges)
 
     @property
+    def world_edges(self) -> tuple[np.ndarray, np.ndarray]:
+        """(vertices, edge vectors), each (n, 2), world coordinates, read-only views (no copy:
+        the rasteriser reads them for every node row)."""
+        return self._world, self._edges
+
+    @property
     def world_vertices(self) -> np.ndarray:
         """(n, 2) counter-clockwise vertices in world coordinates."""
         return self._world.copy()

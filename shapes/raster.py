@@ -78,7 +78,7 @@ def _polygon_box(shape: PolygonalShape, box):
     result equals theirs exactly (tests/test_shapes_raster.py compares them)."""
     x0, y0, x1, y1 = box
     h, w = y1 - y0, x1 - x0
-    a, e = shape._world, shape._edges
+    a, e = shape.world_edges
     ax, ay, ex, ey = a[:, 0], a[:, 1], e[:, 0], e[:, 1]
 
     # interior: node ix is inside when an odd number of crossings lie at x > ix on its row

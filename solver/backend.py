@@ -65,6 +65,8 @@ class FlowSolver(Protocol):
     name: str                # the backend's registry name
     time: int                # steps done
     speed_capped: bool       # the last body motion or inflow was reduced to config.max_speed
+    max_speed_seen: float    # the largest |u| the last physical-range check read (solver/local_guard.py)
+    max_speed_at: int | None  # the step of that check (None: no check yet)
 
     @property
     def gl_context(self) -> Any:
@@ -85,6 +87,10 @@ class FlowSolver(Protocol):
 
     def enable_force_models(self, names) -> None:
         """Compute only these force models (solver/forces)."""
+        ...
+
+    def add_force_model(self, model) -> None:
+        """Enable an already-built model instance too, keyed by its name (solver/forces)."""
         ...
 
     def set_inflow_speed(self, speed: float) -> None:
@@ -137,6 +143,10 @@ class Solver(ABC):
     #: True when the last set_inflow_speed asked for more than config.max_speed
     inflow_capped: bool = False
 
+    #: the largest |u| the last physical-range check read, and the step it read it at (None: none yet)
+    max_speed_seen: float = 0.0
+    max_speed_at: int | None = None
+
     def __init__(self, config: FlowConfig):
         self.config = config.validate()
         self.time = 0  # steps done
@@ -144,6 +154,9 @@ class Solver(ABC):
         self.body = None      # solver.body.BodyState of the body, or None
         self._models = {}     # enabled force models by name
         self._forces: dict[str, tuple[float, float]] = {}  # their means over the last step(n)
+        from feelflow.solver.body import DEFAULT_IMPULSE, DEFAULT_REFILL
+
+        self.body_refill, self.body_impulse = DEFAULT_REFILL, DEFAULT_IMPULSE   # set_body_schemes
 
     @property
     def gl_context(self):
@@ -165,6 +178,16 @@ class Solver(ABC):
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
         """Place the body (a `shapes` shape at its pose, or None) moving at `velocity`,
         rotating at `omega`; covers/uncovers nodes and books their momentum (algorithm.md)."""
+
+    def set_body_schemes(self, refill: str | None = None, impulse: str | None = None) -> None:
+        """How a moving body refills the nodes it uncovers and books the momentum of the nodes it
+        covers and uncovers (solver/body.py REFILL_SCHEMES, IMPULSE_SCHEMES); None keeps one."""
+        from feelflow.solver.body import check_schemes
+
+        refill = self.body_refill if refill is None else refill
+        impulse = self.body_impulse if impulse is None else impulse
+        check_schemes(refill, impulse)
+        self.body_refill, self.body_impulse = refill, impulse
 
     def _body_state(self, shape, velocity, omega, raster=None):
         """The rasterised, speed-capped body state for `set_body` (None without a body), with a
@@ -302,6 +325,7 @@ class Solver(ABC):
         if u_max > limit:
             raise SolverDiverged(self.time, f"max |u| = {u_max:.3g} is far above the Mach limit "
                                             f"(physical range |u| <= {limit:.3g})")
+        self.max_speed_seen, self.max_speed_at = u_max, self.time   # for the local guard (solver/local_guard.py)
         allowed = physical_density_deviation(self.config)
         if dev > allowed:
             lo, hi = float(np.min(rho)), float(np.max(rho))
@@ -322,12 +346,19 @@ def needs_gl_context(backend: str) -> bool:
     return backend in GL_CONTEXT_BACKENDS
 
 
+#: collision operators only the numpy reference implements (solver/kbc.py: entropic KBC, kept for
+#: the comparison in docs/science/collision-operators.md)
+NUMPY_ONLY_COLLISIONS = ("kbc",)
+
+
 def create_solver(backend: str, config: FlowConfig, ctx=None) -> Solver:
     """Instantiate a backend by name. Every caller passes the GL context it has (or None) the
     same way: a backend that draws on one (`needs_gl_context`) gets it and refuses None, the
     others ignore it."""
     if backend not in BACKENDS:
         raise BackendError(f"unknown backend {backend!r}; choose one of {sorted(BACKENDS)}")
+    if config.collision in NUMPY_ONLY_COLLISIONS and backend != "numpy":
+        raise BackendError(f"the {config.collision} collision runs on the numpy backend only, not {backend!r}")
     module_name, cls_name = BACKENDS[backend].split(":")
     cls = getattr(importlib.import_module(module_name), cls_name)
     return cls(config, ctx=ctx) if needs_gl_context(backend) else cls(config)

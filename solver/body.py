@@ -82,21 +82,50 @@ def _neighbour_sum(field: np.ndarray, wrap: tuple[bool, bool] = (False, False)) 
     return out
 
 
+#: how an uncovered node is filled (`refill`): the equilibrium at the body's velocity only
+#: (Lallemand & Luo 2003), or that equilibrium plus the non-equilibrium part of its fluid
+#: neighbours (Caiazzo, Prog. Comput. Fluid Dyn. 8 (2008) 3)
+REFILL_SCHEMES = ("equilibrium", "nonequilibrium")
+#: how the momentum of covered and uncovered nodes enters the force (`refill`): "relative", the
+#: momentum relative to the body's own motion there (Galilean invariant, as Wen et al. 2014 make
+#: each link's term); "absolute", the whole momentum (Wen et al. 2014, Chen et al. 2013); "none"
+IMPULSE_SCHEMES = ("relative", "absolute", "none")
+#: the schemes in use unless a solver is told otherwise (docs/science/force-models.md says why)
+DEFAULT_REFILL = "equilibrium"
+DEFAULT_IMPULSE = "relative"
+
+
+def check_schemes(refill_scheme: str, impulse: str) -> None:
+    """ValueError naming the first unknown scheme."""
+    if refill_scheme not in REFILL_SCHEMES:
+        raise ValueError(f"refill must be one of {', '.join(REFILL_SCHEMES)}, got {refill_scheme!r}")
+    if impulse not in IMPULSE_SCHEMES:
+        raise ValueError(f"impulse must be one of {', '.join(IMPULSE_SCHEMES)}, got {impulse!r}")
+
+
 def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, velocity, omega,
-           x0: int, y0: int, wrap: tuple[bool, bool] = (False, False)):
+           x0: int, y0: int, wrap: tuple[bool, bool] = (False, False), scheme: str = DEFAULT_REFILL,
+           impulse: str = DEFAULT_IMPULSE):
     """Cover, uncover and re-equilibrate the solid nodes of a window of full f* (in place).
 
     f: (9, h, w) float64 post-collision populations; masks cut to the same window, which must
     reach one node beyond every old and new solid node (or the domain edge); `wrap`: the
     window spans a periodic direction whole, so neighbours continue across the seam.
     Covered nodes (new & ~old) give their momentum to the body; uncovered ones (old & ~new)
-    get f^eq(rho_new, u_body) and take momentum -rho_new u_body from it; every solid node gets
-    f^eq(RHO0, u_body). The mass this creates or destroys (solid nodes hold RHO0) goes back to
-    the fluid ring around the body (fluid nodes next to an old or new solid node), each node
-    scaled by the same added density (velocity kept); the momentum that adds is booked too.
+    get f^eq(rho_new, u_body) (`scheme` "nonequilibrium": plus the mean non-equilibrium part
+    f - f^eq(rho, u) of their fluid neighbours, which carries no mass or momentum) and take
+    momentum rho_new u_body from it; every solid node gets f^eq(RHO0, u_body). The mass this
+    creates or destroys (solid nodes hold RHO0) goes back to the fluid ring around the body
+    (fluid nodes next to an old or new solid node), each node scaled by the same added density
+    (velocity kept); the momentum that adds is booked too.
+    `impulse`: "absolute" books those momenta whole; "relative" books each less the mass it
+    moves times the body's velocity at that node (mass that joins or leaves the body at the
+    body's own velocity needs no force: only the momentum relative to the body is exchanged,
+    the Galilean-invariant form); "none" books nothing.
     `shape` gives u_body: the new body, or the old one when it is removed (None: at rest).
     Returns (impulse (Jx, Jy), changed (h, w) bool mask of written nodes).
     """
+    check_schemes(scheme, impulse)
     covered = new_solid & ~old_solid
     uncovered = old_solid & ~new_solid
     if not (covered.any() or uncovered.any()):
@@ -104,6 +133,7 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
             ux, uy = node_velocity(shape, velocity, omega, x0, y0, new_solid)
             f[:, new_solid] = equilibrium(np.full(ux.size, RHO0), ux, uy)
         return (0.0, 0.0), new_solid.copy()
+    relative = impulse == "relative"
     cx_, cy_ = C[:, 0].astype(np.float64), C[:, 1].astype(np.float64)
     jx = jy = 0.0
     lost = 0.0   # mass the cover/uncover removes from the grid
@@ -113,27 +143,46 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
         jx += float(cx_ @ fc_i)
         jy += float(cy_ @ fc_i)
         lost += float(fc.sum()) - RHO0 * int(covered.sum())
+        if relative:
+            ucx, ucy = node_velocity(shape, velocity, omega, x0, y0, covered)
+            rho_c = fc.sum(axis=0)
+            jx -= float((rho_c * ucx).sum())
+            jy -= float((rho_c * ucy).sum())
     body_nodes = (new_solid | old_solid).astype(np.float64)
     # the equilibria of the uncovered nodes (rho_new) and of the solid ones (RHO0), in one call
     written = uncovered | new_solid
     ux, uy = node_velocity(shape, velocity, omega, x0, y0, written)
     rho_eq = np.full(ux.size, RHO0)
+    neq = None
     if uncovered.any():
         rho = f.sum(axis=0)
         donor = ~new_solid & ~uncovered
+        fields = [np.where(donor, rho, 0.0), donor.astype(np.float64), body_nodes]
+        if scheme == "nonequilibrium":
+            per = np.where(donor, rho, 1.0)
+            mx = np.tensordot(cx_, f, axes=1)
+            my = np.tensordot(cy_, f, axes=1)
+            fneq = f - equilibrium(per, np.where(donor, mx, 0.0) / per, np.where(donor, my, 0.0) / per)
+            fields += list(np.where(donor, fneq, 0.0))
         # one stacked neighbour sum: donor densities, donor count, body nodes (the ring below)
-        rsum, cnt, near_body = _neighbour_sum(np.stack([np.where(donor, rho, 0.0), donor.astype(np.float64),
-                                                        body_nodes]), wrap)
+        sums = _neighbour_sum(np.stack(fields), wrap)
+        rsum, cnt, near_body = sums[0], sums[1], sums[2]
         rho_new = np.where(cnt > 0, rsum / np.maximum(cnt, 1), RHO0)[uncovered]
+        if scheme == "nonequilibrium":
+            neq = (sums[3:] / np.maximum(cnt, 1))[:, uncovered]
+            neq -= neq.mean(axis=0)   # no mass (float rounding of the means)
         is_uncovered = uncovered[written]
         rho_eq[is_uncovered] = rho_new
-        uxu, uyu = ux[is_uncovered], uy[is_uncovered]
-        jx -= float((rho_new * uxu).sum())
-        jy -= float((rho_new * uyu).sum())
+        if not relative:
+            uxu, uyu = ux[is_uncovered], uy[is_uncovered]
+            jx -= float((rho_new * uxu).sum())
+            jy -= float((rho_new * uyu).sum())
         lost += RHO0 * int(uncovered.sum()) - float(rho_new.sum())
     else:
         near_body = _neighbour_sum(body_nodes, wrap)
     f[:, written] = equilibrium(rho_eq, ux, uy)
+    if neq is not None:
+        f[:, uncovered] += neq
     ring = ~new_solid & (near_body > 0)
     if lost != 0.0 and ring.any():
         fr = f[:, ring]
@@ -144,10 +193,18 @@ def refill(f: np.ndarray, old_solid: np.ndarray, new_solid: np.ndarray, shape, v
         added_i = added.sum(axis=1)
         jx -= float(cx_ @ added_i)
         jy -= float(cy_ @ added_i)
+        if relative:
+            urx, ury = node_velocity(shape, velocity, omega, x0, y0, ring)
+            dm = added.sum(axis=0)
+            jx += float((dm * urx).sum())
+            jy += float((dm * ury).sum())
+    if impulse == "none":
+        jx = jy = 0.0
     return (jx, jy), (new_solid | uncovered | ring)
 
 
-def move_body(old, new, config, read_window, write_nodes, step_sets_solid: bool = False):
+def move_body(old, new, config, read_window, write_nodes, step_sets_solid: bool = False,
+              refill_scheme: str = DEFAULT_REFILL, impulse: str = DEFAULT_IMPULSE):
     """Cover/uncover bookkeeping between two body states (either may be None), for any backend.
 
     read_window(x0, y0, x1, y1) -> (9, y1-y0, x1-x0) float64 full f* of that box;
@@ -157,6 +214,7 @@ def move_body(old, new, config, read_window, write_nodes, step_sets_solid: bool 
     `step_sets_solid`: the backend's step gives every solid node f^eq(RHO0, u_body) itself (the
     gl step pass), so a move that covers and uncovers no node (a sub-cell move, most of a
     slowly dragged body's) reads and writes nothing: refill would only write those equilibria.
+    `refill_scheme`, `impulse`: `refill`'s `scheme` and `impulse`.
     """
     box = union_box(old.raster.window if old else None, new.raster.window if new else None)
     if box is None:
@@ -170,9 +228,22 @@ def move_body(old, new, config, read_window, write_nodes, step_sets_solid: bool 
     motion = new if new is not None else old
     f = read_window(x0, y0, x1, y1)
     impulse, changed = refill(f, old_solid, new_solid, motion.shape, motion.velocity, motion.omega, x0, y0,
-                              wrap=periodic_wrap(config, (x0, y0, x1, y1)))
+                              wrap=periodic_wrap(config, (x0, y0, x1, y1)), scheme=refill_scheme, impulse=impulse)
     write_nodes(x0, y0, f, changed)
     return impulse
+
+
+def same_solid_motion(old, new) -> bool:
+    """Whether a move from body state `old` to `new` leaves every solid node as it was: the same
+    solid nodes (no node covered or uncovered) at the same u_body (same velocity and angular
+    velocity, and for a turning body the same centre). The solid nodes then already hold
+    f^eq(RHO0, u_body), so the move writes nothing (a sub-cell move of a towed body, most of
+    its steps); only the links change."""
+    if old is None or new is None or old.velocity != new.velocity or old.omega != new.omega:
+        return False
+    if new.omega != 0.0 and (old.shape.x, old.shape.y) != (new.shape.x, new.shape.y):
+        return False
+    return old.raster.box == new.raster.box and np.array_equal(old.raster.box_solid, new.raster.box_solid)
 
 
 @dataclass

@@ -435,6 +435,8 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
     Its closure holds only these flags and constants, never another compiled function: numba's
     on-disk cache keys a closure by its variables' pickled bytes, and a compiled function pickles
     with an id that is new in every process, so such a closure would compile again at every start."""
+    if kind not in ("bgk", "trt", "rr"):
+        raise ValueError(f"the cpu backend compiles bgk, trt and rr, not {kind!r}")
     K = constants(dtype)
     rr = kind == "rr"   # the closure's branches on these constants are pruned before inlining,
     trt = kind == "trt"  # so each variant compiles one operator

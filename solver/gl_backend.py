@@ -441,7 +441,8 @@ class GLSolver(Solver):
             self._write_texels(read["texels"], read["kbox"])
 
         # lbm_step.glsl's BODY pass gives every solid node f^eq(RHO0, u_body) each step
-        jx, jy = move_body(old, new, cfg, read_window, write_nodes, step_sets_solid=True)
+        jx, jy = move_body(old, new, cfg, read_window, write_nodes, step_sets_solid=True,
+                           refill_scheme=self.body_refill, impulse=self.body_impulse)
         self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         box = union_box(old.raster.window if old else None, new.raster.window if new else None)
         if box is not None:

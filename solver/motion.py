@@ -7,7 +7,10 @@ each step (sub-cell poses), and the body is re-placed before every step it moves
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+
+from feelflow.solver.force_average import StepWeightedMean
 
 #: phase kinds a scene may name instead of an explicit velocity
 MOVES = ("stop", "with", "against")
@@ -15,10 +18,52 @@ MOVES = ("stop", "with", "against")
 
 @dataclass(frozen=True)
 class Phase:
-    """`steps` steps at body velocity `velocity` (lattice units per step)."""
+    """`steps` steps at body velocity `velocity` (lattice units per step), with, where `period`
+    > 0, a sinusoidal displacement `amplitude` sin(2 pi k / period) on top (k: steps into the
+    phase; an in-line oscillating cylinder, Duetsch et al., J. Fluid Mech. 360 (1998) 249, moves
+    as x = -A sin(2 pi f t): amplitude (-A, 0), period 1 / f)."""
 
     steps: int
     velocity: tuple[float, float] = (0.0, 0.0)
+    amplitude: tuple[float, float] = (0.0, 0.0)
+    period: float = 0.0
+
+    @property
+    def oscillates(self) -> bool:
+        return self.period > 0 and self.amplitude != (0.0, 0.0)
+
+    def displacement(self, k: int) -> tuple[float, float]:
+        """Displacement after k steps of this phase."""
+        dx, dy = k * self.velocity[0], k * self.velocity[1]
+        if self.oscillates:
+            s = math.sin(2.0 * math.pi * k / self.period)
+            dx, dy = dx + self.amplitude[0] * s, dy + self.amplitude[1] * s
+        return dx, dy
+
+    def step_velocity(self, k: int) -> tuple[float, float]:
+        """The body velocity during step k of this phase: what the pose moves in that step (so
+        that the positions the runner places and the wall velocity agree exactly)."""
+        if not self.oscillates:
+            return self.velocity
+        (x0, y0), (x1, y1) = self.displacement(k), self.displacement(k + 1)
+        return x1 - x0, y1 - y0
+
+    @property
+    def peak_speed(self) -> float:
+        """An upper bound of the phase's speed: |V| + 2 pi |A| / period."""
+        extra = 2.0 * math.pi * math.hypot(*self.amplitude) / self.period if self.oscillates else 0.0
+        return math.hypot(*self.velocity) + extra
+
+    def turning_points(self) -> list[int]:
+        """Steps into the phase near which a sinusoidal displacement peaks (both neighbours of
+        each quarter and three-quarter period), for bounding where the body goes."""
+        if not self.oscillates:
+            return []
+        out, t = [], self.period / 4.0
+        while t < self.steps:
+            out += [int(math.floor(t)), int(math.ceil(t))]
+            t += self.period / 2.0
+        return [k for k in out if 0 <= k <= self.steps]
 
 
 def phase_velocity(move: str, speed: float, stream_direction=(1.0, 0.0)) -> tuple[float, float]:
@@ -44,7 +89,7 @@ class MotionScript:
         start = 0
         for phase in self.phases:
             if t < start + phase.steps:
-                return phase.velocity
+                return phase.step_velocity(t - start)
             start += phase.steps
         return (0.0, 0.0)
 
@@ -63,17 +108,20 @@ class MotionScript:
         start = 0
         for phase in self.phases:
             k = min(phase.steps, max(0, t - start))
-            dx += k * phase.velocity[0]
-            dy += k * phase.velocity[1]
+            px, py = phase.displacement(k)
+            dx += px
+            dy += py
             start += phase.steps
         return dx, dy
 
     def extreme_displacements(self, steps: int):
-        """Displacements at the start and at every phase end up to `steps` (the pose moves
-        linearly within a phase, so these bound where the body goes)."""
+        """Displacements at the start, at every phase end and near every turning point of an
+        oscillating phase, up to `steps` (elsewhere the pose moves monotonically, so these
+        bound where the body goes)."""
         times = [0]
         start = 0
         for phase in self.phases:
+            times += [min(start + k, steps) for k in phase.turning_points()]
             start += phase.steps
             times.append(min(start, steps))
         times.append(steps)
@@ -113,13 +161,7 @@ class MotionRunner:
     def advance(self, n: int) -> dict[str, tuple[float, float]]:
         """Run n steps along the script; the force per model averaged over them. Raises
         `SolverDiverged` when the flow has left the physical range (`Solver.check_physical`)."""
-        total: dict[str, list[float]] = {}
-
-        def add(forces, weight):
-            for name, (fx, fy) in forces.items():
-                acc = total.setdefault(name, [0.0, 0.0])
-                acc[0] += weight * fx
-                acc[1] += weight * fy
+        total = StepWeightedMean()
 
         remaining = n
         while remaining > 0:
@@ -135,8 +177,8 @@ class MotionRunner:
                 left = self.script.steps_left_in_phase(self.t)
                 k = remaining if left is None else min(remaining, left)
             self.solver.step(k)
-            add(self.solver.forces(), k)
+            total.add(self.solver.forces(), k)
             self.t += k
             remaining -= k
         self.solver.check_physical()   # SolverDiverged when the flow left the physical range
-        return {name: (acc[0] / n, acc[1] / n) for name, acc in total.items()}
+        return total.mean()

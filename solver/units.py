@@ -112,3 +112,105 @@ class ForceScale:
         if isinstance(lattice_force, tuple):
             return tuple(self.newtons_per_lattice_force * c for c in lattice_force)
         return self.newtons_per_lattice_force * lattice_force
+
+
+# --- physical units: a fluid and a body size, matched to the simulated Reynolds number ----------
+@dataclass(frozen=True)
+class Fluid:
+    """A fluid's name, density rho (kg/m^3) and kinematic viscosity nu (m^2/s)."""
+
+    name: str
+    density: float
+    viscosity: float
+
+
+#: fluids at 20 degrees C and 1 atm: density and dynamic viscosity mu from F. M. White, *Fluid
+#: Mechanics* (7th ed., 2011), Table 1.4; nu = mu / rho
+FLUIDS = {
+    "air": Fluid("air", 1.205, 1.80e-5 / 1.205),
+    "water": Fluid("water", 998.0, 1.00e-3 / 998.0),
+    "oil": Fluid("SAE 30 oil", 891.0, 0.29 / 891.0),
+}
+
+
+@dataclass(frozen=True)
+class PhysicalUnits:
+    """Lattice units read as a physical flow with the same Reynolds number.
+
+    Given the fluid (rho_f, nu_f), the body's physical size D (metres) and its size in cells L,
+    and the simulated flow (wind U and viscosity nu in lattice units): the cell is dx = D / L;
+    matching Re = U L / nu = U_f D / nu_f gives the physical wind U_f = Re nu_f / D, and the step
+    dt = U dx / U_f (the same as nu dx^2 / nu_f). Then a lattice velocity times dx / dt is in
+    m/s, a step is dt seconds, a lattice pressure (rho_0 = 1) times rho_f (dx / dt)^2 is in
+    pascals, and a lattice force per unit span times rho_f dx^3 / dt^2 is in newtons per metre of
+    span (`ForceScale.physical`), times `span` (metres) in newtons. Only the Reynolds number is
+    simulated: the lattice Mach number is not the physical one (water at 2 cm/s is far slower
+    than sound; the lattice flow runs at Ma ~ 0.1 to be fast)."""
+
+    fluid: Fluid
+    size_m: float        # the body's size (its reference length) in metres
+    span_m: float        # the body's extent across the 2D plane (metres): force per span -> newtons
+    size_cells: float    # the same length in cells
+    speed: float         # the simulated wind, lattice units
+    nu: float            # the simulated viscosity, lattice units
+
+    def __post_init__(self):
+        for name in ("size_m", "span_m", "size_cells", "speed", "nu"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"{name}: must be a positive number, got {v!r}")
+
+    @property
+    def reynolds(self) -> float:
+        return reynolds(self.speed, self.size_cells, self.nu)
+
+    @property
+    def dx(self) -> float:
+        """Metres per cell."""
+        return self.size_m / self.size_cells
+
+    @property
+    def wind_m_s(self) -> float:
+        """The physical wind speed with the simulated Reynolds number."""
+        return self.reynolds * self.fluid.viscosity / self.size_m
+
+    @property
+    def dt(self) -> float:
+        """Seconds per solver step."""
+        return self.speed * self.dx / self.wind_m_s
+
+    def velocity(self, v):
+        """Lattice velocity (cells/step) -> m/s."""
+        return v * (self.dx / self.dt)
+
+    def time(self, steps):
+        """Solver steps -> seconds."""
+        return steps * self.dt
+
+    def pressure(self, p):
+        """Lattice pressure difference -> pascals."""
+        return p * self.fluid.density * (self.dx / self.dt) ** 2
+
+    def viscosity(self, nu):
+        """Lattice kinematic viscosity (cells^2/step) -> m^2/s."""
+        return nu * self.dx ** 2 / self.dt
+
+    def force_scale(self) -> ForceScale:
+        return ForceScale.physical(self.dx, self.dt, self.fluid.density, self.span_m)
+
+    def force(self, f):
+        """Lattice force (per unit span) -> newtons on a body `span_m` deep."""
+        return self.force_scale().newtons(f)
+
+    def describe(self) -> str:
+        """'water at 2.0 cm/s past a 1 cm body (10 cm span)': the flow the tunnel simulates."""
+        return (f"{self.fluid.name} at {_si(self.wind_m_s, 'm/s')} past a {_si(self.size_m, 'm')} body "
+                f"({_si(self.span_m, 'm')} span), Re {self.reynolds:.3g}")
+
+
+def _si(value: float, unit: str) -> str:
+    """A length or speed with a readable prefix (cm, mm; cm/s, mm/s)."""
+    for factor, prefix in ((1.0, ""), (1e-2, "c"), (1e-3, "m"), (1e-6, "\u00b5")):
+        if abs(value) >= factor or factor == 1e-6:
+            return f"{value / factor:.3g} {prefix}{unit}"
+    return f"{value:.3g} {unit}"

@@ -22,6 +22,14 @@ def pytest_collection_finish(session):
         set_surface_format()
 
 
+def pytest_runtest_setup(item):
+    """A gui test without a display fails, as a gl test without EGL does: a skip would hide a
+    broken set-up (installer/run-tests.sh runs the gui tier under xvfb-run)."""
+    if item.get_closest_marker("gui") and not os.environ.get("DISPLAY"):
+        pytest.fail("no X display for the gui tier: run it under xvfb-run -a (installer/run-tests.sh does)",
+                    pytrace=False)
+
+
 @pytest.fixture
 def window(qtbot, tmp_path):
     """The FeelFlow window on the numpy solver and a small grid, running, settings in tmp_path."""

@@ -7,16 +7,11 @@ push the default run past its 15 minutes. The default run still checks the cpu b
 numpy case by case (tests/test_cpu_vs_numpy.py) and through the backend choice."""
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
-
-GL_LANDED = (Path(__file__).resolve().parents[1] / "solver" / "gl_backend.py").exists()
 
 #: use as @pytest.mark.parametrize("backend", BACKENDS)
 BACKENDS = [
     "numpy",
     pytest.param("cpu", marks=pytest.mark.slow),
-    pytest.param("gl", marks=[pytest.mark.gl,
-                              pytest.mark.skipif(not GL_LANDED, reason="solver/gl_backend.py not landed yet")]),
+    pytest.param("gl", marks=pytest.mark.gl),
 ]

@@ -32,6 +32,26 @@ def test_spring_damper_caps_the_speed_and_says_so():
     assert math.hypot(*pos) <= 0.05 * 50 + 1e-9
 
 
+@pytest.mark.parametrize("target", [(-100.0, 0.0), (100.0, 0.0), (0.0, 100.0), (-70.0, 70.0)])
+def test_the_body_speed_relative_to_the_wind_stays_under_the_cap(target):
+    """Pulled against, with and across a wind of 0.09 (the cap 0.098): the body's speed relative
+    to the wind and its own speed both stay within the cap; against the wind it may move at
+    only 0.008 (relative 0.098), where without the wind it would move at 0.098."""
+    cap, wind = 0.098, (0.09, 0.0)
+    c = SpringDamper(w0=0.05, max_speed=cap, stream=wind)
+    vel = (0.0, 0.0)
+    pos = (0.0, 0.0)
+    for _ in range(100):
+        pos, vel, capped = c.advance(pos, vel, target, 1)
+        assert math.hypot(vel[0] - wind[0], vel[1] - wind[1]) <= cap + 1e-12
+        assert math.hypot(*vel) <= cap + 1e-12
+    assert capped
+    if target == (-100.0, 0.0):
+        assert vel[0] == pytest.approx(wind[0] - cap)
+    if target == (100.0, 0.0):
+        assert vel[0] == pytest.approx(cap)
+
+
 def test_power_law_fit_recovers_the_exponent():
     from feelflow.app.model.power_law import fit_power_law
 

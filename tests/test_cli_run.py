@@ -135,9 +135,12 @@ def test_divergence_is_one_line_and_exit_1(tmp_path):
         "inflow_speed = 0.04", "inflow_speed = 0.095").replace("inflow_ramp_steps = 20", "inflow_ramp_steps = 0")
     scene = write(tmp_path, text.replace("[output]", "[run]\nsteps = 3000\n\n[output]"))
     result = feelflow("run", scene, "--out", tmp_path / "f.csv", "--backend", "numpy")
-    # far outside the measured stable region: run warns first (one line), then the error (one line)
-    warning, error = result.stderr.strip("\n").split("\n")
+    # far outside the measured stable region: run warns first (one line), then, once its flow has
+    # left the operator's local region (solver/local_guard.py), says so (one line), then the error
+    warning, local, error = result.stderr.strip("\n").split("\n")
     assert warning.startswith("feelflow: warning:") and "stable" in warning
+    assert local.startswith("feelflow: warning: step ") and "where it is fastest" in local
+    assert "runs as written" in local
     assert result.returncode == 1 and "diverged" in error and "Traceback" not in result.stderr
 
 
@@ -160,7 +163,6 @@ def test_validate_prints_a_table_and_writes_json(tmp_path):
 def test_run_on_gl_matches_numpy(tmp_path):
     """`--backend gl` (own EGL context) writes the same forces as the numpy reference, to the
     float32 tolerance of docs/science/algorithm.md."""
-    pytest.importorskip("feelflow.solver.gl_backend", reason="the gl backend is not built yet")
     scene = write(tmp_path, SMALL)
     tables = {}
     for backend in ("numpy", "gl"):

@@ -4,14 +4,12 @@ the next start takes the remembered choice without measuring; the menu's choice 
 next start."""
 from __future__ import annotations
 
-import os
 
 import pytest
 
 from gui_fixtures import GRID
 
-pytestmark = [pytest.mark.gui,
-              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+pytestmark = pytest.mark.gui
 
 
 def started_window(qtbot, settings, backend):

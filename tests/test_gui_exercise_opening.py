@@ -29,7 +29,7 @@ def _window(qtbot, tmp_path, size):
         w.resize(*size)
     w.show()
     qtbot.waitUntil(lambda: w.exercises.exercise is not None, timeout=20000)
-    qtbot.wait(300)   # the docks settle, the tunnel is fitted
+    qtbot.wait(1200)  # the docks settle, the tunnel is fitted, the readouts show the exercise's reference
     return w
 
 
@@ -54,7 +54,9 @@ def test_exercise_opens_readable_without_the_lesson_chooser(qtbot, tmp_path, siz
         for a, b in zip(shown, shown[1:]):
             assert a.geometry().bottom() < b.geometry().top() or a.y() == b.y(), (a, b)
         assert "for the attempts" in panel.attempts_label.text().replace("\u200b", "")
-        assert "1.1086" in panel.references.text()
+        # the scores to the digits the grid uncertainty supports (most_lift: 0.05), ties said
+        assert "1.11" in panel.references.text() and "1.1086" not in panel.references.text()
+        assert "\u00b10.05" in panel.goal.text() and "tie" in panel.goal.text()
         # the instructions read as paragraphs, not the file's line breaks
         assert "area between 60 and 80" in panel.instructions.toPlainText()
         # the 192 x 64 tunnel fills the viewport: its full width (less the colour bar) and most of its height
@@ -65,6 +67,8 @@ def test_exercise_opens_readable_without_the_lesson_chooser(qtbot, tmp_path, siz
         assert r.width() >= 0.97 * (vp.width() - COLOUR_BAR_MARGIN)
         assert r.height() >= 0.85 * vp.height(), (r, vp.size())
         assert vp.width() >= 0.6 * w.width()
+        if size is not None:   # the panel fits: the window keeps the size it was given
+            assert (w.width(), w.height()) == size
     finally:
         w.loop.timer.stop()
         w.loop.slow_timer.stop()

@@ -12,8 +12,7 @@ import pytest
 
 from gui_fixtures import GRID
 
-pytestmark = [pytest.mark.gui,
-              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+pytestmark = pytest.mark.gui
 
 
 def make_window(qtbot, settings_path, backend="gl"):

@@ -3,15 +3,13 @@ force axis shows the settled forces, not the impulsive start's pulse, until the 
 log-log view frames its points even when there is only one speed."""
 from __future__ import annotations
 
-import os
 
 import numpy as np
 import pytest
 
 # the `window` fixture comes from tests/gui_fixtures.py (conftest)
 
-pytestmark = [pytest.mark.gui,
-              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+pytestmark = pytest.mark.gui
 
 
 def test_time_view_force_axis_leaves_out_the_start_pulse(window, qtbot):

@@ -3,12 +3,10 @@ on the running window, every part is reported, and detaching leaves the window a
 the frame length the frame loop aims at (app/gui/window/frame_loop.py)."""
 from __future__ import annotations
 
-import os
 
 import pytest
 
-pytestmark = [pytest.mark.gui,
-              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+pytestmark = pytest.mark.gui
 
 
 def test_the_command_line_takes_frame_profile():

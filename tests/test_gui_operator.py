@@ -3,12 +3,10 @@ in one line of the status bar; the lessons that need the high-Reynolds operator 
 A real Qt window under Xvfb, the numpy solver (`xvfb-run -a python -m pytest -m gui ...`)."""
 from __future__ import annotations
 
-import os
 
 import pytest
 
-pytestmark = [pytest.mark.gui,
-              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+pytestmark = pytest.mark.gui
 
 
 def test_the_status_bar_names_the_operator_and_follows_the_viscosity(window, qtbot):

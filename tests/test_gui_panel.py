@@ -3,14 +3,12 @@ every control explains itself in a tooltip, quantities carry their units, and th
 are plain decimals."""
 from __future__ import annotations
 
-import os
 
 import pytest
 
 # the `window` fixture comes from tests/gui_fixtures.py (conftest)
 
-pytestmark = [pytest.mark.gui,
-              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+pytestmark = pytest.mark.gui
 
 
 def test_every_panel_control_has_a_tooltip(window):

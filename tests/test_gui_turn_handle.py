@@ -8,15 +8,13 @@ the body."""
 from __future__ import annotations
 
 import math
-import os
 
 import numpy as np
 import pytest
 
 from gui_fixtures import solid_mask, wheel   # the `window` fixture comes from gui_fixtures too (conftest)
 
-pytestmark = [pytest.mark.gui,
-              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+pytestmark = pytest.mark.gui
 
 
 def knob_after_hover(window):

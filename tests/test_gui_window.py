@@ -13,8 +13,7 @@ import pytest
 
 from gui_fixtures import GRID, solid_mask, wheel   # the `window` fixture comes from gui_fixtures too (conftest)
 
-pytestmark = [pytest.mark.gui,
-              pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")]
+pytestmark = pytest.mark.gui
 
 
 def test_window_opens_runs_and_shows_a_live_field(window, qtbot):

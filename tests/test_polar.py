@@ -119,3 +119,29 @@ def test_cli_writes_the_polar_and_cp(tmp_path, camber, capsys):
     # an existing output is refused without --force
     assert main(["polar", str(scene), "--angles", "0", "--out", str(out)]) == 2
     assert "exists" in capsys.readouterr().err
+
+
+def test_live_polar_turns_the_body_when_an_angle_settles(tmp_path):
+    """The window's polar (app/model/live_polar.py) in a headless Simulation: an angle is held
+    until it settles, then the body turns to the next (pose angle -alpha); each angle keeps its
+    C_p, and the probe's force never reaches the force history."""
+    from feelflow.app.model.scene import load_scene
+    from feelflow.app.model.simulation import Simulation
+
+    scene = tmp_path / "foil.toml"
+    scene.write_text(TINY.format(camber=0.0))
+    sim = Simulation(backend="numpy")
+    sim.load_scene(load_scene(scene))
+    sim.start_polar((0.0, 4.0), window_chords=1.0, min_chords=1.0)
+    assert sim.hold_still and sim.angle == pytest.approx(0.0)
+    while not sim.polar.sweep.points:
+        sim.advance(50)
+        assert sim.solver.time < 20000
+    assert sim.angle == pytest.approx(math.radians(-4.0)) and sim.polar.sweep.angle == 4.0
+    alpha, cp = sim.polar.cp[0]
+    assert alpha == 0.0 and cp.coordinate == "x/c" and len(cp.upper[0]) > 10
+    assert "surface_pressure" not in sim.history.forces
+    sim.advance(50)
+    assert sim.polar.live_cp(sim) is not None
+    sim.reset_flow()
+    assert sim.polar is None

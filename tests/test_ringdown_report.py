@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from feelflow.app.model.simulation import default_base_config
 from feelflow.app.reports.ringdown import WINDOW_BEFORE, run_window, window_case
 
@@ -33,3 +35,33 @@ def test_report_ringdown_refuses_bad_input_in_one_line():
         r = subprocess.run([*CLI, "report", "ringdown", *extra], capture_output=True, text=True, cwd=ROOT)
         assert r.returncode == 2, r.stderr
         assert len(r.stderr.strip().splitlines()) == 1 and extra[1] in r.stderr
+
+
+def test_report_towed_quick_runs_held_and_towed_rows():
+    """`feelflow report towed --quick` (app/reports/towed.py): the held row and one towed row per
+    impulse scheme asked for; the absolute impulse is the noisy one (a smoke test, not physics)."""
+    r = subprocess.run([*CLI, "report", "towed", "--quick", "--impulse", "relative,absolute"], capture_output=True,
+                       text=True, cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+    rows = [line for line in r.stdout.splitlines() if line.startswith("| held") or line.startswith("| towed")]
+    assert len(rows) == 3 and "relative" in rows[1] and "absolute" in rows[2]
+
+
+def test_report_towed_refuses_bad_schemes_in_one_line():
+    for extra in (["--impulse", "smooth"], ["--refill", "magic"], ["--backend", "fast"]):
+        r = subprocess.run([*CLI, "report", "towed", "--quick", *extra], capture_output=True, text=True, cwd=ROOT)
+        assert r.returncode == 2, r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1 and extra[1] in r.stderr
+
+
+@pytest.mark.slow
+def test_towed_cylinder_drag_is_calm_and_galilean_invariant():
+    """The full towed-versus-held case (docs/science/force-models.md, 'A moving body'), numpy:
+    the momentum exchange's mean drag within 2 % of the held body's, its noise per step at most
+    15 % and over 25-step means at most 2 % of the mean."""
+    from feelflow.app.reports.towed import run
+
+    held, towed = run("numpy", False), run("numpy", True)
+    mea = towed["momentum_exchange"]
+    assert mea["mean"] == pytest.approx(held["momentum_exchange"]["mean"], rel=0.02)
+    assert mea["noise_1"] <= 0.15 and mea["noise_25"] <= 0.02

@@ -138,3 +138,27 @@ def test_equilibrium_key_reaches_the_solver_config():
     scene = scene_from_dict(minimal(flow={"equilibrium": "incompressible"}), "scene.toml")
     assert scene.config.equilibrium == "incompressible"
     assert scene_from_dict(minimal(), "scene.toml").config.equilibrium == "compressible"
+
+
+def test_an_oscillating_phase_is_duetschs_motion():
+    """`amplitude` and `period` add A sin(2 pi k / T) to a phase (docs/reference/scenes.md): the
+    positions follow it exactly, each step's velocity is what the pose moves in that step, the
+    reference speed for `reynolds` is the peak speed 2 pi |A| / T, and the path check sees the
+    turning points."""
+    A, T = 3.0, 400
+    scene = scene_from_dict(minimal(flow={"inflow_speed": 0.0, "reynolds": 100},
+                                    motion=[{"steps": 800, "amplitude": [-A, 0.0], "period": T}]))
+    script = scene.motion
+    for k in (0, 37, 100, 250, 799):
+        assert script.displacement(k)[0] == pytest.approx(-A * math.sin(2 * math.pi * k / T), abs=1e-12)
+        v = script.velocity_at(k)[0]
+        assert v == pytest.approx(script.displacement(k + 1)[0] - script.displacement(k)[0], abs=1e-15)
+    assert scene.reference_speed == pytest.approx(2 * math.pi * A / T)
+    assert scene.config.nu == pytest.approx(2 * math.pi * A / T * 10 / 100)
+    assert min(dx for _, (dx, _) in script.extreme_displacements(800)) == pytest.approx(-A, abs=1e-3)
+    with pytest.raises(UserError, match="leaves the domain"):
+        scene_from_dict(minimal(run=None, motion=[{"steps": 4000, "amplitude": [-45.0, 0.0], "period": 4000}]))
+    with pytest.raises(UserError, match=r"motion\[0\].period.*both amplitude"):
+        scene_from_dict(minimal(motion=[{"steps": 400, "amplitude": [-3.0, 0.0]}]))
+    with pytest.raises(UserError, match="Mach limit"):
+        scene_from_dict(minimal(motion=[{"steps": 400, "amplitude": [-30.0, 0.0], "period": 100}]))

@@ -69,7 +69,10 @@ def record(a) -> None:
             cl_stress.append(c_stress[1])
     solver.close()
     extra = {"cd_stress": np.array(cd_stress), "cl_stress": np.array(cl_stress)} if a.stress else {}
-    np.savez(a.out, t=np.array(t), cd=np.array(cd), cl=np.array(cl), d=a.d, u_mean=geo.u_mean, **extra)
+    from feelflow.app.files import atomic_path
+
+    with atomic_path(a.out, suffix=".npz") as tmp:
+        np.savez(tmp, t=np.array(t), cd=np.array(cd), cl=np.array(cl), d=a.d, u_mean=geo.u_mean, **extra)
 
 
 def analyse(path: str, periods: int = 3) -> None:
@@ -136,6 +139,13 @@ def main() -> None:
             check_resolution(a.d)
         except ValueError as exc:
             p.error(f"--d: {exc}")
+        from feelflow.app.errors import UserError
+        from feelflow.app.files import check_output
+
+        try:   # before the run: never a device, never an existing file (the output policy)
+            check_output(a.out, "--out")
+        except UserError as exc:
+            p.error(str(exc))
         record(a)
     else:
         for path in a.paths:

@@ -23,6 +23,7 @@ COMMANDS = {
     "session": "inspect, replay or export a recorded session file",
     "exercise": "shape-editing exercises: score a class's shapes, check an exercise file",
     "polar": "an angle-of-attack sweep: C_L and C_D against alpha (CSV and image), C_p along the surface",
+    "screenshots": "the guide's pictures of the window (exercise, probes and units)",
 }
 
 
@@ -40,6 +41,12 @@ def build_parser() -> argparse.ArgumentParser:
                         help="open the real window, exercise it and exit 0 only if everything worked")
     parser.add_argument("--screenshot", metavar="PATH", help="with --selftest: save a screenshot")
     parser.add_argument("--seconds", type=float, default=8.0, help="with --selftest: how long to run")
+    parser.add_argument("--lesson", default=None, metavar="KEY",
+                        help="with --selftest: run this lesson (app/model/presets.py) for --seconds instead of the "
+                             "default script, then save the screenshot (e.g. polar)")
+    parser.add_argument("--plot-view", default=None, metavar="VIEW",
+                        help="with --selftest --lesson: the force plot's view for the screenshot (time, speed, polar, "
+                             "drag_polar, cp)")
     parser.add_argument("--frame-profile", action="store_true",
                         help="with --selftest: also print where a frame's time goes (solver, drawing, plot, Qt)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -50,10 +57,10 @@ def build_parser() -> argparse.ArgumentParser:
         except ModuleNotFoundError as exc:  # command not built yet
             if exc.name != f"feelflow.app.cli.commands.{name}":
                 raise
-            p.set_defaults(_missing=name)
+            p.set_defaults(missing_command=name)
             continue
         module.add_arguments(p)
-        p.set_defaults(_module=module)
+        p.set_defaults(command_module=module)
     return parser
 
 
@@ -62,26 +69,26 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     if args.selftest or args.command is None:
         args.command = "gui"
-    if not hasattr(args, "_module") and not hasattr(args, "_missing"):
+    if not hasattr(args, "command_module") and not hasattr(args, "missing_command"):
         # no sub-command on the line (`feelflow`, `feelflow --selftest`): the gui's defaults
         try:
             module = importlib.import_module("feelflow.app.cli.commands.gui")
         except ModuleNotFoundError as exc:
             if exc.name != "feelflow.app.cli.commands.gui":
                 raise
-            args._missing = "gui"
+            args.missing_command = "gui"
         else:
             sub = _Parser()
             module.add_arguments(sub)
             for key, value in vars(sub.parse_args([])).items():
                 if not hasattr(args, key):
                     setattr(args, key, value)
-            args._module = module
-    if getattr(args, "_missing", None):
+            args.command_module = module
+    if getattr(args, "missing_command", None):
         print(f"feelflow: '{args.command}' is not available in this version", file=sys.stderr)
         return 2
     try:
-        return int(args._module.main(args) or 0)
+        return int(args.command_module.main(args) or 0)
     except UserError as exc:
         print(f"feelflow: {one_line(str(exc))}", file=sys.stderr)
         return 2

@@ -134,6 +134,8 @@ class Objective:
     kind: str
     target: float | None = None
     tolerance: float | None = None
+    #: the grid uncertainty of a score, in the score's units (app/exercises/uncertainty.py)
+    uncertainty: float | None = None
 
     @property
     def quantity(self) -> str:
@@ -267,8 +269,9 @@ def exercise_from_dict(data: dict, source: str = "exercise", path: Path | None =
     if kind.startswith("target_"):
         target = o.number("target")
         tolerance = o.number("tolerance", positive=True)
+    uncertainty = o.number("grid_uncertainty", None, positive=True)
     o.done()
-    objective = Objective(kind, target, tolerance)
+    objective = Objective(kind, target, tolerance, uncertainty)
 
     refs = top.raw("reference", [])
     if not isinstance(refs, list) or not refs:

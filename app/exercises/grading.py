@@ -19,7 +19,8 @@ from feelflow.app.exercises import scoring
 #: row status besides scoring's SCORED / NOT_SETTLED
 BREAKS = "breaks a constraint"
 INVALID = "not a shape file"
-CSV_HEADER = ["rank", "file", "status", "score", "verdict", "cd", "cl", "steps", "seconds", "reason"]
+CSV_HEADER = ["rank", "file", "status", "score", "verdict", "cd", "cl", "steps", "seconds", "reason", "tied",
+              "grid_uncertainty"]
 
 
 @dataclass
@@ -86,7 +87,7 @@ def _exercise(path: str):
     return load_exercise(path)
 
 
-def score_file(exercise, path, scale: int = 1) -> Row:
+def score_file(exercise, path, scale: int = 1, backend: str = "numpy") -> Row:
     """One shape file's row (never raises for a bad shape file or a broken constraint)."""
     from feelflow.app.exercises.constraints import check_shape
     from feelflow.shapes.base import ShapeError
@@ -103,25 +104,27 @@ def score_file(exercise, path, scale: int = 1) -> Row:
     problems = check_shape(exercise, shape)
     if problems:
         return Row(name, BREAKS, verdict="; ".join(problems), reason=problems[0], scale=scale)
-    r = scoring.score_shape(exercise, shape, scale)
+    r = scoring.score_shape(exercise, shape, scale, backend=backend)
     return Row(name, r.status, r.score, "ok", r.cd, r.cl, r.steps, r.seconds, r.reason, scale, r.averaging, r.cpu_seconds)
 
 
 def _worker(job) -> Row:
-    exercise_path, path, scale = job
-    return score_file(_exercise(exercise_path), path, scale)
+    exercise_path, path, scale, backend = job
+    return score_file(_exercise(exercise_path), path, scale, backend)
 
 
 def default_workers() -> int:
     return os.cpu_count() or 1
 
 
-def grade(exercise, paths, workers: int | None = None, scales=(1,), progress=None) -> tuple[list[Row], float]:
-    """Score every (file, scale) on `workers` processes (default: every core). Returns the rows
-    in the order of `paths` x `scales` and the wall seconds. `progress(done, total)` after each."""
+def grade(exercise, paths, workers: int | None = None, scales=(1,), progress=None,
+          backend: str = "numpy") -> tuple[list[Row], float]:
+    """Score every (file, scale) on `workers` processes (default: every core) with the solver
+    `backend` (float64; scoring.BACKENDS). Returns the rows in the order of `paths` x `scales`
+    and the wall seconds. `progress(done, total)` after each."""
     if exercise.path is None:
         raise ValueError("grading needs an exercise loaded from a file")
-    jobs = [(str(exercise.path), str(p), s) for p in paths for s in scales]
+    jobs = [(str(exercise.path), str(p), s, backend) for p in paths for s in scales]
     workers = max(1, min(workers or default_workers(), len(jobs)))
     start = time.perf_counter()
     rows: list[Row | None] = [None] * len(jobs)
@@ -152,11 +155,32 @@ def ranked(exercise, rows: list[Row]) -> list[Row]:
     return sorted(rows, key=key)
 
 
-def csv_rows(rows: list[Row]) -> list[list]:
-    """CSV cells; numbers with repr() digits (every digit, so reruns compare exactly)."""
+def ranks(exercise, rows: list[Row]) -> list[int | None]:
+    """Each row's rank (None when not scored), ties within the exercise's grid uncertainty
+    sharing one (app/exercises/uncertainty.py)."""
+    from feelflow.app.exercises.uncertainty import tied_ranks
+
+    scored = [r.score for r in rows if r.ok]
+    tied = iter(tied_ranks(scored, exercise.objective.better, exercise.objective.uncertainty))
+    return [next(tied) if r.ok else None for r in rows]
+
+
+def csv_rows(rows: list[Row], exercise=None) -> list[list]:
+    """CSV cells for ranked rows; numbers with repr() digits (every digit, so reruns compare
+    exactly; the printed table has the digits the grid uncertainty supports). With the
+    exercise, ranks are shared by ties (the `tied` column says "yes") and the exercise's grid
+    uncertainty is in every scored row."""
+    if exercise is not None:
+        rank = ranks(exercise, rows)
+        u = exercise.objective.uncertainty
+    else:
+        n = iter(range(1, len(rows) + 1))
+        rank = [next(n) if r.ok else None for r in rows]
+        u = None
     out = []
-    for rank, r in enumerate(rows, 1):
-        out.append([rank if r.ok else "", r.file, r.status, "" if r.score is None else repr(r.score), r.verdict,
-                    "" if r.cd is None else repr(r.cd), "" if r.cl is None else repr(r.cl), r.steps,
-                    f"{r.seconds:.2f}", r.reason])
+    for k, r in zip(rank, rows):
+        tied = "yes" if k is not None and rank.count(k) > 1 else ""
+        out.append([k if k is not None else "", r.file, r.status, "" if r.score is None else repr(r.score),
+                    r.verdict, "" if r.cd is None else repr(r.cd), "" if r.cl is None else repr(r.cl), r.steps,
+                    f"{r.seconds:.2f}", r.reason, tied, "" if u is None or not r.ok else repr(u)])
     return out

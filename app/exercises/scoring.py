@@ -28,6 +28,10 @@ import numpy as np
 from feelflow.app.model import readouts
 
 FORCE_MODEL = "momentum_exchange"
+#: solvers a score may be computed with, both float64: numpy (the reference, what the window
+#: and `feelflow exercise score` use) and the compiled cpu backend, which gives the same digits
+#: (tests/test_exercises.py) in less CPU time for `feelflow exercise check --backend cpu`
+BACKENDS = ("numpy", "cpu")
 SCORED, NOT_SETTLED, BROKEN = "scored", "not settled", "broken"
 
 
@@ -134,9 +138,9 @@ def objective_score(objective, cd: float, cl: float) -> tuple[float, bool | None
     return miss, miss <= objective.tolerance
 
 
-def score_shape(exercise, shape, scale: int = 1, progress=None, cancelled=None) -> Result:
+def score_shape(exercise, shape, scale: int = 1, progress=None, cancelled=None, backend: str = "numpy") -> Result:
     """Score `shape` (already checked against the constraints) at `scale` times the exercise's
-    resolution. `progress(done_fraction)` is called after every sample; `cancelled()` returning
+    resolution, on the float64 solver `backend` (BACKENDS). `progress(done_fraction)` is called after every sample; `cancelled()` returning
     True stops the run (raises Cancelled)."""
     from feelflow.app.exercises.constraints import posed
     from feelflow.solver.backend import SolverDiverged, create_solver
@@ -144,7 +148,9 @@ def score_shape(exercise, shape, scale: int = 1, progress=None, cancelled=None) 
     s = exercise.scene.scaled(scale)
     body = posed(exercise, shape, scale)
     start, cpu0 = time.perf_counter(), time.process_time()
-    solver = create_solver("numpy", s.flow_config())
+    if backend not in BACKENDS:
+        raise ValueError(f"backend: scores are computed on {' or '.join(BACKENDS)}, not {backend!r}")
+    solver = create_solver(backend, s.flow_config())
     cd, cl = [], []
     try:
         solver.enable_force_models([FORCE_MODEL])

@@ -18,6 +18,7 @@ from PySide6.QtWidgets import QDockWidget, QFileDialog, QMessageBox
 from feelflow import EXERCISE_DIR
 from feelflow.app.errors import UserError
 from feelflow.app.exercises import scoring
+from feelflow.app.exercises.uncertainty import better_by, fmt, tied
 from feelflow.app.gui.exercise_panel import PARAMETERS, PANEL_WIDTH, ExercisePanel, ScrollingPanel
 from feelflow.app.model import readouts
 from feelflow.app.model.readouts import EXERCISE_LENGTH, ReferenceLength
@@ -240,7 +241,8 @@ class ExerciseController(QObject):
         if self.attempts is None:
             self.panel.set_attempts([], None, "nowhere: the attempts file is unreadable")
         else:
-            self.panel.set_attempts(self.attempts.items, self.attempts.best(), str(self.attempts.path))
+            self.panel.set_attempts(self.attempts.items, self.attempts.best(), str(self.attempts.path),
+                                    self.exercise.objective.uncertainty)
 
     def close(self, _=False):
         if self.worker is not None:
@@ -371,17 +373,22 @@ class ExerciseController(QObject):
         ex = self.exercise
         if result.ok:
             o = ex.objective
+            u = o.uncertainty
             s = ex.scene
-            lines = [f"<b>Score {result.score:.4f}</b> ({o.quantity}; C_D {result.cd:.4f}, C_L {result.cl:.4f} "
+            lines = [f"<b>Score {fmt(result.score, u, with_uncertainty=True)}</b> ({o.quantity}; "
+                     f"C_D {fmt(result.cd, u)}, C_L {fmt(result.cl, u)} "
                      f"with L = {s.reference_length:g} cells ({EXERCISE_LENGTH}), U = {s.inflow_speed:.3f}; "
                      f"{result.steps} steps, {result.seconds:.1f} s)"]
             if result.hit is not None:
                 lines.append("A hit: within the tolerance." if result.hit else "Not a hit yet: outside the tolerance.")
             for ref in ex.references:
-                better = result.score < ref.score if o.better == "lower" else result.score > ref.score
-                same = round(result.score, 4) == round(ref.score, 4)
-                word = "the same as" if same else ("better than" if better else "behind")
-                lines.append(f"{word} the reference \u201c{ref.label}\u201d ({ref.score:.4f})")
+                if u is not None and tied(result.score, ref.score, u):
+                    word = "tied (within the grid uncertainty) with"
+                elif u is None and round(result.score, 4) == round(ref.score, 4):
+                    word = "the same as"
+                else:
+                    word = "better than" if better_by(result.score, ref.score, o.better, None) else "behind"
+                lines.append(f"{word} the reference \u201c{ref.label}\u201d ({fmt(ref.score, u)})")
             lines.append(f"<small>{result.averaging}</small>")
             self.panel.result.setText("<br>".join(lines))
         else:

@@ -13,6 +13,7 @@ from PySide6.QtWidgets import (QComboBox, QDoubleSpinBox, QFormLayout, QGroupBox
                                QListWidgetItem, QProgressBar, QPushButton, QScrollArea, QTextBrowser,
                                QVBoxLayout, QWidget)
 
+from feelflow.app.exercises.uncertainty import fmt, tied
 from feelflow.app.model import readouts
 
 #: parametric kinds: parameter -> (label, minimum, maximum, step); angles in degrees
@@ -27,6 +28,8 @@ PARAMETERS = {
 THUMB = QSize(72, 44)
 #: the panel's width in the window (logical pixels): the goal, references and attempts lines wrap to it
 PANEL_WIDTH = 340
+#: the narrowest it gets (the window keeps 1280 pixels with the forces' toolbar below the flow)
+PANEL_MIN_WIDTH = 290
 BAD = "#d03030"
 GOOD = "#208040"
 
@@ -83,7 +86,7 @@ class ScrollingPanel(QScrollArea):
         self.setWidget(panel)
         self.setWidgetResizable(True)
         self.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
-        self.setMinimumWidth(PANEL_WIDTH)
+        self.setMinimumWidth(PANEL_MIN_WIDTH)
 
 
 class ExercisePanel(QWidget):
@@ -203,8 +206,11 @@ class ExercisePanel(QWidget):
         goal = f"Goal: {o.kind.replace('_', ' ')}; score = {o.quantity}, {o.better} is better"
         if o.target is not None:
             goal += f" (a hit is within {o.tolerance:g} of {o.target:g})"
+        u = o.uncertainty
+        if u is not None:
+            goal += f". Scores are good to \u00b1{u:g} (the grid uncertainty); closer than that is a tie"
         self.goal.setText(goal + ".")
-        refs = "; ".join(f"{r.label}: {r.score:.4f}" for r in exercise.references)
+        refs = "; ".join(f"{r.label}: {fmt(r.score, u)}" for r in exercise.references)
         self.references.setText(f"Reference solution{'s' if len(exercise.references) > 1 else ''}: {refs}.")
         self.edit.setVisible("polygon" in exercise.kinds)
         parametric = [k for k in exercise.kinds if k in PARAMETERS]
@@ -284,16 +290,18 @@ class ExercisePanel(QWidget):
     def set_progress(self, fraction: float):
         self.progress.setValue(int(round(1000 * fraction)))
 
-    def set_attempts(self, attempts, best, where: str):
+    def set_attempts(self, attempts, best, where: str, uncertainty: float | None = None):
         self.attempts_label.setText(f"Attempts, the best framed in gold; saved in {breakable_path(where)}")
         self.attempts_label.setToolTip(where)
         self.attempts.clear()
         for a in attempts:
             shape = a.load_shape()
-            text = (f"#{a.number}  {a.score:.4f}" if a.score is not None else f"#{a.number}  {a.status}")
+            text = (f"#{a.number}  {fmt(a.score, uncertainty)}" if a.score is not None else f"#{a.number}  {a.status}")
             text += f"   {a.time.replace('T', ' ')[:19]}, {a.seconds:.1f} s"
             if best is not None and a.number == best.number:
                 text += "   \u2605 best"
+            elif best is not None and a.score is not None and tied(a.score, best.score, uncertainty):
+                text += "   = ties the best"
             item = QListWidgetItem(thumbnail(shape.outline(), best is not None and a.number == best.number), text)
             item.setToolTip(a.reason or f"C_D {a.cd:.4f}, C_L {a.cl:.4f}" if a.cd is not None else a.reason)
             self.attempts.addItem(item)

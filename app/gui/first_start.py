@@ -120,7 +120,7 @@ def run_on_cpu(window, detail: str) -> None:
     box.setObjectName("no-gl-dialog")
     window.no_gl_dialog = box
     QTimer.singleShot(0, box.open)   # window-modal, not blocking: the tunnel starts behind it
-    window._on_context(None)
+    window.on_context(None)
 
 
 # --- the lessons first ----------------------------------------------------------------------------

@@ -13,8 +13,10 @@ from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (QCheckBox, QComboBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget)
 
 from feelflow.app.files import atomic_path, write_text_atomic
+from feelflow.app.gui.polar_views import VIEWS as LIFT_VIEWS, LiftViews
 from feelflow.app.model.power_law import fit_power_law
 from feelflow.app.model import readouts
+from feelflow.app.model.display_units import DisplayUnits, si_columns
 from feelflow.app.model.readouts import start_pulse_steps
 from feelflow.app.model.force_history import History
 from feelflow.app.model.simulation import FORCE_MODELS
@@ -30,12 +32,16 @@ class ForcePlot(QWidget):
 
     def __init__(self, parent=None):
         super().__init__(parent)
+        self.probes = None   # app.model.probes.Probes, set by the window: their columns join the CSV
+        self.units = DisplayUnits()   # lattice or SI (app/model/display_units.py), set by the window
         self.sim: TunnelModel | None = None   # what the plot shows (the window sets it)
         self.paused = False
         self._frozen = None
         self.view = QComboBox()
         self.view.addItem("Drag and lift against time", "time")
         self.view.addItem("Drag against relative speed (log-log)", "speed")
+        for key, (label, _, _) in LIFT_VIEWS.items():
+            self.view.addItem(label, key)
         self.pause_box = QCheckBox("Pause plot")
         self.clear_button = QPushButton("Clear")
         self.csv_button = QPushButton("Export CSV\u2026")
@@ -51,6 +57,7 @@ class ForcePlot(QWidget):
         small = self.reference_label.font()
         small.setPointSizeF(small.pointSizeF() * 0.85)
         self.reference_label.setFont(small)
+        self.reference_label.setWordWrap(True)   # a long reference ("the exercise's ...") wraps, the window keeps its width
         self.reference_label.setToolTip("C = 2 F / (\u03c1 U\u00b2 L): U the relative wind's speed, "
                                         "L the reference length")
         bar = QHBoxLayout()
@@ -70,8 +77,8 @@ class ForcePlot(QWidget):
         self.plot = pg.PlotWidget()
         self.plot.showGrid(x=False, y=True, alpha=0.3)   # the grid is redrawn with the axes: keep it light
         self.legend = self.plot.addLegend(offset=(10, 5))
-        self.plot.getAxis("bottom").setLabel("time (solver steps)")
-        self.plot.getAxis("left").setLabel("force (lattice units)")
+        self.plot.getAxis("bottom").setLabel(self.axis_labels()[0])
+        self.plot.getAxis("left").setLabel(self.axis_labels()[1])
         for ax in ("bottom", "left"):
             self.plot.getAxis(ax).enableAutoSIPrefix(False)
             f = self.plot.getAxis(ax).label.font()
@@ -80,6 +87,7 @@ class ForcePlot(QWidget):
         self.follow_range = True   # the plot sets its ranges until the user zooms or pans
         self.plot.getViewBox().sigRangeChangedManually.connect(self._user_moved_range)
         self.curves = {}
+        self.lift_views = LiftViews(self.plot)
         self.scatter = self.fit_line = None
         self.fitted_exponent = None
         layout = QVBoxLayout(self)
@@ -117,8 +125,13 @@ class ForcePlot(QWidget):
         self.plot.enableAutoRange()
         self.plot.clear()
         self.curves.clear()
+        self.lift_views.reset()
+        self.plot.getPlotItem().invertY(False)
         self._reset_legend(1)
-        speed_view = self.view.currentData() == "speed"
+        view = self.view.currentData()
+        if self.sim is not None and hasattr(self.sim, "watch_surface_pressure"):
+            self.sim.watch_surface_pressure(view == "cp")   # the wall sampling runs only while C_p is shown
+        speed_view = view == "speed"
         self.plot.setLogMode(speed_view, speed_view)
         if speed_view:   # PlotDataItems: the log mode transforms them (bare scatter items it does not)
             self.scatter = self.plot.plot([], [], pen=None, symbol="o", symbolSize=10,
@@ -127,12 +140,32 @@ class ForcePlot(QWidget):
             self.fit_line = self.plot.plot([], [], pen=pg.mkPen((40, 40, 40), width=2, style=Qt.DashLine),
                                            name="fit")
             self._set_speed_ranges(np.array([]), np.array([]))
-            self.plot.getAxis("bottom").setLabel("relative speed |U - V| (lattice units)")
-            self.plot.getAxis("left").setLabel("drag (lattice units)")
-        else:
-            self.plot.getAxis("bottom").setLabel("time (solver steps)")
-            self.plot.getAxis("left").setLabel("force (lattice units)")
+        x, y = self.axis_labels()
+        self.plot.getAxis("bottom").setLabel(x)
+        self.plot.getAxis("left").setLabel(y)
         self.refresh(force=True)
+
+    def axis_labels(self) -> tuple[str, str]:
+        """The (bottom, left) axis labels of the view shown, in the units shown."""
+        u = self.units
+        view = self.view.currentData()
+        if view == "speed":
+            return f"relative speed |U - V| ({u.speed_unit})", f"drag ({u.force_unit})"
+        if view in LIFT_VIEWS:   # C_p and the polar: dimensionless (app/gui/polar_views.py)
+            _, xlabel, ylabel = LIFT_VIEWS[view]
+            return xlabel, ylabel
+        return f"time ({u.time_unit})", f"force ({u.force_unit})"
+
+    def set_units(self, units):
+        """Show numbers in `units` (app.model.display_units.DisplayUnits) from now on."""
+        changed = (units.is_si, units.describe()) != (self.units.is_si, self.units.describe())
+        self.units = units
+        if changed:
+            x, y = self.axis_labels()
+            self.plot.getAxis("bottom").setLabel(x)
+            self.plot.getAxis("left").setLabel(y)
+            self.follow_range = True
+            self.refresh(force=True)
 
     def _reset_legend(self, columns: int):
         """The plot keeps one legend across clear(): empty it and set its layout."""
@@ -149,10 +182,29 @@ class ForcePlot(QWidget):
         if self.sim is None or (self.paused and not force):
             return
         self._update_readout()
-        if self.view.currentData() == "speed":
+        view = self.view.currentData()
+        if view == "speed":
             self._draw_speed_view()
+        elif view == "polar":
+            self.lift_views.draw_polar(self.sim)
+        elif view == "drag_polar":
+            self.lift_views.draw_drag_polar(self.sim)
+        elif view == "cp":
+            self.lift_views.draw_cp(self.surface_pressure())
         else:
             self._draw_time_view()
+
+    def surface_pressure(self):
+        """C_p along the surface now (app/model/live_polar.py): the polar's angle being held, else
+        the C_p view's own sampling; None where there is none (a replay, nothing sampled yet)."""
+        sim = self.sim
+        polar = getattr(sim, "polar", None)
+        if polar is not None and not polar.done:
+            return polar.live_cp(sim)
+        if polar is not None and polar.cp:
+            return polar.cp[-1][1]
+        watch = getattr(sim, "surface_watch", None)
+        return watch.take(sim) if watch is not None else None
 
     def readout(self, model=None) -> readouts.Readout:
         """The mean drag, lift and coefficients of the last samples, with the reference they use
@@ -189,11 +241,13 @@ class ForcePlot(QWidget):
             t, drag, lift = sim.history.drag_lift(model)
             first = int(np.argmax(np.isfinite(drag))) if np.isfinite(drag).any() else len(t)
             t, drag, lift = t[first:], drag[first:], lift[first:]   # from when the model was switched on
+            settled = t >= start_pulse_steps(sim.params.size)
+            u = self.units
+            t, drag, lift = u.time(t), u.force(drag), u.force(lift)
             cd, cl = MODEL_COLOURS.get(model, ((0, 0, 0), (90, 90, 90)))
             self._curve((model, "drag"), pg.mkPen(cd, width=2.5), self._name((model, "drag"))).setData(t, drag, connect="finite")
             self._curve((model, "lift"), pg.mkPen(cl, width=2.5, style=Qt.DashLine if len(shown) > 1 else Qt.SolidLine),
                         self._name((model, "lift"))).setData(t, lift, connect="finite")
-            settled = t >= start_pulse_steps(sim.params.size)
             values.append(np.r_[drag[settled], lift[settled]])
         self._set_force_range(np.concatenate(values) if values else np.array([]))
 
@@ -228,6 +282,8 @@ class ForcePlot(QWidget):
 
     def _draw_speed_view(self):
         us, fs, n = fit_power_law(*self.speed_drag())
+        u = self.units
+        us, fs = np.asarray(u.speed(np.asarray(us, float))), np.asarray(u.force(np.asarray(fs, float)))
         self.scatter.setData(us, fs)
         if n is not None:
             c = np.mean(np.log(fs) - n * np.log(us))
@@ -239,6 +295,7 @@ class ForcePlot(QWidget):
             self._set_fit_text("fit: needs speeds 1.5\u00d7 apart" if len(us) else
                                f"fit: hold a speed {History.SETTLE_STEPS} steps")
         self.fitted_exponent = n
+        self.lift_views.draw_published_drag(self.sim, us)
         self._set_speed_ranges(us, fs)
 
     def fit_text(self) -> str:
@@ -268,9 +325,26 @@ class ForcePlot(QWidget):
 
     # --- export ---------------------------------------------------------------------------
     def csv_text(self) -> str:
-        """The forces CSV (app/model/readouts.py `forces_csv`)."""
+        """The forces CSV (app/model/readouts.py `forces_csv`), with the probes' columns
+        (app/model/probes.py) joined on the step when there are probes."""
         sim = self.sim
-        return readouts.forces_csv(sim.history, FORCE_MODELS, sim.reference_length())
+        text = readouts.forces_csv(sim.history, FORCE_MODELS, sim.reference_length())
+        probes = self.probes if self.probes is not None and len(self.probes) else None
+        if probes is None and not self.units.is_si:
+            return text
+        import csv
+        import io
+
+        rows = list(csv.reader(io.StringIO(text)))
+        out = io.StringIO()
+        w = csv.writer(out)
+        head = rows[0] + (probes.columns() if probes else [])
+        body = [row + (probes.values_at(int(float(row[0]))) if probes else []) for row in rows[1:]]
+        if self.units.is_si:   # SI columns beside the lattice ones (app/model/display_units.py)
+            head, body = si_columns(head, body, self.units)
+        w.writerow(head)
+        w.writerows(body)
+        return out.getvalue()
 
     def export_csv(self, path):
         write_text_atomic(path, self.csv_text())

@@ -11,6 +11,9 @@ app/gui/window/, one module per concept, each an object holding the window (`sel
     window.flow     flow.py        FlowController: wind, viscosity, walls, grid, models, reset
     window.exports  exports.py     ExportController: CSV, plot PNG, screenshot, shape files
     window.lessons  lessons.py     LessonController: the Presets menu's lessons
+    window.video    video.py       VideoController: a session rendered to MP4/GIF, the window recorded
+    window.probes   probes.py      ProbeController: probes placed in the view, their plot beside the forces
+    window.units    units.py       UnitsController: View > Units, lattice or SI for a chosen fluid
     window.backends backend_controller.py  BackendController: which solver backend runs, its menu
     window.exercises  app/gui/exercise_controller.py  ExerciseController: the Exercises menu and panel
 
@@ -47,9 +50,13 @@ from feelflow.app.gui.window.flow import FlowController  # noqa: E402
 from feelflow.app.gui.window.frame_loop import FrameLoop  # noqa: E402
 from feelflow.app.gui.window.input_controller import InputController  # noqa: E402
 from feelflow.app.gui.window.lessons import LessonController  # noqa: E402
+from feelflow.app.gui.window.events import WindowEvents  # noqa: E402
 from feelflow.app.gui.window.menus import build_menus  # noqa: E402
 from feelflow.app.gui.window.replay_controller import ReplayController  # noqa: E402
 from feelflow.app.gui.window.settings import WindowSettings  # noqa: E402
+from feelflow.app.gui.window.probes import ProbeController  # noqa: E402
+from feelflow.app.gui.window.units import UnitsController  # noqa: E402
+from feelflow.app.gui.window.video import VideoController  # noqa: E402
 from feelflow.app.model.simulation import Params, Simulation  # noqa: E402
 from feelflow.app.model.tunnel import TunnelModel  # noqa: E402
 from feelflow.shapes.base import ShapeError  # noqa: E402
@@ -83,7 +90,8 @@ class MainWindow(QMainWindow):
         for label in self.status.values():
             self.statusBar().addPermanentWidget(label)
 
-        # controllers
+        # controllers, and the events they tell each other (window/events.py)
+        self.events = WindowEvents(self)
         self.loop = FrameLoop(self)
         self.replays = ReplayController(self)
         self.inputs = InputController(self)
@@ -91,6 +99,10 @@ class MainWindow(QMainWindow):
         self.flow = FlowController(self)
         self.exports = ExportController(self)
         self.lessons = LessonController(self)
+        self.video = VideoController(self)
+        self.probes = ProbeController(self)
+        self.plot.probes = self.probes.probes   # the forces CSV carries the probes' columns
+        self.units = UnitsController(self)
         self.backends = BackendController(self, backend)   # "auto": measured once the context exists
         self.exercises = ExerciseController(self)   # the Exercises menu and panel
         self.actions = build_menus(self)
@@ -127,7 +139,7 @@ class MainWindow(QMainWindow):
         p.displayModeChanged.connect(self.loop.set_display_mode)
         p.arrowsToggled.connect(lambda on: setattr(self.viewport, "show_arrows", on))
         p.inputChanged.connect(self.inputs.set_input)
-        vp.contextReady.connect(self._on_context)
+        vp.contextReady.connect(self.on_context)
         first_start.watch_gl(self)   # no OpenGL 3.3: a dialog, then the numpy solver on the CPU
         vp.bodyPulled.connect(self.inputs.mouse_pulled)
         vp.polygonEdited.connect(self.bodies.edit_polygon)
@@ -136,6 +148,7 @@ class MainWindow(QMainWindow):
         vp.turnFinished.connect(self.bodies.turn_done)
         vp.wheelTurned.connect(self.bodies.turn_by_wheel)
         vp.turnRefused.connect(self.bodies.turn_refused)
+        vp.probeClicked.connect(self.probes.clicked)
 
     # --- what the window shows ----------------------------------------------------------------
     @property
@@ -160,7 +173,7 @@ class MainWindow(QMainWindow):
         QTimer.singleShot(0, lambda: (QMessageBox.critical(self, "FeelFlow cannot start", message + hint),
                                       self.close()))
 
-    def _on_context(self, ctx):
+    def on_context(self, ctx):
         from feelflow.solver.backend import BackendError
 
         self.backend = self.backends.resolve(ctx)
@@ -184,17 +197,16 @@ class MainWindow(QMainWindow):
             self.bodies.install_default_polygon()
 
     def _simulation_started(self):
-        self.viewport.sim = self.sim
-        self.plot.sim = self.sim
         self.viewport.mode = self.loop.display_mode
+        self.events.shownChanged.emit(self.sim)   # the viewport and the plot show it, its field drawn
         self.panel.show_params(self.sim.params, self.loop.display_mode)
         self.status["renderer"].setText(self.backends.status_text(self.viewport.renderer().split(' (')[0], self.backend))
         self.status["renderer"].setToolTip(f"{self.viewport.renderer()}; {self.backends.description}")
-        self.loop.upload_field()
         self.inputs.refresh_devices()
         self.flow.say_guard()
         self.loop.start()
         self.loop.refresh_readouts()
+        self.units.start()
         if not self.statusBar().currentMessage():   # a note about ignored settings comes first
             self.statusBar().showMessage(MOUSE_HINT, 20000)
         self.simulationReady.emit()
@@ -215,6 +227,7 @@ class MainWindow(QMainWindow):
         self.store.save(self)
         self.loop.stop()
         self.exercises.shutdown()
+        self.video.close()
         self.replays.close()
         self.inputs.close_device()
         super().closeEvent(ev)

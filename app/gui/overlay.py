@@ -47,8 +47,24 @@ class Overlay:
         self._paint_turn_handle(p)
         if v.show_arrows and v.arrow_forces and v.sim.shape is not None:
             self._paint_arrows(p)
+        if v.probe_marks:
+            self._paint_probes(p)
         self._paint_colour_bar(p)
         self._paint_notes(p)
+
+    def _paint_probes(self, p: QPainter):
+        """Each probe: a ring with a cross in its plot colour, and its number."""
+        v = self.view
+        for x, y, colour, label in v.probe_marks:
+            c = v.to_widget(x, y)
+            p.setPen(QPen(QColor(0, 0, 0, 160), 4))
+            p.drawEllipse(c, 6, 6)
+            p.setPen(QPen(colour, 2))
+            p.setBrush(Qt.NoBrush)
+            p.drawEllipse(c, 6, 6)
+            p.drawLine(c.x() - 9, c.y(), c.x() + 9, c.y())
+            p.drawLine(c.x(), c.y() - 9, c.x(), c.y() + 9)
+            p.drawText(c.x() + 8, c.y() - 8, label)
 
     def _paint_body(self, p: QPainter):
         v = self.view
@@ -67,7 +83,7 @@ class Overlay:
         p.setBrush(QBrush(BODY_FILL))
         p.drawPolygon(v.body_outline_points())
         if v.editing and sim.polygon is not None:
-            verts = v._edit_preview if v._edit_preview is not None else sim.polygon
+            verts = v.edit_preview if v.edit_preview is not None else sim.polygon
             world = v.body_to_world(verts)
             p.setPen(QPen(QColor(255, 200, 0), 1.5, Qt.DashLine))
             p.setBrush(Qt.NoBrush)
@@ -217,11 +233,11 @@ class Overlay:
         if not v.handle_shown():
             return
         centre, knob, reach = v.handle_geometry()
-        turn = v._turn
+        turn = v.turn
         if turn is not None and abs(math.radians(turn.target) - v.sim.angle) > 1e-3:
             target = turn_handle.knob_position(centre, reach, math.radians(turn.target))
             turn_handle.paint_turn_target(p, centre, target)
-        state = "refused" if v.turn_blocker() else "active" if turn is not None or v._hover == "handle" else "idle"
+        state = "refused" if v.turn_blocker() else "active" if turn is not None or v.hover == "handle" else "idle"
         turn_handle.paint_handle(p, centre, knob, state)
         if turn is not None:
             shown = (turn.target + 180.0) % 360.0 - 180.0

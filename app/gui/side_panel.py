@@ -11,6 +11,7 @@ from PySide6.QtWidgets import (QCheckBox, QComboBox, QDoubleSpinBox, QFormLayout
                                QPushButton, QScrollArea, QVBoxLayout, QWidget)
 
 from feelflow.app.model.bodies import SHAPE_LABELS
+from feelflow.app.model.display_units import DisplayUnits
 from feelflow.app.model.simulation import FORCE_MODELS, GRID_PRESETS, WALLS
 from feelflow.app.gui.display_modes import DISPLAY_MODES
 
@@ -84,6 +85,7 @@ class SidePanel(QScrollArea):
 
     def __init__(self, parent=None):
         super().__init__(parent)
+        self.units = DisplayUnits()   # lattice or SI (View > Units; app/model/display_units.py)
         inner = QWidget()
         col = QVBoxLayout(inner)
         col.setSpacing(6)
@@ -135,6 +137,11 @@ class SidePanel(QScrollArea):
         flow.addRow("Viscosity", self.viscosity)
         flow.addRow("Reynolds number", self.reynolds)
         flow.addRow("Mach number", self.mach)
+        self.physical = QLabel()   # the SI reading of the flow (View > Units), hidden in lattice units
+        self.physical.setWordWrap(True)
+        self.physical.setObjectName("physical_flow")
+        self.physical.hide()
+        flow.addRow(self.physical)
         flow.addRow("Grid", self.grid)
         flow.addRow("Walls", self.wall)
         col.addWidget(self._group("Flow", flow))
@@ -231,9 +238,25 @@ class SidePanel(QScrollArea):
             self.drag.setText("\u2013")
             self.lift.setText("\u2013")
             return
-        d, l_ = force_pair_text(drag, lift)
-        self.drag.setText(f"{d} (lattice units)")
-        self.lift.setText(f"{l_} (lattice units)")
+        u = self.units
+        if u.is_si:   # newtons: four significant digits (forces of micronewtons in water)
+            d, l_ = f"{u.force(drag):.4g}", f"{u.force(lift):.4g}"
+        else:
+            d, l_ = force_pair_text(drag, lift)
+        self.drag.setText(f"{d} ({'N' if u.is_si else 'lattice units'})")
+        self.lift.setText(f"{l_} ({'N' if u.is_si else 'lattice units'})")
+
+    def show_units(self, units):
+        """Numbers from now on in `units` (app.model.display_units.DisplayUnits); in SI the flow's
+        physical reading under the Reynolds number."""
+        self.units = units
+        if units.is_si:
+            ph = units.physical
+            self.physical.setText(f"<i>Simulates {ph.describe()}: wind {ph.wind_m_s:.3g} m/s, "
+                                  f"ν {ph.fluid.viscosity:.3g} m²/s, ρ {ph.fluid.density:g} kg/m³; "
+                                  f"a step is {ph.dt:.3g} s, a cell {ph.dx:.3g} m. The wind and viscosity fields "
+                                  f"above are the solver's (lattice units).</i>")
+        self.physical.setVisible(units.is_si)
 
     def show_numbers(self, reynolds: float, mach: float, mach_limit: float):
         self.reynolds.setText(f"Re = {reynolds:.0f}")

@@ -63,6 +63,7 @@ class Viewport(QWidget):
     turnFinished = Signal(float, float)   # one drag of the handle: angle before and after (degrees)
     wheelTurned = Signal(float)     # the wheel asks to turn the body by this many degrees
     turnRefused = Signal(str)       # the handle was pressed while this (a device, a script) drives the body
+    probeClicked = Signal(float, float, bool)   # while `probing`: a click at (x, y) cells; True = right button
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -72,6 +73,8 @@ class Viewport(QWidget):
         self.show_arrows = True
         self.editing = False
         self.body_edge = None    # a QColor for the body's outline instead of the usual, or None
+        self.probing = False     # clicks place (left) and remove (right) probes instead of moving the body
+        self.probe_marks = []    # [(x, y, QColor, label)] probes to draw (app/gui/window/probes.py)
         self.arrow_forces = None       # {"drag": (x, y), "lift": (x, y)} cells (app/model/readouts.py arrows)
         self.tracers = None
         self.frames = 0
@@ -125,6 +128,21 @@ class Viewport(QWidget):
             self.contextFailed.emit(f"OpenGL 3.3 is not available here ({str(exc).splitlines()[0]})")
             return
         self._init_programs()
+
+    @property
+    def edit_preview(self):
+        """The polygon's vertices (body frame) while the editor drags one, else None."""
+        return self._edit_preview
+
+    @property
+    def turn(self):
+        """The handle's drag in progress (turn_handle.Turn), or None."""
+        return self._turn
+
+    @property
+    def hover(self):
+        """What the pointer is over: "handle", "body" or "near", or None."""
+        return self._hover
 
     def makeCurrent(self):
         """The viewport's GL context current (the gl solver draws with it too)."""
@@ -408,6 +426,9 @@ class Viewport(QWidget):
             return
         pos = ev.position()
         x, y = self.to_lattice(pos)
+        if self.probing and ev.button() in (Qt.LeftButton, Qt.RightButton):
+            self.probeClicked.emit(x, y, ev.button() == Qt.RightButton)
+            return
         if self.editing and self.sim.polygon is not None:
             i = self._vertex_at(pos)
             if i is not None and ev.button() == Qt.RightButton:

@@ -87,8 +87,10 @@ class PolarSweep:
         self.index = 0
         self._cl: list[float] = []
         self._cd: list[float] = []
+        self._steps: list[int] = []
         passing = self.chord / self.speed     # steps for the flow to pass one chord
         self.window = max(4, int(round(self.window_chords * passing / self.sample_steps)))
+        self.window_steps = self.window * self.sample_steps
         self.min_steps = int(self.min_chords * passing)
         self.max_steps = max(self.min_steps, int(self.max_chords * passing))
 
@@ -103,7 +105,7 @@ class PolarSweep:
 
     @property
     def steps_at_angle(self) -> int:
-        return len(self._cl) * self.sample_steps
+        return int(sum(self._steps))
 
     def coefficients(self, fx: float, fy: float) -> tuple[float, float]:
         """(C_D, C_L) on the chord."""
@@ -113,33 +115,58 @@ class PolarSweep:
         """The current angle's (C_L, C_D) samples so far (for a live plot)."""
         return np.array(self._cl), np.array(self._cd)
 
-    def drift(self) -> float | None:
-        """max |change of the window mean| of C_L and C_D, or None before two windows."""
-        w = self.window
-        if len(self._cl) < 2 * w:
+    def _window(self, end: int):
+        """(first index, step-weighted C_L and C_D means, C_L std) of the samples before `end`
+        that make up one window (`window_steps` steps), or None if there are not enough."""
+        total, first = 0, end
+        while first > 0 and total < self.window_steps:
+            first -= 1
+            total += self._steps[first]
+        if total < self.window_steps:
             return None
-        cl, cd = np.array(self._cl[-2 * w:]), np.array(self._cd[-2 * w:])
-        return float(max(abs(cl[w:].mean() - cl[:w].mean()), abs(cd[w:].mean() - cd[:w].mean())))
+        w = np.array(self._steps[first:end], dtype=np.float64)
+        cl, cd = np.array(self._cl[first:end]), np.array(self._cd[first:end])
+        mean_cl = float(np.average(cl, weights=w))
+        std = float(np.sqrt(np.average((cl - mean_cl) ** 2, weights=w)))
+        return first, mean_cl, float(np.average(cd, weights=w)), std
 
-    def add_sample(self, fx: float, fy: float) -> bool:
-        """Record one sample (force averaged over `sample_steps` steps); True when the angle is done."""
+    def drift(self) -> float | None:
+        """max |change of the window mean| of C_L and C_D between the last window and the one
+        before it, or None before two windows."""
+        last = self._window(len(self._cl))
+        if last is None:
+            return None
+        before = self._window(last[0])
+        if before is None:
+            return None
+        return float(max(abs(last[1] - before[1]), abs(last[2] - before[2])))
+
+    def add_sample(self, fx: float, fy: float, steps: int | None = None) -> bool:
+        """Record one sample: the force averaged over `steps` steps (default `sample_steps`);
+        True when the angle is done."""
         if self.done:
             raise ValueError("the polar is complete")
         cd, cl = self.coefficients(fx, fy)
         self._cl.append(cl)
         self._cd.append(cd)
+        self._steps.append(int(steps or self.sample_steps))
         steps = self.steps_at_angle
         drift = self.drift()
         settled = steps >= self.min_steps and drift is not None and drift < self.tolerance
         if not (settled or steps >= self.max_steps):
             return False
-        w = min(self.window, len(self._cl))
-        cl_w, cd_w = np.array(self._cl[-w:]), np.array(self._cd[-w:])
-        self.points.append(PolarPoint(self.angle, float(cl_w.mean()), float(cd_w.mean()), float(cl_w.std()),
-                                      steps, bool(settled)))
-        self._cl, self._cd = [], []
+        last = self._window(len(self._cl)) or (0, *self._whole())
+        self.points.append(PolarPoint(self.angle, last[1], last[2], last[3], steps, bool(settled)))
+        self._cl, self._cd, self._steps = [], [], []
         self.index += 1
         return True
+
+    def _whole(self):
+        """(C_L mean, C_D mean, C_L std) of every sample at this angle (fewer than a window)."""
+        w = np.array(self._steps, dtype=np.float64)
+        cl = np.array(self._cl)
+        mean = float(np.average(cl, weights=w))
+        return mean, float(np.average(self._cd, weights=w)), float(np.sqrt(np.average((cl - mean) ** 2, weights=w)))
 
     # --- what the sweep measured -----------------------------------------------------------------
     def rows(self) -> list[list[str]]:

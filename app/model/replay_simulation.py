@@ -17,6 +17,7 @@ from feelflow.app.sessions import SessionPlayer
 from feelflow.app.model.force_history import History
 from feelflow.app.model.simulation import FORCE_MODELS, Params, shape_hit
 from feelflow.solver import units
+from feelflow.solver.force_average import StepWeightedMean
 
 
 class ReplaySimulation:
@@ -149,6 +150,9 @@ class ReplaySimulation:
         c = self.config.collision
         return f"{NAMES.get(c, c)}: as recorded"
 
+    def field_texture(self, vorticity: bool = True):
+        return self.solver.field_texture(vorticity=vorticity)
+
     def field_rgba(self):
         return self.solver.field_rgba()
 
@@ -168,16 +172,13 @@ class ReplaySimulation:
         first = len(self.player.rows)
         self.last_steps = self.player.advance(max(1, int(n)), split_rows=self.split_rows)
         rows = self.player.rows[first:]
-        acc: dict = {}
+        mean = StepWeightedMean()
         for row in rows:
             vx, vy = (0.0, 0.0) if math.isnan(row.body[2]) else row.body[2:4]
             self.history.add(row.step, (vx, vy), (row.inflow_speed - vx, -vy), row.forces)
-            for name, (fx, fy) in row.forces.items():
-                ax, ay = acc.get(name, (0.0, 0.0))
-                acc[name] = (ax + fx * row.n, ay + fy * row.n)
+            mean.add(row.forces, row.n)
         if rows:
-            steps = sum(r.n for r in rows)
-            self._last_forces = {k: (v[0] / steps, v[1] / steps) for k, v in acc.items()}
+            self._last_forces = mean.mean()
         return self._last_forces
 
     def close(self) -> None:

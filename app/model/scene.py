@@ -15,6 +15,7 @@ from feelflow.app.inputs import MAX_STEPS, check_work
 from feelflow.solver.motion import MOVES, MotionScript, Phase, phase_velocity
 from feelflow.solver import units
 from feelflow.solver.backend import BACKENDS
+from feelflow.solver.backend import NUMPY_ONLY_COLLISIONS
 from feelflow.solver.config import COLLISIONS, DTYPES, EQUILIBRIA, PROFILES, X_BOUNDARIES, Y_BOUNDARIES, ConfigError, FlowConfig
 from feelflow.solver.forces import MODELS
 
@@ -181,7 +182,8 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
     grid.done()
 
     flow = top.table("flow")
-    named_operator = flow.choice("collision", COLLISIONS, None)   # None: solver/operator_choice.py picks
+    # None: solver/operator_choice.py picks; the numpy-only operators (KBC) are not for scenes
+    named_operator = flow.choice("collision", tuple(c for c in COLLISIONS if c not in NUMPY_ONLY_COLLISIONS), None)
     smagorinsky = flow.number("smagorinsky", 0.0, nonnegative=True)
     trt_magic = flow.number("trt_magic", 3.0 / 16.0, positive=True)
     equilibrium = flow.choice("equilibrium", EQUILIBRIA, "compressible")
@@ -225,7 +227,7 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
     phases = _phases(reader, motion_list, inflow_speed)
     script = MotionScript(phases)
     length = float(body.frontal_area(STREAM_DIRECTION))
-    speed = inflow_speed if inflow_speed > 0 else max((math.hypot(*p.velocity) for p in phases), default=0.0)
+    speed = inflow_speed if inflow_speed > 0 else max((p.peak_speed for p in phases), default=0.0)
     if re_number is not None:
         if speed <= 0:
             reader.fail("flow.reynolds", "needs a reference speed (flow.inflow_speed > 0 or a moving "
@@ -281,8 +283,8 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
 
     check_work(nx, ny, steps, source, "run.steps")
     for i, phase in enumerate(phases):
-        if math.hypot(*phase.velocity) > config.max_speed:
-            reader.fail(f"motion[{i}]", f"body speed {math.hypot(*phase.velocity):.4g} exceeds the Mach limit "
+        if phase.peak_speed > config.max_speed:
+            reader.fail(f"motion[{i}]", f"body speed {phase.peak_speed:.4g} exceeds the Mach limit "
                                         f"{config.max_speed:.4f} (Ma {config.mach_limit})")
     check_path_inside(source, body, script, steps, nx, ny)
 
@@ -359,14 +361,25 @@ def _phases(reader: _Reader, motion, inflow_speed: float) -> list[Phase]:
             reader.fail(t.key("move"), "give either move or velocity, not both")
         if t.has("velocity"):
             velocity = t.pair("velocity")
+        elif t.has("amplitude") and not t.has("move"):   # an oscillation about a resting pose
+            velocity = (0.0, 0.0)
         else:
             move = t.choice("move", MOVES)
             speed = t.number("speed", inflow_speed, nonnegative=True)
             if move != "stop" and speed == 0:
                 reader.fail(t.key("speed"), f"a '{move}' phase needs a speed (flow.inflow_speed is 0)")
             velocity = phase_velocity(move, speed, STREAM_DIRECTION)
+        amplitude, period = (0.0, 0.0), 0.0
+        if t.has("amplitude") or t.has("period"):   # a sinusoidal oscillation on top
+            if not (t.has("amplitude") and t.has("period")):
+                reader.fail(t.key("period" if t.has("amplitude") else "amplitude"),
+                            "an oscillating phase needs both amplitude (cells) and period (steps)")
+            amplitude = t.pair("amplitude")
+            period = t.number("period", positive=True)
+            if period < 4:
+                reader.fail(t.key("period"), f"must be at least 4 steps, got {period:g}")
         t.done()
-        phases.append(Phase(steps=steps, velocity=velocity))
+        phases.append(Phase(steps=steps, velocity=velocity, amplitude=amplitude, period=period))
     return phases
 
 

@@ -11,6 +11,8 @@ import numpy as np
 
 from feelflow.app.model import readouts
 from feelflow.app.model.body_input import BodyInput
+from feelflow.app.model.body_motion import advance_with_motion, is_moving
+from feelflow.app.model.flow_choice import QUIET_INLET_RATE, FlowChoice, default_base_config, stable_params  # noqa: F401 (re-exported)
 from feelflow.app.model.force_history import History
 from feelflow.app.model.wind_sweep import SLEW_STEPS, WindSweep
 from feelflow.app.model.coupling import AngleSpring, SpringDamper
@@ -20,8 +22,7 @@ from feelflow.solver.backend import create_solver
 from feelflow.solver.config import FlowConfig
 from feelflow.solver.inflow import ramp
 from feelflow.solver.motion import MotionRunner
-from feelflow.solver.operator_choice import MOST_STABLE, Choice, choose
-from feelflow.solver.stability_limit import inside, min_stable_viscosity
+from feelflow.solver.operator_choice import Choice
 
 #: grid presets offered in the side panel: label -> (nx, ny)
 GRID_PRESETS = {
@@ -42,26 +43,6 @@ FORCE_MODELS = {
 #: y-boundaries offered as "wall type": config value -> label
 WALLS = {"no_slip": "Solid walls (no slip)", "free_slip": "Slippery walls (free slip)",
          "periodic": "No walls (periodic)"}
-
-#: the quiet inlet's rate in the window's tunnel (FlowConfig.inlet_nonreflecting, solver/quiet_inlet.py)
-QUIET_INLET_RATE = 1e-3
-
-
-def default_base_config(grid) -> FlowConfig:
-    """What the panel does not edit: TRT, float32, an outlet sponge with its absorbing layer,
-    and the wind blowing everywhere from the first step (initial velocity = inflow, no ramp).
-    Ramping the inlet up from fluid at rest excites a slow slosh of the whole tunnel, its
-    quarter-wave sound mode (mean u swings +-60 % of U with a 1000-step ramp, +-6 % with 2000,
-    measured at 256 x 128); starting in uniform flow keeps the mean within +-4 % from the start.
-    The absorbing layer (sponge_absorb, docs/science/algorithm.md step 3) lets that sound out: after a
-    1000-step ramp at 256 x 128 the mean u swings by 0.3 % of U instead of 46 % (a test,
-    tests/test_solver_boundaries.py), so a change of wind settles at once. The quiet inlet
-    (inlet_nonreflecting) lets out the sound a moving or stopping body sends upstream
-    (docs/science/quiet-tunnel.md)."""
-    nx, ny = grid
-    return FlowConfig(nx=nx, ny=ny, dtype="float32", inflow_ramp_steps=0, sponge_cells=32, sponge_absorb=0.1,
-                      inlet_nonreflecting=QUIET_INLET_RATE)
-
 
 #: distance (cells) the body's bounding box keeps from the domain edges
 EDGE_MARGIN = 8.0
@@ -97,26 +78,12 @@ def phase_name(velocity, wind: float) -> str:
     return f"moving at ({vx:.3f}, {vy:.3f})"
 
 
-def stable_params(params: Params, collision: str) -> tuple[Params, str | None]:
-    """`params` kept inside the measured stable region (solver/stability_limit.py): where the
-    wind and body size over the viscosity, U sqrt(d) / nu, exceed what the scheme survives, the viscosity
-    is raised to the limit (the wind is what the student sees and feels, and what the lessons
-    step through; viscosity is the scheme's stability lever). Returns (params, plain sentence
-    for the status bar, or None when nothing changed)."""
-    if inside(params.wind, params.nu, collision, params.size):
-        return params, None
-    nu = math.ceil(min_stable_viscosity(params.wind, collision, params.size) * 1e4 - 1e-6) / 1e4   # 4 decimals
-    return replace(params, nu=nu), (f"Viscosity raised to {nu:.4f}: at wind {params.wind:.3f} past a "
-                                    f"{params.size:g}-cell body a thinner fluid makes this grid unstable "
-                                    f"(lower the wind or the size to go thinner).")
-
-
 class Simulation:
     """The running tunnel: owns the solver (a `SessionSolver`), the body and its pose, and runs
     `advance(n)`: n steps and one force sample. Its parts, each set up here:
-    - the panel's parameters (`params`) kept inside the measured stable region (`stable_params`;
-      `guard_note` says what the last change had to adjust, None when nothing), and the
-      collision operator chosen for them (`operator_for`, solver/operator_choice.py);
+    - the panel's parameters (`params`) and the flow they make (`flow_choice`,
+      app/model/flow_choice.py: the base configuration, the collision operator, the stability
+      guard; `guard_note` says what the last change had to adjust, None when nothing);
     - the body's pose and its input: the mouse's spring-damper (`coupling`) and the angle spring
       (app/model/coupling.py), through `drive(BodyInput)`;
     - a motion script (`runner`, solver/motion.py) or a wind sweep (`sweep`,
@@ -142,18 +109,20 @@ class Simulation:
         self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
         self.sweep: WindSweep | None = None       # a wind-speed sweep (a lesson), or None
         self.sweep_slew_steps = self.SWEEP_SLEW_STEPS   # for the next sweep (0: changes at once)
-        self.base_config = base_config or default_base_config(self.params.grid)
-        self._wind_starts_everywhere = base_config is None   # default tunnel: no ramp, see below
-        # the collision operator: a given base configuration names it; else chosen per flow
-        self.operator_named = None if base_config is None else base_config.collision
-        self.params, self.guard_note = stable_params(self.params, self.guard_operator)
+        #: the base configuration, the collision operator and the stability guard (app/model/flow_choice.py)
+        self.flow_choice = FlowChoice(base_config, self.params.grid)
+        self.params, self.guard_note = self.flow_choice.stable(self.params)
+        self._guard_read_at = None   # solver step of the last max |u| the local guard read
+        self.guard_changed = False   # the local guard changed the flow (the window shows guard_note)
+        self.polar = None            # app/model/live_polar.LivePolar: an angle-of-attack sweep
+        self.surface_watch = None    # app/model/live_polar.SurfacePressureWatch: C_p along the surface
         self.capped = False          # the Mach cap limited the body's speed in the last frame
         #: the coefficients' reference length when it is not the body's size (an exercise's)
         self.reference_override: readouts.ReferenceLength | None = None
         self.config = self.flow_config()
         # one SessionSolver for the life of the window (app/sessions/): rebuilt, never replaced
         self.solver = SessionSolver(create_solver(self.backend, self.config, ctx=ctx))
-        self.coupling = SpringDamper(max_speed=self.config.max_speed)
+        self.coupling = SpringDamper(max_speed=self.config.max_speed, stream=self._stream(self.config))
         # the body's pose: reference point (cells), velocity (cells per step), angle and its rate
         self.pos, self.vel = self.start_position(self.config), (0.0, 0.0)
         self.angle, self.rate = math.radians(self.params.angle_deg), 0.0
@@ -170,29 +139,13 @@ class Simulation:
         return (config.nx * 0.3, config.ny * 0.5)
 
     # --- construction --------------------------------------------------------------------
-    @property
-    def guard_operator(self) -> str:
-        """The operator whose measured region the stability guard keeps the flow in: the named
-        one, else the most stable one the chooser can pick."""
-        return self.operator_named or MOST_STABLE
-
     def operator_for(self, params: Params | None = None) -> Choice:
-        """The collision operator for `params` (solver/operator_choice.py) and why, in one line."""
-        p = params or self.params
-        base = self.base_config
-        return choose(p.wind, p.nu, p.size, base.mach_limit, named=self.operator_named,
-                      smagorinsky=base.smagorinsky)
+        """The collision operator for `params` (default: the panel's) and why (FlowChoice)."""
+        return self.flow_choice.operator_for(params or self.params)
 
     def flow_config(self, params: Params | None = None) -> FlowConfig:
-        """The base configuration (scene or default) with what the panel edits, and the operator."""
-        p = params or self.params
-        nx, ny = p.grid
-        base = self.base_config
-        op = self.operator_for(p)
-        extra = {"initial_velocity": (p.wind, 0.0)} if self._wind_starts_everywhere else {}
-        return replace(base, nx=nx, ny=ny, nu=p.nu, inflow_speed=p.wind, y_boundary=p.wall,
-                       collision=op.collision, smagorinsky=op.smagorinsky,
-                       sponge_cells=min(base.sponge_cells, nx // 4), **extra).validate()
+        """The flow configuration for `params` (default: the panel's; FlowChoice)."""
+        return self.flow_choice.config_for(params or self.params)
 
     def _build(self, keep_flow: bool):
         """The flow for the parameters now, from the old one where `keep_flow` and the grid is the
@@ -210,7 +163,7 @@ class Simulation:
         if self.runner is not None and not keep_flow:
             self.runner = None
         self.config = config
-        self.coupling = SpringDamper(max_speed=config.max_speed)
+        self.coupling = SpringDamper(max_speed=config.max_speed, stream=self._stream(config))
         if not keep_flow:
             self.shape = self.make_shape(self.params, self.polygon, *self.pos, self.angle).validate(config.nx, config.ny)
         self._place_body()
@@ -221,9 +174,43 @@ class Simulation:
         self._enable_models()
         self.solver.set_body(self.shape, self.vel, 0.0)
 
+    @staticmethod
+    def _stream(config: FlowConfig, wind: float | None = None) -> tuple[float, float]:
+        """The wind the body's speed is capped relative to (app/model/coupling.py): the inflow in
+        the tunnel, none in a periodic box."""
+        if config.x_boundary != "tunnel":
+            return (0.0, 0.0)
+        return (float(config.inflow_speed if wind is None else wind), 0.0)
+
     def _enable_models(self):
         names = list(FORCE_MODELS) if self.params.compare_all else [self.params.force_model]
         self.solver.enable_force_models(names)
+        for probe in self._probes():
+            self.solver.add_force_model(probe)
+
+    def _probes(self):
+        """The surface-pressure probes switched on (the C_p view, the polar), beside the force models."""
+        watch = self.polar or self.surface_watch   # one probe: the polar's serves the C_p view too
+        return [] if watch is None else [watch.probe]
+
+    def watch_surface_pressure(self, on: bool = True):
+        """Switch the pressure model's wall sampling on for C_p along the surface (the C_p view)."""
+        if on and self.surface_watch is None:
+            from feelflow.app.model.live_polar import SurfacePressureWatch
+
+            self.surface_watch = SurfacePressureWatch()
+        elif not on:
+            self.surface_watch = None
+        self._enable_models()
+
+    def start_polar(self, angles, sample_steps: int = 25, **settling):
+        """An angle-of-attack sweep (app/model/live_polar.py): the body held still at each angle
+        of `angles` (degrees, nose up positive) until its forces settle, then the next."""
+        from feelflow.app.model.live_polar import LivePolar
+
+        self.polar = LivePolar(self, angles, sample_steps=sample_steps, **settling)
+        self._enable_models()
+        self.polar.start(self)
 
     # --- what the panel changes ------------------------------------------------------------
     def set_shape(self, kind=None, size=None, angle_deg=None, polygon=None):
@@ -237,7 +224,7 @@ class Simulation:
         self.angle = self.angle_target = angle
         self._clamp_pose()
         self.solver.set_body(self.shape, self.vel, 0.0)
-        guarded, note = stable_params(self.params, self.guard_operator)
+        guarded, note = self.flow_choice.stable(self.params)
         if note:   # a larger body needs a thicker fluid at this wind
             self.set_flow(nu=guarded.nu)
         elif self.operator_for().collision != self.config.collision:   # the size changed the operator
@@ -247,13 +234,14 @@ class Simulation:
     def set_flow(self, wind=None, nu=None, wall=None):
         """Change inflow speed, viscosity or walls, keeping the flow as it is (raises ConfigError)."""
         params = replace(self.params, **{k: v for k, v in (("wind", wind), ("nu", nu), ("wall", wall)) if v is not None})
-        params, self.guard_note = stable_params(params, self.guard_operator)
+        params, self.guard_note = self.flow_choice.stable(params)
         new = self.flow_config(params)  # validate first: a bad value leaves everything as it was
         only_wind = ((params.nu, params.wall) == (self.params.nu, self.params.wall)
                      and new.collision == self.config.collision)
         self.params = params
         if only_wind:
             self.solver.set_inflow_speed(params.wind)   # live, no rebuild
+            self.coupling.stream = self._stream(self.config, params.wind)
         else:
             self._build(keep_flow=True)
 
@@ -269,7 +257,7 @@ class Simulation:
     def reset_flow(self):
         """The flow from its initial state again (time 0), body where it was, at rest; history cleared."""
         self.solver.reset()
-        self.runner = self.sweep = None
+        self.runner = self.sweep = self.polar = None
         self.vel, self.rate, self._target = (0.0, 0.0), 0.0, None
         self.angle_target = self.angle
         self.shape = self.shape.moved(*self.pos, self.angle)
@@ -315,16 +303,14 @@ class Simulation:
         kind, size, verts = params_for_shape(scene.body)
         cfg = scene.config
         models = [m for m in scene.force_models if m in FORCE_MODELS] or [self.params.force_model]
-        self.base_config = cfg
-        self.operator_named = scene.operator_named
-        self._wind_starts_everywhere = False
+        self.flow_choice.use_scene(scene)
         self.params = replace(self.params, grid=(cfg.nx, cfg.ny), shape=kind, size=size or self.params.size,
                               angle_deg=math.degrees(scene.body.angle), wind=cfg.inflow_speed, nu=cfg.nu,
                               wall=cfg.y_boundary, force_model=models[0], compare_all=len(models) > 1)
-        self.params, self.guard_note = stable_params(self.params, self.guard_operator)
+        self.params, self.guard_note = self.flow_choice.stable(self.params)
         self.polygon = verts
         self.runner = None
-        self.sweep = None
+        self.sweep = self.polar = None
         self._build(keep_flow=False)
         self.pos = (scene.body.x, scene.body.y)
         self.shape = self.shape.moved(*self.pos, self.angle)
@@ -383,7 +369,7 @@ class Simulation:
         return (wind - self.vel[0], -self.vel[1])
 
     def advance(self, n: int):
-        """Run n steps, moving the body in chunks of at most half a cell; record a sample."""
+        """Run n steps, the body's pose advanced every step while it moves; record a sample."""
         n = max(1, int(n))
         if self.sweep is not None:
             wind = self.sweep.wind(self.solver.time)
@@ -403,19 +389,55 @@ class Simulation:
                 self.runner = None
                 self.vel = (0.0, 0.0)
             done = n
-        while done < n:
-            speed = math.hypot(*self.vel)
-            chunk = n - done if speed < 1e-9 else max(1, min(n - done, int(0.5 / speed)))
-            self._move_body(chunk)
-            self.solver.step(chunk)   # raises solver.backend.SolverDiverged when the flow blows up
+        if done < n:   # the pose advances every step while the body moves (app/model/body_motion.py)
+            acc = advance_with_motion(self.solver, n, self._move_body, self._body_moves)
             self.capped |= self.solver.speed_capped
-            for name, (fx, fy) in self.solver.forces().items():
-                ax, ay = acc.get(name, (0.0, 0.0))
-                acc[name] = (ax + fx * chunk, ay + fy * chunk)
-            done += chunk
         forces = {k: (v[0] / n, v[1] / n) for k, v in acc.items()}
+        for probe in self._probes():   # a probe's force is the pressure model's: not a model of its own
+            forces.pop(probe.name, None)
+        if self.polar is not None:
+            self.polar.after_advance(self, forces, n)
         self.history.add(self.solver.time, self.vel, self.relative_wind(), forces)
+        self.apply_local_guard()
         return forces
+
+    def apply_local_guard(self) -> bool:
+        """The local stability guard (solver/local_guard.py): when the last physical-range check
+        found the fastest node outside the running operator's stable region, raise the viscosity
+        to the one that brings it back (for the operator that viscosity gets), keeping the flow;
+        `guard_note` and `guard_changed` say so in one line. Returns whether it acted."""
+        from feelflow.solver import local_guard
+
+        at = self.solver.max_speed_at
+        if at is None or at == self._guard_read_at:
+            return False
+        self._guard_read_at = at
+        verdict = local_guard.check(self.config.collision, self.params.nu, self.solver.max_speed_seen)
+        if verdict.inside:
+            return False
+        if verdict.nu_needed is None:
+            self.guard_note = verdict.line(self.operator_for().label)
+            self.guard_changed = True
+            return True
+        nu = verdict.nu_needed
+        for _ in range(3):   # the chooser may pick another operator at the new viscosity: its region counts
+            op = self.operator_for(replace(self.params, nu=nu)).collision
+            again = local_guard.check(op, nu, verdict.max_speed).nu_needed
+            if again is None or again <= nu:
+                break
+            nu = again
+        nu = math.ceil(nu * 1e4 - 1e-6) / 1e4
+        label = self.operator_for().label
+        self.set_flow(nu=nu)
+        self.guard_note = verdict.line(label, nu_set=self.params.nu)
+        self.guard_changed = True
+        return True
+
+    def _body_moves(self) -> bool:
+        """Whether the next step moves or turns the body (app/model/body_motion.py is_moving)."""
+        if self.hold_still:
+            return bool(self.rate) or self.vel != (0.0, 0.0)
+        return is_moving(self.vel, self.rate, self.pos, self._target, self.angle, self.angle_target)
 
     def _move_body(self, steps: int):
         old = (self.pos, self.angle)
@@ -464,6 +486,9 @@ class Simulation:
     def operator_line(self) -> str:
         """Which collision operator runs and why, in one line (the status bar's)."""
         return self.operator_for().reason
+
+    def field_texture(self, vorticity: bool = True):
+        return self.solver.field_texture(vorticity=vorticity)
 
     def field_rgba(self) -> np.ndarray:
         return self.solver.field_rgba()

@@ -23,6 +23,8 @@ from feelflow.solver.config import FlowConfig
 from feelflow.solver.motion import MotionRunner
 
 if TYPE_CHECKING:   # simulation.py defines them and implements this interface
+    import moderngl
+
     from feelflow.app.model.force_history import History
     from feelflow.app.model.simulation import Params
 
@@ -79,6 +81,10 @@ class TunnelModel(Protocol):
 
     def operator_line(self) -> str:
         """Which collision operator runs and why, in one line (solver/operator_choice.py)."""
+        ...
+
+    def field_texture(self, vorticity: bool = True) -> "moderngl.Texture | None":
+        """The field as a texture on the flow's GL context, or None (draw `field_rgba`)."""
         ...
 
     def field_rgba(self) -> np.ndarray:

@@ -12,6 +12,7 @@ from feelflow.app.sessions.format import SessionError, config_to_dict
 from feelflow.app.sessions.recorder import SessionRecorder
 from feelflow.solver.backend import SolverDiverged, create_solver
 from feelflow.solver.config import ConfigError, FlowConfig
+from feelflow.solver.force_average import StepWeightedMean
 
 
 def _geometry(shape):
@@ -85,6 +86,14 @@ class SessionSolver:
     @property
     def speed_capped(self) -> bool:
         return self._solver.speed_capped
+
+    @property
+    def max_speed_seen(self) -> float:
+        return self._solver.max_speed_seen
+
+    @property
+    def max_speed_at(self) -> int | None:
+        return self._solver.max_speed_at
 
     @property
     def gl_context(self):
@@ -164,6 +173,11 @@ class SessionSolver:
         self._solver.enable_force_models(names)
         self.models = names
 
+    def add_force_model(self, model) -> None:
+        """Enable an already-built model instance beside them (the C_p view's wall sampling,
+        solver/forces/surface_pressure.py); not recorded: a replay computes its own."""
+        self._solver.add_force_model(model)
+
     def step(self, n: int = 1) -> None:
         n = int(n)
         if n < 1:
@@ -188,7 +202,8 @@ class SessionSolver:
         k, row_steps = int(k), int(row_steps)
         part = self._part
         if part is None:
-            part = self._part = {"done": 0, "sums": {}, "body": self._body_row(), "start": self._solver.time}
+            part = self._part = {"done": 0, "mean": StepWeightedMean(), "body": self._body_row(),
+                                 "start": self._solver.time}
         k = max(1, min(k, row_steps - part["done"]))
         try:
             self._solver.step(k)
@@ -197,10 +212,7 @@ class SessionSolver:
             done = part["done"] + max(1, min(k, exc.step - part["start"] - part["done"]))
             self._record_row(done, {m: (math.nan, math.nan) for m in self.models}, part["body"])
             raise
-        sums = part["sums"]
-        for m, (fx, fy) in self._solver.forces().items():
-            sx, sy = sums.get(m, (0.0, 0.0))
-            sums[m] = (sx + fx * k, sy + fy * k)
+        part["mean"].add(self._solver.forces(), k)
         part["done"] += k
         if part["done"] < row_steps:
             return False
@@ -211,8 +223,7 @@ class SessionSolver:
             self._record_row(row_steps, {m: (math.nan, math.nan) for m in self.models}, part["body"])
             raise
         self._part = None
-        self._record_row(row_steps, {m: (sx / row_steps, sy / row_steps) for m, (sx, sy) in sums.items()},
-                         part["body"])
+        self._record_row(row_steps, part["mean"].mean(), part["body"])
         return True
 
     def check_physical(self) -> None:
@@ -253,7 +264,7 @@ class SessionSolver:
         self.flow_config = config
         old = self._solver
         new = carry_flow(self._factory, config, old.distributions(), old.time, self.shape, old.inlet_reference())
-        self._reapply(new)
+        self.adopt(new)
         old.close()
 
     def reset(self) -> None:
@@ -262,7 +273,7 @@ class SessionSolver:
         if self.recorder is not None:
             self.recorder.record_parameter("reset")
         old = self._solver
-        self._reapply(self._factory(self.flow_config))
+        self.adopt(self._factory(self.flow_config))
         old.close()
 
     def rebuild(self, config: FlowConfig, keep_flow: bool = True) -> None:
@@ -286,7 +297,7 @@ class SessionSolver:
         self._solver = new
         old.close()
 
-    def _reapply(self, new) -> None:
+    def adopt(self, new) -> None:
         if self.models:
             new.enable_force_models(self.models)
         if self.inflow_speed is not None:

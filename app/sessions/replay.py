@@ -39,6 +39,23 @@ class ReplayedRow(NamedTuple):
 
 
 
+def check_replay_memory(session: Session, source) -> None:
+    """SessionError (one line naming the need and the limit) before a replay when the largest
+    grid the session uses (its scene or a recorded rebuild) needs more memory than can be used
+    here (app/inputs.py's estimate)."""
+    from feelflow.app.errors import UserError
+    from feelflow.app.inputs import check_memory
+
+    grids = [(session.config.nx, session.config.ny)] + [
+        (p["value"]["config"]["nx"], p["value"]["config"]["ny"]) for p in session.parameters
+        if p.get("name") == "rebuild"]
+    nx, ny = max(grids, key=lambda g: g[0] * g[1])
+    try:
+        check_memory(nx, ny, str(source), "the largest grid it uses")
+    except UserError as exc:
+        raise SessionError(str(exc)) from None
+
+
 class SessionPlayer:
     """An incremental replay of `session` on `backend` (default: the recorded one).
 
@@ -73,7 +90,7 @@ class SessionPlayer:
             self.recorder.inlet_reference = session.inlet_reference
             d.models, d.inflow_speed = tuple(start["force_models"]), start["inflow_speed"]
             d.shape, d.velocity, d.omega = placed, tuple(start["velocity"]), start["omega"]
-            d._reapply(solver)
+            d.adopt(solver)
         self.geometry = session.body   # the geometry the next input places
         self.diverged_at: int | None = None
         self.rows: list[ReplayedRow] = []

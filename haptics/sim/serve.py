@@ -74,10 +74,10 @@ class _RemoteHand:
     def set(self, x: float, y: float = 0.0) -> None:
         self.moved_at = time.monotonic()
         self._xy = (x, y)
-        self._owner._send({"op": "hand", "x": x, "y": y})
+        self._owner.send({"op": "hand", "x": x, "y": y})
 
     def get(self):
-        return self._owner._state()["hand"]
+        return self._owner.state()["hand"]
 
     @property
     def buttons(self) -> int:
@@ -86,7 +86,7 @@ class _RemoteHand:
     @buttons.setter
     def buttons(self, mask: int) -> None:
         self._buttons = mask
-        self._owner._send({"op": "buttons", "mask": mask})
+        self._owner.send({"op": "buttons", "mask": mask})
 
 
 class _RemoteForces:
@@ -95,15 +95,15 @@ class _RemoteForces:
 
     @property
     def last(self):
-        return tuple(self._owner._state()["last"])
+        return tuple(self._owner.state()["last"])
 
     @property
     def max_magnitude(self) -> float:
-        return self._owner._state()["max"]
+        return self._owner.state()["max"]
 
     @property
     def count(self) -> int:
-        return self._owner._state()["count"]
+        return self._owner.state()["count"]
 
 
 class RemoteSim:
@@ -123,7 +123,7 @@ class RemoteSim:
         self._muted = False
         self._last_state = {"last": [0.0, 0.0], "max": 0.0, "count": 0, "hand": [0.0, 0.0], "errors": []}
 
-    def _send(self, cmd: dict) -> None:
+    def send(self, cmd: dict) -> None:
         with self._lock:
             try:
                 self._proc.stdin.write(json.dumps(cmd) + "\n")
@@ -131,7 +131,7 @@ class RemoteSim:
             except (OSError, ValueError):
                 pass
 
-    def _state(self) -> dict:
+    def state(self) -> dict:
         with self._lock:
             try:
                 self._proc.stdin.write(json.dumps({"op": "state"}) + "\n")
@@ -143,10 +143,10 @@ class RemoteSim:
 
     @property
     def errors(self):
-        return self._state()["errors"]
+        return self.state()["errors"]
 
     def inject(self, data: bytes) -> None:
-        self._send({"op": "inject", "hex": bytes(data).hex()})
+        self.send({"op": "inject", "hex": bytes(data).hex()})
 
     @property
     def muted(self) -> bool:
@@ -155,14 +155,14 @@ class RemoteSim:
     @muted.setter
     def muted(self, on: bool) -> None:
         self._muted = bool(on)
-        self._send({"op": "mute", "on": self._muted})
+        self.send({"op": "mute", "on": self._muted})
 
     def disconnect(self) -> None:
-        self._send({"op": "disconnect"})
+        self.send({"op": "disconnect"})
 
     def stop(self) -> None:
         if self._proc.poll() is None:
-            self._send({"op": "stop"})
+            self.send({"op": "stop"})
             try:
                 self._proc.stdin.close()
             except OSError:

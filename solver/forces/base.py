@@ -57,3 +57,8 @@ class ForceModel(ABC):
     @abstractmethod
     def compute(self, window: BodyWindow) -> tuple[float, float]:
         """(F_x, F_y) on the body for this step."""
+
+    def torque(self, window: BodyWindow) -> float:
+        """The torque of the fluid on the body about its centre (shape.x, shape.y), counter-
+        clockwise positive, lattice units per step; a model without a moment gives 0."""
+        return 0.0

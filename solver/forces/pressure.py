@@ -82,3 +82,12 @@ class PressureIntegration(ForceModel):
         fx = -float(np.sum(p * normals[:, 0] * lengths))
         fy = -float(np.sum(p * normals[:, 1] * lengths))
         return fx, fy
+
+    def torque(self, window: BodyWindow) -> float:
+        """- sum r x n p dA about the body's centre (zero on a circle: pressure acts through its
+        centre; the viscous shear, which turns it, is not in this model)."""
+        pts, normals, lengths, rho = self.wall_density(window)
+        valid = self._geom[3].valid
+        p = np.where(valid, self.beta_prime * (rho * rho - RHO0 * RHO0), 0.0)
+        rx, ry = pts[:, 0] - window.shape.x, pts[:, 1] - window.shape.y
+        return -float(np.sum(p * lengths * (rx * normals[:, 1] - ry * normals[:, 0])))

@@ -58,15 +58,20 @@ class SurfacePressureProbe(PressureIntegration):
         """Steps summed since the last `take()`."""
         return self._count
 
-    def take(self):
-        """(shape, points (k, 2), normals (k, 2), lengths (k,), mean wall rho (k,), valid (k,)) over
-        the steps since the last take, or None before the first step; starts a new average."""
+    def peek(self):
+        """What `take()` would return, without starting a new average."""
         if not self._count:
             return None
         shape, pts, normals, lengths, valid = self._last
-        mean = self._sum / self._count
-        self._sum, self._count = np.zeros_like(self._sum), 0
-        return shape, pts, normals, lengths, mean, valid
+        return shape, pts, normals, lengths, self._sum / self._count, valid
+
+    def take(self):
+        """(shape, points (k, 2), normals (k, 2), lengths (k,), mean wall rho (k,), valid (k,)) over
+        the steps since the last take, or None before the first step; starts a new average."""
+        taken = self.peek()
+        if taken is not None:
+            self._sum, self._count = np.zeros_like(self._sum), 0
+        return taken
 
 
 @dataclass(frozen=True)

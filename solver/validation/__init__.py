@@ -19,6 +19,8 @@ CASES: dict[str, str] = {
     "mass": "feelflow.solver.validation.mass",
     "stability": "feelflow.solver.validation.stability",
     "strouhal-re100": "feelflow.solver.validation.strouhal",
+    "cylinder-re200": "feelflow.solver.validation.cylinder_re200",
+    "cylinder-re1000": "feelflow.solver.validation.cylinder_re1000",
 }
 
 

@@ -1,6 +1,6 @@
-"""`feelflow bench [solver|accuracy|haptics|operators]`: speed of the solver backends, their speed
-against their error, the haptic loop, or the cost per step of each collision operator
-(`app/bench/operator_cost.py`).
+"""`feelflow bench [solver|accuracy|haptics|operators|motion]`: speed of the solver backends, their speed
+against their error, the haptic loop, the cost per step of each collision operator
+(`app/bench/operator_cost.py`), or of moving the body (`app/bench/motion_cost.py`).
 
 The solver bench lives in `app/bench/solver_speed.py`, speed against error in
 `app/bench/accuracy.py`, the haptic one in `app/bench/haptic_loop.py`; this module only
@@ -13,7 +13,8 @@ import importlib
 from feelflow.app.bench.accuracy import AXES
 
 TARGETS = {"solver": "feelflow.app.bench.solver_speed", "accuracy": "feelflow.app.bench.accuracy",
-           "haptics": "feelflow.app.bench.haptic_loop", "operators": "feelflow.app.bench.operator_cost"}
+           "haptics": "feelflow.app.bench.haptic_loop", "operators": "feelflow.app.bench.operator_cost",
+           "motion": "feelflow.app.bench.motion_cost"}
 
 
 def add_arguments(parser):
@@ -27,10 +28,11 @@ def add_arguments(parser):
     parser.add_argument("--rounds", type=int, default=None,
                         help="solver, operators: alternating rounds (solver: numpy / cpu / gl) per scene, medians reported (default 3; --quick 1)")
     parser.add_argument("--grid", action="append", metavar="NXxNY",
-                        help="solver: only this grid (repeatable; default 256x128, 512x256 and 1024x512)")
+                        help="solver: only this grid (repeatable; default 256x128, 512x256 and 1024x512); motion: default 256x128")
     parser.add_argument("--quick", action="store_true", help="solver, accuracy: fewer steps or points (smoke test)")
-    parser.add_argument("--backend", action="append", choices=("numpy", "gl"),
-                        help="accuracy: only this backend (repeatable; default: numpy float64, numpy float32, gl)")
+    parser.add_argument("--backend", action="append", choices=("numpy", "cpu", "gl"),
+                        help="accuracy: only this backend (repeatable; default: numpy float64, numpy float32, gl); "
+                             "motion: default numpy and cpu")
     parser.add_argument("--axis", action="append", choices=AXES,
                         help="accuracy: only this axis (repeatable; default: all three)")
     parser.add_argument("--profile", action="store_true",

@@ -2,10 +2,13 @@
 
 `score EXERCISE.toml SHAPES...` scores shape files (or folders of them) on every core with a
 progress bar on stderr, writes one CSV row per file (app/files.py atomic write) and prints a
-ranked table, the wall time and the time per shape. `check EXERCISE.toml` validates the file and
-scores its reference solutions (exit 1 when one misses its recorded score); `--convergence`
-also scores the [check] shapes, all at the exercise's resolution and at twice it, and exits 1
-unless the ranking is the same (docs/guide/exercises.md quotes its tables).
+ranked table (scores to the digits the exercise's grid uncertainty supports, ties within it
+sharing a rank), the wall time and the time per shape. `check EXERCISE.toml` validates the file
+and scores its reference solutions (exit 1 when one misses its recorded score); `--convergence`
+also scores the [check] shapes, all at the exercise's resolution and at twice it, prints the
+measured grid uncertainty (the largest change) and exits 1 unless the ranking is the same (ties
+within the declared uncertainty allowed) and the declared uncertainty covers the measured one
+(docs/guide/exercises.md quotes its tables).
 Format: docs/reference/exercise-format.md. Bad input is one line on stderr and exit 2.
 """
 from __future__ import annotations
@@ -41,6 +44,9 @@ def add_arguments(parser):
                    help="also score the [check] shapes; everything at 1x and 2x the resolution; "
                         "exit 1 unless the ranking is the same")
     p.add_argument("--markdown", action="store_true", help="--convergence: print the table as Markdown")
+    p.add_argument("--backend", choices=("numpy", "cpu"), default="numpy",
+                   help="float64 solver for the runs: numpy (default; what the window and 'score' use) or "
+                        "the compiled cpu backend (the same digits, less CPU time)")
     p.add_argument("--workers", default=None, metavar="N", help="processes (default: every core)")
     sub.add_parser("list", help="list the shipped exercises")
 
@@ -152,8 +158,26 @@ def _list() -> int:
     return 0
 
 
+def _uncertainty_line(exercise) -> str:
+    u = exercise.objective.uncertainty
+    if u is None:
+        return ("grid uncertainty: not stated in the exercise file (feelflow exercise check --convergence "
+                "measures it); scores with four decimals, no ties")
+    return (f"grid uncertainty of a score: {u:g} (the exercise's [objective] grid_uncertainty, from "
+            f"feelflow exercise check --convergence); scores closer than that are ties and share a rank (=)")
+
+
+def _rank_labels(ranks) -> list[str]:
+    from feelflow.app.exercises.uncertainty import rank_labels
+
+    shown = rank_labels([k for k in ranks if k is not None])
+    it = iter(shown)
+    return [next(it) if k is not None else "-" for k in ranks]
+
+
 def _score(exercise, args) -> int:
     from feelflow.app.exercises import grading
+    from feelflow.app.exercises.uncertainty import fmt
     from feelflow.app.files import check_output, save_csv
 
     files = grading.shape_files(args.shapes)
@@ -170,14 +194,17 @@ def _score(exercise, args) -> int:
           f"(numpy float64, {s.nx} x {s.ny}, {s.steps} steps each)", flush=True)
     rows, wall = grading.grade(exercise, files, workers, scales=(scale,), progress=ProgressBar("shapes"))
     rows = grading.ranked(exercise, rows)
-    save_csv(out, grading.CSV_HEADER, grading.csv_rows(rows), "--out")
+    save_csv(out, grading.CSV_HEADER, grading.csv_rows(rows, exercise), "--out")
     o = exercise.objective
     print(f"\nobjective: {o.kind} (score = {o.quantity}, {o.better} is better"
           + (f"; hit within {o.tolerance:g} of {o.target:g}" if o.target is not None else "") + ")")
+    u = o.uncertainty
+    print(_uncertainty_line(exercise))
+    labels = _rank_labels(grading.ranks(exercise, rows))
     print(f"{'rank':>4s}  {'score':>9s}  {'C_D':>7s}  {'C_L':>8s}  {'s':>6s}  file / verdict")
-    for i, r in enumerate(rows, 1):
+    for label, r in zip(labels, rows):
         verdict = "" if r.ok else f"  [{r.status}: {r.reason}]"
-        print(f"{(str(i) if r.ok else '-'):>4s}  {_fmt(r.score):>9s}  {_fmt(r.cd, 3):>7s}  {_fmt(r.cl, 4):>8s}  "
+        print(f"{label:>4s}  {fmt(r.score, u):>9s}  {_fmt(r.cd, 3):>7s}  {_fmt(r.cl, 4):>8s}  "
               f"{r.seconds:6.1f}  {r.file}{verdict}")
     run_s = [r.seconds for r in rows if r.steps]
     per = f"; each scored shape's run took {sum(run_s) / len(run_s):.1f} s on average" if run_s else ""
@@ -197,10 +224,11 @@ def _check(exercise, args) -> int:
     s = exercise.scene
     print(f"{exercise.source}: valid. {exercise.title}: {s.nx} x {s.ny}, Re {s.reynolds:g}, "
           f"U {s.inflow_speed:g}, L {s.reference_length:g} cells, {s.steps} steps; objective "
-          f"{exercise.objective.kind}", flush=True)
+          f"{exercise.objective.kind}; {args.backend} float64", flush=True)
+    print(_uncertainty_line(exercise))
     refs = [r.path for r in exercise.references]
     paths = refs + (list(exercise.check_shapes) if args.convergence else [])
-    rows, wall = grading.grade(exercise, paths, workers, scales, progress=ProgressBar("runs"))
+    rows, wall = grading.grade(exercise, paths, workers, scales, progress=ProgressBar("runs"), backend=args.backend)
     by = {(r.file, r.scale): r for r in rows}
     failed = False
     for ref in exercise.references:
@@ -221,23 +249,31 @@ def _check(exercise, args) -> int:
 
 
 def _convergence(exercise, paths, by, markdown: bool) -> bool:
-    """Print both resolutions' scores, ranks and differences; True when the rankings differ."""
+    """Print both resolutions' scores, ranks (ties within the declared grid uncertainty share
+    one) and differences, the measured uncertainty; True when the rankings differ beyond the
+    declared ties or the declared uncertainty is smaller than the measured one."""
     from feelflow.app.exercises import grading
+    from feelflow.app.exercises.uncertainty import declared, largest_change, order_changes
 
-    ranks = {}
+    o = exercise.objective
+    u = o.uncertainty
+    ranks, scores = {}, {}
     for scale in (1, 2):
-        ok = grading.ranked(exercise, [by[(str(p), scale)] for p in paths])
-        ranks[scale] = {r.file: i for i, r in enumerate(ok, 1) if r.ok}
+        rows = grading.ranked(exercise, [by[(str(p), scale)] for p in paths])
+        labels = _rank_labels(grading.ranks(exercise, rows))
+        ranks[scale] = {r.file: label for r, label in zip(rows, labels) if r.ok}
+        scores[scale] = {r.file: r.score for r in rows if r.ok}
     s = exercise.scene
     head = ["shape", f"score {s.nx}x{s.ny}", "rank", f"score {2 * s.nx}x{2 * s.ny}", "rank", "difference",
             "s (1x)", "s (2x)"]
+    order = [r.file for r in grading.ranked(exercise, [by[(str(p), 1)] for p in paths])]
     lines = []
-    for p in sorted(paths, key=lambda p: ranks[1].get(str(p), 999)):
-        a, b = by[(str(p), 1)], by[(str(p), 2)]
+    for f in order:
+        a, b = by[(f, 1)], by[(f, 2)]
         diff = (f"{b.score - a.score:+.4f} ({(b.score - a.score) / abs(a.score):+.1%})"
                 if a.ok and b.ok and a.score else "-")
-        lines.append([Path(p).name, _fmt(a.score) if a.ok else a.status, str(ranks[1].get(str(p), "-")),
-                      _fmt(b.score) if b.ok else b.status, str(ranks[2].get(str(p), "-")), diff,
+        lines.append([Path(f).name, _fmt(a.score) if a.ok else a.status, ranks[1].get(f, "-"),
+                      _fmt(b.score) if b.ok else b.status, ranks[2].get(f, "-"), diff,
                       f"{a.seconds:.1f}", f"{b.seconds:.1f}"])
     if markdown:
         print("| " + " | ".join(head) + " |")
@@ -248,7 +284,23 @@ def _convergence(exercise, paths, by, markdown: bool) -> bool:
         print("  ".join(f"{h:>14s}" if i else f"{h:36s}" for i, h in enumerate(head)))
         for row in lines:
             print("  ".join(f"{c:>14s}" if i else f"{c:36s}" for i, c in enumerate(row)))
-    same = [f for f, _ in sorted(ranks[1].items(), key=lambda kv: kv[1])] == \
-           [f for f, _ in sorted(ranks[2].items(), key=lambda kv: kv[1])]
-    print(f"ranking at {s.nx}x{s.ny} and {2 * s.nx}x{2 * s.ny}: {'the same' if same else 'DIFFERENT'}")
-    return not same
+    measured = largest_change(scores[1], scores[2])
+    failed = False
+    if u is None:
+        print(f"grid uncertainty: the largest change is {measured:.4f}; state it in the exercise file as "
+              f"[objective] grid_uncertainty = {declared(measured):g}")
+    else:
+        covers = measured <= u
+        failed |= not covers
+        print(f"grid uncertainty: the largest change is {measured:.4f}, "
+              + (f"within the declared {u:g}" if covers else
+                 f"MORE than the declared {u:g} (declare {declared(measured):g})"))
+    swapped = order_changes(scores[1], scores[2], o.better, u)
+    unscored = [f for f in order if f not in scores[1] or f not in scores[2]]
+    for a, b in swapped:
+        print(f"  order changes: {Path(a).name} ahead of {Path(b).name} by more than the uncertainty on one grid, "
+              f"behind it on the other")
+    same = not swapped and not unscored
+    ties = "" if u is None else f" (ties within {u:g} allowed)"
+    print(f"ranking at {s.nx}x{s.ny} and {2 * s.nx}x{2 * s.ny}{ties}: {'the same' if same else 'DIFFERENT'}")
+    return failed or not same

@@ -7,6 +7,8 @@ outlet sponge as `feelflow run` does and print how calm their tunnel is (app/sce
 `feelflow report ringdown [--only window,d16,...] [--phase-steps N] [--json PATH]`: how long the
 tunnel's sound rings in the drag after a body stops, with the old boundaries and the quiet
 tunnel's, in one table (app/reports/ringdown.py).
+`feelflow report towed [--refill A,B] [--impulse A,B] [--json PATH]`: a cylinder towed through fluid at
+rest against the same one held in a stream: mean drag and its noise per step (app/reports/towed.py).
 
 Parts (`--only`): protocol (or one diameter, protocol:d32), shapes, sweep, lift; each stores its
 series in OUT/seed-report/data-<part>.json (data-protocol-<d>.json per diameter), and the report
@@ -20,15 +22,23 @@ from pathlib import Path
 
 from feelflow.app.errors import UserError
 
-TARGETS = ("seed", "lessons", "scenes", "ringdown")
+TARGETS = ("seed", "lessons", "scenes", "ringdown", "towed")
 
 
 def add_arguments(parser):
     parser.add_argument("target", choices=TARGETS,
                         help="which report (seed: the thesis's experiments; lessons: the Presets menu's lessons; "
                              "scenes: how calm the example scenes' tunnels are; ringdown: how long sound rings in "
-                             "the drag after a stop, old and quiet boundaries)")
-    parser.add_argument("--backend", default="numpy", metavar="numpy|gl", help="solver backend (default: numpy)")
+                             "the drag after a stop, old and quiet boundaries; towed: a towed body's drag against a held "
+                             "one's, and its noise)")
+    parser.add_argument("--backend", default="numpy", metavar="numpy|gl",
+                        help="solver backend (default: numpy; towed also takes cpu)")
+    parser.add_argument("--refill", default=None, metavar="SCHEME[,SCHEME]",
+                        help="towed: how uncovered nodes are refilled (equilibrium, nonequilibrium; default: the "
+                             "solver's); several run one after the other")
+    parser.add_argument("--impulse", default=None, metavar="SCHEME[,SCHEME]",
+                        help="towed: how covered/uncovered nodes' momentum enters the force (relative, absolute, "
+                             "none; default: the solver's)")
     parser.add_argument("--quick", action="store_true",
                         help="a few dozen steps per run: a smoke test of the whole chain, not physics")
     parser.add_argument("--phase-steps", default=None, metavar="N",
@@ -50,7 +60,7 @@ def add_arguments(parser):
 
 
 def main(args) -> int:
-    from feelflow.app.files import check_output
+    from feelflow.app.files import check_output, check_output_folder
 
     if args.json:   # before any run
         check_output(args.json, "--json", force=args.force)
@@ -60,11 +70,11 @@ def main(args) -> int:
         return scene_calm(args)
     if args.target == "ringdown":
         return ringdown(args)
+    if args.target == "towed":
+        return towed(args)
     from feelflow.app.reports.seed import PARTS, PROTOCOL, run_part, save_part, write_report
 
-    out = Path(args.out)
-    if not out.is_dir():
-        raise UserError(f"--out: {args.out!r} is not a folder")
+    out = check_output_folder(args.out, "--out")
     phase_steps = phase_steps_option(args.phase_steps, 1)
     parts = PARTS
     keys = None  # protocol diameters
@@ -155,7 +165,28 @@ def ringdown(args) -> int:
     return _print_runs(runs, format_table(runs), args.json)
 
 
-def _chosen(only: str | None, choices: list[str], what: str) -> list[str]:
+def towed(args) -> int:
+    from feelflow.app.headless import gl_context
+    from feelflow.app.reports.towed import format_table, run
+    from feelflow.solver.body import IMPULSE_SCHEMES, REFILL_SCHEMES
+
+    if args.backend == "gl":
+        gl_context()   # one line on stderr, exit 2, when there is no EGL context
+    elif args.backend not in ("numpy", "cpu"):
+        raise UserError(f"--backend: must be numpy, cpu or gl, got {args.backend!r}")
+    refills = [None] if args.refill is None else _chosen(args.refill, list(REFILL_SCHEMES), "scheme", "--refill")
+    impulses = [None] if args.impulse is None else _chosen(args.impulse, list(IMPULSE_SCHEMES), "scheme", "--impulse")
+    print(f"feelflow report towed: held on {args.backend}", file=sys.stderr, flush=True)
+    runs = [run(args.backend, False, quick=args.quick)]
+    for refill in refills:
+        for impulse in impulses:
+            print(f"feelflow report towed: towed (refill {refill or 'default'}, impulse {impulse or 'default'}) "
+                  f"on {args.backend}", file=sys.stderr, flush=True)
+            runs.append(run(args.backend, True, quick=args.quick, refill=refill, impulse=impulse))
+    return _print_runs(runs, format_table(runs), args.json)
+
+
+def _chosen(only: str | None, choices: list[str], what: str, option: str = "--only") -> list[str]:
     """The names given to --only (comma-separated), all of `choices` without it; UserError names
     the first unknown one."""
     if only is None:
@@ -163,7 +194,7 @@ def _chosen(only: str | None, choices: list[str], what: str) -> list[str]:
     names = [k.strip() for k in only.split(",") if k.strip()]
     bad = [k for k in names if k not in choices]
     if bad or not names:
-        raise UserError(f"--only: unknown {what} {bad[0] if bad else only!r}; choose from {', '.join(choices)}")
+        raise UserError(f"{option}: unknown {what} {bad[0] if bad else only!r}; choose from {', '.join(choices)}")
     return names
 
 

@@ -26,6 +26,10 @@ def add_arguments(parser):
     parser.add_argument("--out", default="forces.csv", metavar="PATH", help="CSV file to write (default: forces.csv)")
     parser.add_argument("--record", default=None, metavar="FILE.ffsession",
                         help="also record the run as a session file (docs/reference/session-format.md)")
+    parser.add_argument("--si", default=None, metavar="FLUID:SIZE_M[:SPAN_M]",
+                        help="add SI columns to the CSV for a physical flow with the scene's Reynolds number: "
+                             "FLUID air, water or oil, the body's size (its reference length) and span in metres "
+                             "(default span 0.1), for example water:0.01")
     parser.add_argument("--force", action="store_true",
                         help="replace --out / --record if they exist (never the scene itself; "
                              "without --force an existing file is refused before the run starts)")
@@ -63,6 +67,17 @@ def main(args) -> int:
     from feelflow.solver.backend import BACKENDS
     if backend not in BACKENDS and backend != "auto":   # before the run and its outputs
         raise UserError(f"--backend: must be one of {', '.join(sorted(BACKENDS))} or auto, got {backend!r}")
+    si = None
+    if getattr(args, "si", None):
+        from feelflow.app.model.display_units import DisplayUnits, parse_si
+        from feelflow.solver.units import FLUIDS, PhysicalUnits
+
+        try:
+            choice = parse_si(args.si)
+            si = DisplayUnits(PhysicalUnits(FLUIDS[choice.fluid], choice.size_m, choice.span_m,
+                                            scene.reference_length, scene.reference_speed, scene.config.nu))
+        except ValueError as exc:
+            raise UserError(str(exc).splitlines()[0]) from None
     steps = positive_int_option("--steps", args.steps) if args.steps is not None else scene.steps
     if args.steps is not None:   # the command line's steps: the same bounds as the scene's
         check_work(scene.config.nx, scene.config.ny, steps, "--steps", "--steps")
@@ -92,6 +107,10 @@ def main(args) -> int:
     finally:
         solver.close()
 
+    if si is not None:   # SI columns beside the lattice ones (app/model/display_units.py)
+        from feelflow.app.model.display_units import si_columns
+
+        header, rows = si_columns(header, rows, si)
     csv_error = None
     try:
         save_csv(out, header, rows, "--out")
@@ -116,7 +135,8 @@ def main(args) -> int:
     mlups = cells * steps / wall / 1e6 if wall > 0 else float("nan")
     print(f"{out}: {len(rows)} rows, {steps} steps on {backend} ({scene.config.nx} x {scene.config.ny}, "
           f"Re {scene.reynolds:.4g} with L = {scene.reference_length:g} cells, U = {scene.reference_speed:g}, "
-          f"Ma {scene.mach:.3f}); {wall:.1f} s, {mlups:.1f} MLUPS")
+          f"Ma {scene.mach:.3f}); {wall:.1f} s, {mlups:.1f} MLUPS"
+          + (f"; SI columns for {si.describe()}" if si is not None else ""))
     return 0
 
 
@@ -142,6 +162,24 @@ def warn_outside_stable_region(scene, name) -> bool:
     return True
 
 
+def warn_outside_local_region(scene, solver, step: int) -> bool:
+    """One line on stderr the first time the flow's fastest node leaves the operator's stable
+    region (the local guard, solver/local_guard.py, from the physical-range check's max |u|); the
+    scene runs as written (the window, by contrast, raises the viscosity)."""
+    from feelflow.solver import local_guard
+    from feelflow.solver.operator_choice import NAMES
+
+    if solver.max_speed_at is None:
+        return False
+    cfg = scene.config
+    verdict = local_guard.check(cfg.collision, cfg.nu, solver.max_speed_seen)
+    if verdict.inside:
+        return False
+    print(f"feelflow: warning: step {step}: {verdict.line(NAMES.get(cfg.collision, cfg.collision))} "
+          f"The scene runs as written.", file=sys.stderr)
+    return True
+
+
 def run_scene(scene, solver, steps: int):
     """Step `scene` in `solver` along its motion script for `steps` steps.
 
@@ -157,6 +195,7 @@ def run_scene(scene, solver, steps: int):
     for m in scene.force_models:
         header += [f"fx_{m}", f"fy_{m}"]
     rows = []
+    warned = False
     start = time.perf_counter()
     while runner.t < steps:
         t0 = runner.t
@@ -170,6 +209,8 @@ def run_scene(scene, solver, steps: int):
         values = [v for m in scene.force_models for v in forces[m]]
         if not all(math.isfinite(v) for v in values) or not math.isfinite(solver.total_mass()):
             return header, rows, time.perf_counter() - start, (t0, t0 + n, "NaN")
+        if not warned:
+            warned = warn_outside_local_region(scene, solver, runner.t)
         x, y = runner.position
         rows.append([runner.t] + [_fmt(v) for v in (x, y, *velocity, *values)])
     return header, rows, time.perf_counter() - start, None

@@ -1,4 +1,6 @@
-"""`feelflow session info|replay|export FILE`: look into, re-simulate or export a session file.
+"""`feelflow session info|replay|export|render FILE`: look into, re-simulate, export a session
+file, or render its replay to a video (MP4 or animated GIF, without a window: app/gui/video_export.py
+paints offscreen, PyAV encodes).
 
 Format: docs/reference/session-format.md. A bad file is one line on stderr and exit 2 (app.cli.UserError).
 `replay --check` exits 1 when the replay deviates from the recorded forces by more than
@@ -37,6 +39,17 @@ def add_arguments(parser):
     p.add_argument("--manifest", default=None, metavar="PATH", help="the manifest as JSON")
     p.add_argument("--force", action="store_true",
                    help="replace --csv / --manifest if they exist (never the session itself)")
+    p = sub.add_parser("render", help="replay a session into a video file (MP4 or animated GIF), no window needed")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("--out", default=None, metavar="CLIP.mp4|CLIP.gif", help="the video to write (.mp4 or .gif; required)")
+    p.add_argument("--steps-per-frame", default="50", metavar="N",
+                   help="solver steps replayed between two frames (default 50)")
+    p.add_argument("--fps", default="25", metavar="F", help="frames per second of the video (default 25)")
+    p.add_argument("--width", default="960", metavar="PX", help="width of the picture in pixels (default 960)")
+    p.add_argument("--show", default="speed", choices=("speed", "vorticity", "pressure"),
+                   help="what the colours show (default speed)")
+    p.add_argument("--backend", default=None, metavar="numpy|cpu|gl", help="backend (default: the recorded one)")
+    p.add_argument("--force", action="store_true", help="replace --out if it exists (never the session itself)")
 
 
 def _load(path):
@@ -91,20 +104,9 @@ def info(args) -> int:
     return 0
 
 
-def check_replay_memory(session, source) -> None:
-    """UserError before the replay when the largest grid the session uses (its scene or a
-    recorded rebuild) needs more memory than can be used here (app/inputs.py)."""
-    from feelflow.app.inputs import check_memory
-
-    grids = [(session.config.nx, session.config.ny)] + [
-        (p["value"]["config"]["nx"], p["value"]["config"]["ny"]) for p in session.parameters
-        if p.get("name") == "rebuild"]
-    nx, ny = max(grids, key=lambda g: g[0] * g[1])
-    check_memory(nx, ny, str(source), "the largest grid it uses")
-
-
 def replay(args) -> int:
     from feelflow.app.sessions import SessionError, export_csv, replay as run_replay
+    from feelflow.app.sessions.replay import check_replay_memory
 
     try:
         tolerance = float(args.tolerance)
@@ -115,7 +117,10 @@ def replay(args) -> int:
     if args.out:
         check_output(args.out, "--out", inputs=[args.file], force=args.force)
     s = _load(args.file)
-    check_replay_memory(s, args.file)
+    try:
+        check_replay_memory(s, args.file)
+    except SessionError as exc:
+        raise UserError(str(exc)) from None
     backend = args.backend or s.backend
     factory = _make_factory(backend)
     try:
@@ -163,4 +168,57 @@ def export(args) -> int:
 
 
 def main(args) -> int:
-    return {"info": info, "replay": replay, "export": export}[args.action](args)
+    return {"info": info, "replay": replay, "export": export, "render": render}[args.action](args)
+
+
+def _number(option, text, lo, integer=False):
+    try:
+        value = int(text) if integer else float(text)
+    except ValueError:
+        raise UserError(f"{option}: must be {'a whole number' if integer else 'a number'}, got {text!r}") from None
+    if not math.isfinite(value) or value < lo:
+        raise UserError(f"{option}: must be at least {lo:g}, got {text!r}")
+    return value
+
+
+def render(args) -> int:
+    """Replay FILE into a video: headless (Qt's offscreen platform, the numpy canvas's colours)."""
+    import os
+    import time
+
+    from feelflow.app.video import video_format
+
+    if not args.out:
+        raise UserError("session render: give --out CLIP.mp4 (or CLIP.gif), the video to write")
+    out = check_output(args.out, "--out", inputs=[args.file], force=args.force)
+    video_format(out)
+    steps = _number("--steps-per-frame", args.steps_per_frame, 1, integer=True)
+    fps = _number("--fps", args.fps, 1)
+    width = _number("--width", args.width, 64, integer=True)
+    s = _load(args.file)
+    backend = args.backend or s.backend
+    factory = _make_factory(backend)
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")   # no window: the pictures are painted offscreen
+    from PySide6.QtWidgets import QApplication
+
+    app = QApplication.instance() or QApplication(["feelflow"])  # noqa: F841 - QPainter and fonts need it
+    from feelflow.app.cli.commands.exercise import ProgressBar
+    from feelflow.app.gui.video_export import SessionRender
+    from feelflow.app.sessions import SessionError
+
+    start = time.perf_counter()
+    try:
+        job = SessionRender(s, out, backend=backend, steps_per_frame=steps, fps=fps, width=width,
+                            mode=args.show, factory=factory)
+        bar = ProgressBar("of the session")
+        job.run(progress=lambda f: bar(int(round(1000 * f)), 1000))
+    except SessionError as exc:
+        raise UserError(str(exc)) from None
+    wall = time.perf_counter() - start
+    w, h = job.renderer.size
+    n = job.frames
+    print(f"{out}: {n} frames ({w} x {h}, {fps:g} fps, one every {steps} steps of {s.steps}) replayed on "
+          f"{backend}: {1000 * job.seconds / n:.0f} ms a frame ({1000 * job.replay_seconds / n:.0f} ms replaying, "
+          f"{1000 * job.draw_seconds / n:.0f} ms drawing, {1000 * job.encode_seconds / n:.0f} ms encoding); "
+          f"{wall:.1f} s in all, start-up included")
+    return 0

@@ -15,7 +15,7 @@ from PySide6.QtGui import QAction, QActionGroup
 from PySide6.QtWidgets import QApplication
 
 from feelflow.app.model.backend_choice import CANDIDATES, choose_backend
-from feelflow.app.model.simulation import default_base_config
+from feelflow.app.model.flow_choice import default_base_config
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow

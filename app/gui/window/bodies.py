@@ -31,6 +31,12 @@ class BodyController:
 
     def __init__(self, window: "MainWindow"):
         self.w = window
+        window.events.replayStarted.connect(self._replay_started)
+
+    def _replay_started(self):
+        """A replay takes over: the polygon editor closes and a drag is cancelled."""
+        self.set_editing(False)
+        self.w.viewport.cancel_drag()
 
     def _refused(self) -> bool:
         return self.w.sim is None or self.w.replays.refuse("the body follows the recording")

@@ -1,6 +1,6 @@
 """The flow's settings from the side panel: wind, viscosity, walls, grid and force models, and
 Reset flow. Values outside the measured stable region are moved inside it by the model
-(app/model/simulation.py `stable_params`), and the status bar says what changed.
+(app/model/flow_choice.py `stable_params`), and the status bar says what changed.
 """
 from __future__ import annotations
 
@@ -20,6 +20,12 @@ class FlowController:
 
     def __init__(self, window: "MainWindow"):
         self.w = window
+        window.events.replayStopped.connect(self._replay_stopped)
+
+    def _replay_stopped(self, _paused: bool):
+        """Back on the live tunnel: the panel shows its parameters, the status bar its operator."""
+        self.w.panel.show_params(self.w.sim.params, self.w.loop.display_mode)
+        self.after_rebuild()
 
     def apply(self, **changes):
         """`Simulation.set_flow(**changes)` (wind, nu, wall); a bad value is a dialog."""
@@ -69,7 +75,7 @@ class FlowController:
         w.loop.refresh_readouts()
 
     def say_guard(self) -> bool:
-        """Show in the status bar what the stability guard changed (simulation.stable_params)."""
+        """Show in the status bar what the stability guard changed (app/model/flow_choice.py stable_params)."""
         note = self.w.sim.guard_note if self.w.sim is not None else None
         if note:
             self.w.statusBar().showMessage(note, 10000)

@@ -62,6 +62,9 @@ class FrameLoop:
         self.slow_timer = QTimer(window)
         self.slow_timer.setInterval(READOUT_MS)
         self.slow_timer.timeout.connect(self.refresh_readouts)
+        window.events.shownChanged.connect(self.show_model)
+        window.events.replayStarted.connect(lambda: self.timer.setInterval(0))
+        window.events.replayStopped.connect(self._replay_stopped)
 
     def start(self):
         if self.w.sim is not None:
@@ -72,6 +75,23 @@ class FrameLoop:
     def stop(self):
         self.timer.stop()
         self.slow_timer.stop()
+
+    def show_model(self, model):
+        """Point the viewport and the plot at `model` (the live tunnel or a replay) and draw it."""
+        w = self.w
+        vp = w.viewport
+        vp.sim = w.plot.sim = model
+        vp.locked = model is not w.sim
+        vp.tracers = vp.arrow_forces = None
+        self.forget_last_frame()
+        self.upload_field()
+        w.plot.refresh(force=True)
+        vp.update()
+
+    def _replay_stopped(self, paused: bool):
+        """Back on the live tunnel: its own pace and pause."""
+        self.w.actions.pause.setChecked(paused)
+        self.timer.setInterval(30 if paused else 0)
 
     def forget_last_frame(self):
         """The next frame starts afresh (the model shown changed): no frame time to smooth."""
@@ -104,7 +124,7 @@ class FrameLoop:
         if mode != "tracers":
             w.viewport.tracers = None
         w.panel.show_params(w.params_now(), mode)
-        if w.shown is not None and w.shown.solver.gl_context is not None:   # vorticity only where shown
+        if w.shown is not None:   # the field again (a gl texture computes the vorticity only where shown)
             w.make_current()
             self.upload_field()
         w.viewport.update()
@@ -118,7 +138,7 @@ class FrameLoop:
         model = w.shown
         if model is None:
             return None
-        texture = model.solver.field_texture(vorticity=self.display_mode == "vorticity")
+        texture = model.field_texture(vorticity=self.display_mode == "vorticity")
         if texture is not None:
             w.viewport.use_texture(texture)
             return None
@@ -162,6 +182,11 @@ class FrameLoop:
         if not all(math.isfinite(v) for f in forces.values() for v in f):
             self._on_nan()
             return
+        if getattr(sim, "guard_changed", False):   # the local stability guard raised the viscosity
+            sim.guard_changed = False
+            w.flow.say_guard()
+            w.panel.show_params(sim.params, self.display_mode)
+            w.flow.after_rebuild()
         w.inputs.after_frame(forces)
         self._frame_done(now, t0, t1, n, forces, rgba)
 
@@ -199,6 +224,7 @@ class FrameLoop:
         if self.display_mode == "pressure" and vp.frames % 5 == 0:
             vp.rho_ref = self._free_stream_density(rgba)
         self.update_arrows(forces)
+        self.w.probes.sample_frame(rgba if rgba is not None else self._field_array)   # app/gui/window/probes.py
         vp.update()
         # adaptive stepping: cost per step and the rest of the frame, smoothed
         self.step_cost = 0.8 * self.step_cost + 0.2 * (t1 - t0) / n

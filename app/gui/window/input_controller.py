@@ -27,6 +27,8 @@ class InputController:
 
     def __init__(self, window: "MainWindow"):
         self.w = window
+        window.events.replayStarted.connect(self.replay_started)
+        window.events.replayStopped.connect(self.replay_stopped)
         self.device: DeviceInput | None = None
         self._device_seen = None     # the device's target when the replay began
 

@@ -39,6 +39,8 @@ class LessonController:
         w.bodies.set_hold_still(lesson.hold_still and w.sim.runner is None)
         if lesson.wind_sweep:
             w.sim.start_sweep(lesson.wind_sweep, lesson.hold_steps)
+        if lesson.angle_sweep:
+            w.sim.start_polar(lesson.angle_sweep)
         w.loop.set_display_mode(lesson.display)
         w.plot.view.setCurrentIndex(w.plot.view.findData(lesson.plot_view))
         w.viewport.tracers = None

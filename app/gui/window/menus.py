@@ -31,6 +31,8 @@ class Actions:
     undo: QAction
     redo: QAction
     replay_toolbar: QToolBar
+    record_video: QAction | None = None
+    place_probes: QAction | None = None
 
 
 def add_action(window: "MainWindow", menu: QMenu, text: str, slot, shortcut: str | None = None,
@@ -63,6 +65,9 @@ def build_menus(w: "MainWindow") -> Actions:
     stop_replay.setToolTip("Stop the replay and return to the live tunnel (Esc)")
     stop_replay.setEnabled(False)
     f.addSeparator()
+    add_action(w, f, "Export video of a session\u2026", w.video.export_session_dialog)
+    record_video = add_action(w, f, "Record video of the window", w.video.toggle_live, checkable=True)
+    f.addSeparator()
     add_action(w, f, "Quit", w.close, "Ctrl+Q")
     e = bar.addMenu("&Edit")
     undo = w.undo.createUndoAction(w, "Undo")
@@ -78,6 +83,10 @@ def build_menus(w: "MainWindow") -> Actions:
     r.addSeparator()
     w.backends.build_menu(r)   # Solver backend: Automatic / cpu / gl / numpy
     v = bar.addMenu("&View")
+    place_probes = add_action(w, v, "Place probes (click in the flow)", w.probes.set_placing, "P", checkable=True)
+    add_action(w, v, "Remove all probes", w.probes.clear)
+    add_action(w, v, "Units\u2026", w.units.dialog)
+    v.addSeparator()
     add_action(w, v, "Full screen", lambda _=False: w.showNormal() if w.isFullScreen() else w.showFullScreen(), "F11")
     v.addSeparator()
     for key, mode in DISPLAY_MODES.items():
@@ -93,4 +102,4 @@ def build_menus(w: "MainWindow") -> Actions:
     w.addToolBar(Qt.TopToolBarArea, toolbar)
     toolbar.hide()
     return Actions(record=record, replay=replay, stop_replay=stop_replay, pause=pause, undo=undo, redo=redo,
-                   replay_toolbar=toolbar)
+                   replay_toolbar=toolbar, record_video=record_video, place_probes=place_probes)

@@ -47,6 +47,7 @@ class ReplayController:
         recorder = solver.stop_recording()
         path, _ = QFileDialog.getSaveFileName(w, "Save session", "lesson.ffsession", "Sessions (*.ffsession)")
         if path:
+            recorder.probes = w.probes.session_arrays()   # the probes placed while it recorded, if any
             attempt(w, lambda: recorder.save(path), "Could not save the session")
 
     # --- replaying ----------------------------------------------------------------------------
@@ -72,19 +73,16 @@ class ReplayController:
             return False
         if self.replay is not None:
             self.stop()
-        w.bodies.set_editing(False)
-        w.viewport.cancel_drag()
-        w.inputs.replay_started()    # lets go of the body; a device's force fades, its moves are refused
+        w.events.replayStarted.emit()   # before the replay takes over: editing ends, the body is let go
         self.replay = replay
         w.actions.undo.setEnabled(False)
         w.actions.redo.setEnabled(False)
-        self._show(replay)
+        w.events.shownChanged.emit(replay)
         w.actions.pause.setChecked(False)
         w.actions.stop_replay.setEnabled(True)
         w.actions.replay_toolbar.show()
         w.statusBar().clearMessage()   # a passing message (the mouse hint) would be drawn over the label
         self.label.show()
-        w.loop.timer.setInterval(0)
         self.show_progress()
         return True
 
@@ -92,8 +90,10 @@ class ReplayController:
         """A ReplaySimulation of the file on the window's backend; SessionError (one line)."""
         from feelflow.app.model.replay_simulation import ReplaySimulation
         from feelflow.app.sessions import load_session
+        from feelflow.app.sessions.replay import check_replay_memory
 
         session = load_session(path)
+        check_replay_memory(session, path)   # before any grid is allocated
         w = self.w
         w.make_current()
         return ReplaySimulation(session, w.backend, ctx=w.viewport.ctx)
@@ -105,7 +105,7 @@ class ReplayController:
             return
         w = self.w
         w.make_current()
-        self._show(w.sim)
+        w.events.shownChanged.emit(w.sim)
         replay.close()
         w.viewport.banner = None
         self.label.hide()
@@ -113,12 +113,7 @@ class ReplayController:
         w.actions.stop_replay.setEnabled(False)
         w.actions.undo.setEnabled(w.undo.canUndo())
         w.actions.redo.setEnabled(w.undo.canRedo())
-        paused = w.loop.paused
-        w.actions.pause.setChecked(paused)
-        w.loop.timer.setInterval(30 if paused else 0)
-        w.inputs.replay_stopped(paused)
-        w.panel.show_params(w.sim.params, w.loop.display_mode)
-        w.flow.after_rebuild()
+        w.events.replayStopped.emit(w.loop.paused)
         w.statusBar().showMessage("Replay stopped: back to the live tunnel.", 4000)
 
     def close(self):
@@ -126,17 +121,6 @@ class ReplayController:
         if self.replay is not None:
             self.w.make_current()
             self.replay.close()
-
-    def _show(self, model):
-        """Point the viewport and the plot at `model` (live or replay) and draw it."""
-        w = self.w
-        w.viewport.sim = w.plot.sim = model
-        w.viewport.locked = model is self.replay
-        w.viewport.tracers = w.viewport.arrow_forces = None
-        w.loop.forget_last_frame()
-        w.loop.upload_field()
-        w.plot.refresh(force=True)
-        w.viewport.update()
 
     def show_progress(self):
         r = self.replay

@@ -1,0 +1,127 @@
+"""Probes in the window: View > Place probes turns clicks in the view into probes (left click
+places one, right click removes the nearest); each frame the probes sample the field the frame
+loop already has (app/model/probes.py), and the probes' plot beside the forces shows their
+series (app/gui/probe_plot.py). The forces CSV carries their columns (app/gui/force_plot.py)."""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from PySide6.QtCore import Qt, QTimer
+from PySide6.QtWidgets import QDockWidget
+
+from feelflow.app.gui.probe_plot import ProbePlot, probe_colour
+from feelflow.app.model import readouts
+from feelflow.app.model.probes import Probes
+
+if TYPE_CHECKING:
+    from feelflow.app.gui.main_window import MainWindow
+
+PLOT_REFRESH_MS = 250
+PLACING_HINT = "Click in the flow to place a probe (up to 4); right-click one to remove it. View > Place probes ends this."
+
+
+class ProbeController:
+    def __init__(self, window: "MainWindow"):
+        self.w = window
+        self.probes = Probes()
+        self.plot = ProbePlot()
+        self.plot.probes = self.probes
+        self.dock = None
+        self.timer = QTimer(window)
+        self.timer.setInterval(PLOT_REFRESH_MS)
+        self.timer.timeout.connect(self.plot.refresh)
+        window.events.shownChanged.connect(self.model_changed)
+
+    def _ensure_dock(self):
+        if self.dock is not None:
+            return
+        w = self.w
+        self.dock = QDockWidget("Probes", w)
+        self.dock.setObjectName("probe_dock")
+        self.dock.setWidget(self.plot)
+        self.dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetClosable)
+        forces = w.plot.parentWidget()
+        if isinstance(forces, QDockWidget):
+            w.splitDockWidget(forces, self.dock, Qt.Horizontal)   # beside the forces, same height
+        else:
+            w.addDockWidget(Qt.BottomDockWidgetArea, self.dock)
+
+    # --- placing ------------------------------------------------------------------------------
+    def set_placing(self, on: bool):
+        w = self.w
+        w.viewport.probing = bool(on)
+        w.actions.place_probes.setChecked(bool(on))
+        if on:
+            self._ensure_dock()
+            self.dock.show()
+            w.statusBar().showMessage(PLACING_HINT, 20000)
+        elif w.statusBar().currentMessage() == PLACING_HINT:
+            w.statusBar().clearMessage()
+        w.viewport.setCursor(Qt.CrossCursor if on else Qt.ArrowCursor)
+
+    def clicked(self, x: float, y: float, remove: bool):
+        w = self.w
+        model = w.shown
+        if model is None:
+            return
+        if remove:
+            self.probes.remove_near(x, y, radius=max(2.0, 12.0 * model.config.nx / max(1, w.viewport.lattice_rect().width())))
+        else:
+            try:
+                self.probes.add(x, y, model.config.nx, model.config.ny)
+            except ValueError as exc:
+                w.statusBar().showMessage(str(exc), 6000)
+                return
+        self._ensure_dock()
+        self.dock.show()
+        self.show_marks()
+        self.plot.refresh(force=True)
+        self.timer.start()
+
+    def add(self, x: float, y: float):
+        """A probe at (x, y) cells, as a click there places it."""
+        self.clicked(x, y, False)
+
+    def clear(self):
+        self.probes.clear()
+        self.show_marks()
+        self.plot.refresh(force=True)
+
+    def show_marks(self):
+        self.w.viewport.probe_marks = [(p.x, p.y, probe_colour(k), str(k + 1)) for k, p in enumerate(self.probes)]
+        self.w.viewport.update()
+
+    # --- each frame ---------------------------------------------------------------------------
+    def sample_frame(self, field):
+        """Sample every probe from this frame's field: `field` is the (ny, nx, 4) array or a
+        callable that reads it back (the gl path reads it only when there are probes)."""
+        if not len(self.probes):
+            return
+        model = self.w.shown
+        if model is None:
+            return
+        rgba = field() if callable(field) else field
+        if rgba is None:
+            return
+        times = model.history.time   # the forces' sample of this frame: the CSV joins on it
+        self.probes.sample(times[-1] if times else model.solver.time, rgba, readouts.free_stream_density(rgba))
+
+    def session_arrays(self) -> dict | None:
+        """The probes and their series for a session file (None without probes)."""
+        return self.probes.to_arrays() if len(self.probes) else None
+
+    def model_changed(self, model):
+        """A replay started or stopped: the series start again at its steps; a session that
+        was recorded with probes puts them back where they stood."""
+        session = getattr(getattr(model, "player", None), "session", None)
+        arrays = getattr(session, "probes", None)
+        if arrays is not None:
+            restored = Probes.from_arrays(arrays)
+            self.probes.items[:] = restored.items
+        self.probes.clear_series()
+        self.show_marks()
+        if len(self.probes):
+            self._ensure_dock()
+            self.dock.show()
+            self.timer.start()
+        self.plot.refresh(force=True)

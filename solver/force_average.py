@@ -1,0 +1,28 @@
+"""The mean force of several solver calls, each weighted by its steps: what a force row, a
+window frame or a motion phase reports when it ran as several `step(k)` calls (a body moved
+between them, a row run in parts). `Solver.forces()` is already the mean over the steps of one
+call, so the mean over calls of k_1, k_2, ... steps is sum(k_i F_i) / sum(k_i). Lattice units."""
+from __future__ import annotations
+
+
+class StepWeightedMean:
+    """Forces per model, accumulated call by call (`add`) and averaged over all steps added
+    (`mean`); a model absent from some calls counts as zero there, so that its mean is its
+    impulse over the whole span divided by the span."""
+
+    def __init__(self):
+        self._sums: dict[str, list[float]] = {}
+        self.steps = 0
+
+    def add(self, forces: dict, steps: int) -> None:
+        """The mean forces {model: (Fx, Fy)} of a call of `steps` steps."""
+        for name, (fx, fy) in forces.items():
+            acc = self._sums.setdefault(name, [0.0, 0.0])
+            acc[0] += steps * fx
+            acc[1] += steps * fy
+        self.steps += steps
+
+    def mean(self, steps: int | None = None) -> dict[str, tuple[float, float]]:
+        """{model: (Fx, Fy)} averaged over `steps` (default: the steps added)."""
+        n = self.steps if steps is None else steps
+        return {name: (sx / n, sy / n) for name, (sx, sy) in self._sums.items()} if n else {}

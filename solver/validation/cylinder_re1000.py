@@ -1,0 +1,16 @@
+"""The cylinder at Re 1000 (solver/validation/cylinder_high_re.py): `feelflow validate --case cylinder-re1000`."""
+from __future__ import annotations
+
+from feelflow.solver.validation.base import CaseResult, SolverFactory
+from feelflow.solver.validation.cylinder_high_re import (DEFAULT_RESOLUTION, QUICK_RESOLUTION,  # noqa: F401
+                                                          format_details, run_ladder)
+
+NAME = "cylinder-re1000"
+RE = 1000.0
+#: hours at d = 40: `feelflow validate` runs it only when named with --case
+NAMED_ONLY = True
+
+
+def run(make_solver: SolverFactory, resolution: int | None = None, quick: bool = False,
+        backend: str = "numpy") -> CaseResult:
+    return run_ladder(NAME, RE, make_solver, resolution, quick, backend)
