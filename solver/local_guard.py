@@ -90,7 +90,7 @@ class Verdict:
     def line(self, name: str, nu_set: float | None = None) -> str:
         """One sentence for the status bar or the terminal."""
         where = (f"the flow reached |u| {self.max_speed:.3f} (Ma {self.mach:.2f}) where it is fastest, beyond "
-                 f"{MARGIN * self.limit:.3f}, what {name} keeps stable at viscosity {self.nu:.4f}")
+                 f"{MARGIN * self.limit:.3g}, what {name} keeps stable at viscosity {self.nu:.4g}")
         if nu_set is not None:
             return f"Viscosity raised to {nu_set:.4f}: {where}."
         if self.nu_needed is None:
