@@ -22,14 +22,6 @@ def gl_context():
     return _gl_context
 
 
-def release_gl_context() -> None:
-    """Release the process's EGL context (the next gl_context() makes a new one)."""
-    global _gl_context
-    if _gl_context is not None:
-        _gl_context.release()
-        _gl_context = None
-
-
 def make_solver(backend: str, config):
     """Create the named backend for `config`; UserError (one line) when it cannot run here."""
     if backend not in BACKENDS:

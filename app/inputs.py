@@ -9,6 +9,7 @@ Problems are a `UserError`, one line naming the file and what is wrong.
 from __future__ import annotations
 
 import json
+import math
 import os
 import stat
 import tomllib
@@ -94,7 +95,7 @@ def is_folder(path) -> bool:
         return False
 
 
-def check_document(doc, source: str) -> None:
+def check_document(doc, source: str, max_items: int = MAX_ITEMS) -> None:
     """Bound nesting depth, integer size and list length of a parsed document (iteratively); the
     message names the key where the problem is (`scene.steps`, `reference[0].score`)."""
     stack = [(doc, 1, "")]
@@ -104,8 +105,8 @@ def check_document(doc, source: str) -> None:
         if isinstance(value, (dict, list)):
             if depth > MAX_DEPTH:
                 raise UserError(f"{source}: {at}nested more than {MAX_DEPTH} levels deep")
-            if isinstance(value, list) and len(value) > MAX_ITEMS:
-                raise UserError(f"{source}: {at}a list of {len(value)} items (at most {MAX_ITEMS})")
+            if isinstance(value, list) and len(value) > max_items:
+                raise UserError(f"{source}: {at}a list of {len(value)} items (at most {max_items})")
             if isinstance(value, dict):
                 stack.extend((v, depth + 1, f"{where}.{k}" if where else str(k)) for k, v in value.items())
             else:
@@ -152,12 +153,15 @@ def _scan_depth(text: str, source: str, opens: str) -> None:
             depth = max(0, depth - 1)
 
 
-def loads_json(data: bytes, source: str):
-    """Strict JSON: UTF-8, no NaN/Infinity, integers of at most 16 digits, bounded depth."""
+def loads_json(data: bytes, source: str, *, allow_nan: bool = False, max_items: int = MAX_ITEMS):
+    """Strict JSON: UTF-8, no NaN/Infinity (NaN allowed with `allow_nan`: a report's "not
+    measured"), integers of at most 16 digits, bounded depth and list length."""
     text = _text(data, source, "JSON")
     _scan_depth(text, source, "[{")
 
     def constant(name):
+        if allow_nan and name == "NaN":
+            return math.nan
         raise ValueError(f"{name} is not allowed")
 
     try:
@@ -170,7 +174,7 @@ def loads_json(data: bytes, source: str):
         raise UserError(f"{source}: not enough memory to read it") from None
     except ValueError as exc:
         raise UserError(f"{source}: not valid JSON: {shown(str(exc).splitlines()[0], 120)}") from None
-    check_document(doc, source)
+    check_document(doc, source, max_items)
     return doc
 
 
@@ -194,10 +198,11 @@ def loads_toml(data: bytes, source: str):
     return doc
 
 
-def load_json(path, what: str = "JSON file", max_bytes: int = MAX_TEXT_BYTES):
-    """A JSON file read through `read_bytes` and parsed by `loads_json`: the one bounded JSON
-    reader (shape, attempts and session member files all come through here)."""
-    return loads_json(read_bytes(path, what, max_bytes), shown_path(path))
+def load_json(path, what: str = "JSON file", max_bytes: int = MAX_TEXT_BYTES, **options):
+    """A JSON file read through `read_bytes` and parsed by `loads_json` (`options`: its
+    `allow_nan`, `max_items`): the one bounded JSON reader (shape, attempts, backend choice,
+    stored report series and session member files all come through here)."""
+    return loads_json(read_bytes(path, what, max_bytes), shown_path(path), **options)
 
 
 def load_toml(path, what: str = "TOML file", max_bytes: int = MAX_TEXT_BYTES):

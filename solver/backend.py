@@ -346,12 +346,19 @@ def needs_gl_context(backend: str) -> bool:
     return backend in GL_CONTEXT_BACKENDS
 
 
+#: collision operators only the numpy reference implements (solver/kbc.py: entropic KBC, kept for
+#: the comparison in docs/science/collision-operators.md)
+NUMPY_ONLY_COLLISIONS = ("kbc",)
+
+
 def create_solver(backend: str, config: FlowConfig, ctx=None) -> Solver:
     """Instantiate a backend by name. Every caller passes the GL context it has (or None) the
     same way: a backend that draws on one (`needs_gl_context`) gets it and refuses None, the
     others ignore it."""
     if backend not in BACKENDS:
         raise BackendError(f"unknown backend {backend!r}; choose one of {sorted(BACKENDS)}")
+    if config.collision in NUMPY_ONLY_COLLISIONS and backend != "numpy":
+        raise BackendError(f"the {config.collision} collision runs on the numpy backend only, not {backend!r}")
     module_name, cls_name = BACKENDS[backend].split(":")
     cls = getattr(importlib.import_module(module_name), cls_name)
     return cls(config, ctx=ctx) if needs_gl_context(backend) else cls(config)

@@ -12,8 +12,9 @@ from feelflow.solver.quiet_inlet import shortest_ramp
 
 X_BOUNDARIES = ("tunnel", "periodic")
 Y_BOUNDARIES = ("no_slip", "free_slip", "periodic")
-#: bgk, trt, and "rr": recursive-regularised BGK (solver/regularised.py), the high-Reynolds operator
-COLLISIONS = ("bgk", "trt", "rr")
+#: bgk, trt, "rr": recursive-regularised BGK (solver/regularised.py), the high-Reynolds operator,
+#: and "kbc": entropic KBC (solver/kbc.py; numpy backend only, for comparison)
+COLLISIONS = ("bgk", "trt", "rr", "kbc")
 #: the equilibrium's velocity terms: rho u (compressible, the seed's eq. 9) or RHO0 u with
 #: u = j / RHO0 (incompressible, He & Luo 1997, J. Stat. Phys. 88, 927)
 EQUILIBRIA = ("compressible", "incompressible")
@@ -92,8 +93,8 @@ class FlowConfig:
         need(self.equilibrium in EQUILIBRIA, "equilibrium", f"must be one of {EQUILIBRIA}, got {self.equilibrium!r}")
         need(math.isfinite(self.smagorinsky) and 0.0 <= self.smagorinsky <= 0.5, "smagorinsky",
              f"must be in 0..0.5, got {self.smagorinsky!r}")
-        need(self.smagorinsky == 0.0 or self.collision == "rr", "smagorinsky",
-             f"only the rr collision takes a Smagorinsky constant (collision is {self.collision!r})")
+        need(self.smagorinsky == 0.0 or self.collision in ("rr", "kbc"), "smagorinsky",
+             f"only the rr and kbc collisions take a Smagorinsky constant (collision is {self.collision!r})")
         need(0 < self.trt_magic < 10, "trt_magic", f"must be in (0, 10), got {self.trt_magic!r}")
         need(self.dtype in DTYPES, "dtype", f"must be one of {DTYPES}, got {self.dtype!r}")
         need(self.x_boundary in X_BOUNDARIES, "x_boundary", f"must be one of {X_BOUNDARIES}, got {self.x_boundary!r}")

@@ -7,7 +7,8 @@ The region is the operator's linear (von Neumann) stability region, measured by
 solver/validation/linear_stability.py on the numpy reference operators: a uniform flow at
 speed |u| and viscosity nu is stable when no disturbance of any wavelength grows, along every
 direction of the flow (0, 22.5 and 45 degrees; 22.5 is the weakest for TRT, 45 for rr).
-`LINEAR_LIMIT` holds, per operator, the largest such |u| at each tabulated viscosity
+`LINEAR_LIMIT` holds, per operator, the largest such |u| at each tabulated viscosity (an
+operator without a row, KBC, whose entropic gamma is not linearisable at equilibrium, gets BGK's)
 (`python -m feelflow.solver.local_guard` prints and checks the table). A flow whose fastest node
 moves faster than `MARGIN` x that limit at its viscosity has left the region there: the guard
 asks for the smallest tabulated-and-interpolated viscosity whose limit covers it.
@@ -89,7 +90,7 @@ class Verdict:
     def line(self, name: str, nu_set: float | None = None) -> str:
         """One sentence for the status bar or the terminal."""
         where = (f"the flow reached |u| {self.max_speed:.3f} (Ma {self.mach:.2f}) where it is fastest, beyond "
-                 f"{MARGIN * self.limit:.3f}, what {name} keeps stable at viscosity {self.nu:.4f}")
+                 f"{MARGIN * self.limit:.3g}, what {name} keeps stable at viscosity {self.nu:.4g}")
         if nu_set is not None:
             return f"Viscosity raised to {nu_set:.4f}: {where}."
         if self.nu_needed is None:

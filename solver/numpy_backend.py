@@ -3,7 +3,7 @@
 Storage: post-collision populations shifted by their rest value, g_i = f*_i - w_i RHO0, so
 float32 keeps density fluctuations of 1e-5 (Skordos 1993). Streaming is a periodic shift of
 each population by slicing, then the boundary rules overwrite what they own in reverse order
-of priority (d outlet, c inlet, b walls, a body), then collision (BGK, TRT or recursive-regularised BGK, Guo forcing).
+of priority (d outlet, c inlet, b walls, a body), then collision (BGK, TRT, recursive-regularised BGK or entropic KBC, Guo forcing).
 Every boundary rule is affine with coefficients summing to one, so it applies to g unchanged.
 """
 from __future__ import annotations
@@ -18,6 +18,7 @@ from feelflow.solver.config import FlowConfig
 from feelflow.solver.forces.base import BodyWindow
 from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS, inlet_wall_profile, outlet_incoming, profile, ramp
 from feelflow.solver.lattice import C, OPP, Q, RHO0, W, equilibrium
+from feelflow.solver.kbc import KBCCollider
 from feelflow.solver.regularised import RegularisedCollider
 from feelflow.solver.relaxation import relaxation_rates
 from feelflow.solver.quiet_inlet import checked_reference, quiet_terms, wall_velocity_correction
@@ -53,7 +54,10 @@ class NumpySolver(Solver):
         self._drho_ref = np.zeros(ny, dtype=self.dtype)  # the quiet inlet's reference (quiet_inlet.py)
         self._w = W.astype(self.dtype)
         op, om = relaxation_rates(cfg)
-        if cfg.collision == "rr":
+        if cfg.collision == "kbc":
+            self._collide = KBCCollider(ny, nx, self.dtype, op, cfg.body_force, keep=absorb_keep(cfg),
+                                        incompressible=cfg.incompressible, smagorinsky=cfg.smagorinsky)
+        elif cfg.collision == "rr":
             self._collide = RegularisedCollider(ny, nx, self.dtype, op, cfg.body_force, keep=absorb_keep(cfg),
                                                 incompressible=cfg.incompressible, smagorinsky=cfg.smagorinsky)
         else:

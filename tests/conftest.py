@@ -19,14 +19,14 @@ def gl_context():
     """The process's standalone EGL OpenGL 3.3 core context (app.headless.gl_context: llvmpipe
     where there is no GPU), the one the CLI's gl solvers get too."""
     from feelflow.app.errors import UserError
-    from feelflow.app.headless import gl_context as egl_context, release_gl_context
+    from feelflow.app.headless import gl_context as egl_context
 
     try:
         ctx = egl_context()
     except UserError as exc:  # no EGL on this machine: the gl tier cannot run
         pytest.fail(f"EGL standalone context unavailable: {exc}")
     yield ctx
-    release_gl_context()   # released and forgotten: a later gl_context() makes a new one
+    ctx.release()   # at the end of the session: nothing in this process draws after it
 
 
 def make_solver(backend: str, config, request=None):

@@ -50,3 +50,21 @@ def test_place_a_probe_see_its_trace_and_csv(window, qtbot):  # noqa: F811
     assert len(w.probes.probes) == 1 and w.probes.probes.items[0].x > x0
     w.probes.set_placing(False)
     assert not w.viewport.probing
+
+
+def test_probes_are_recorded_in_the_session_and_come_back_in_its_replay(window, qtbot, tmp_path, monkeypatch):  # noqa: F811
+    from PySide6.QtWidgets import QFileDialog
+
+    w = window
+    path = tmp_path / "probed.ffsession"
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(path), ""))
+    w.probes.add(8.0, w.sim.pos[1])
+    w.replays.toggle_recording()
+    qtbot.waitUntil(lambda: len(w.probes.probes.items[0].time) > 5, timeout=20000)
+    w.replays.toggle_recording()          # stop: saved with the probe
+    assert path.exists()
+    w.probes.clear()
+    assert w.replays.start(path)
+    assert len(w.probes.probes) == 1 and w.probes.probes.items[0].x == 8.0   # put back where it stood
+    qtbot.waitUntil(lambda: len(w.probes.probes.items[0].time) >= 1, timeout=20000)   # sampling the replay
+    w.replays.stop()

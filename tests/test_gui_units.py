@@ -1,7 +1,8 @@
 """Units in the real window (Xvfb): View > Units switches lattice units to SI for water, and
 the side panel's drag and lift, the force plot's axes, the probes' plot and the forces CSV all
-change together; the drag the window shows in newtons is the lattice drag converted by hand
-from water's density and viscosity (no hidden factor); back to lattice units restores them."""
+change together; the vortex-street lesson's drag the window shows in newtons is its lattice drag
+converted by hand from water's density and viscosity (no hidden factor); back to lattice units
+restores them."""
 from __future__ import annotations
 
 import csv
@@ -23,8 +24,9 @@ def test_switch_units_and_convert_the_drag_by_hand(window, qtbot):  # noqa: F811
     from feelflow.app.model.display_units import UnitsChoice
 
     w = window
+    assert w.lessons.apply("vortex_street")      # a lesson: the cylinder at Re 100 (Presets menu)
     w.probes.add(6.0, w.sim.pos[1])
-    qtbot.waitUntil(lambda: len(w.sim.history.time) > 40 and len(w.probes.probes.items[0].time) > 5, timeout=20000)
+    qtbot.waitUntil(lambda: len(w.sim.history.time) > 20 and len(w.probes.probes.items[0].time) > 5, timeout=30000)
     assert "lattice units" in w.panel.drag.text()
     assert w.plot.plot.getAxis("left").labelText == "force (lattice units)"
     lattice_header = next(csv.reader(io.StringIO(w.plot.csv_text())))

@@ -160,6 +160,23 @@ def bypassing_command() -> types.ModuleType:
     return module
 
 
+def test_every_option_that_writes_names_a_file():
+    """An output must be found by the enumeration above: an option whose help says it writes or
+    saves something has a file metavar (PATH, FILE, DIR or a suffix)."""
+    found = {(words, opt) for words, opt, _ in file_options(cli.build_parser())}
+
+    def writing(parser, words=()):
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    yield from writing(sub, words + (name,))
+            elif action.option_strings and re.search(r"\b(write|writes|save|saves|record)\b", action.help or "", re.I) \
+                    and action.nargs != 0:
+                yield " ".join(words), action.option_strings[-1]
+    hidden = [f"{w} {o}".strip() for w, o in writing(cli.build_parser()) if (w, o) not in found]
+    assert hidden == [], f"options that write but have no file metavar: {hidden}"
+
+
 def test_the_enumeration_catches_a_bypassing_output(tmp_path, monkeypatch, capsys):
     monkeypatch.setitem(sys.modules, "feelflow.app.cli.commands.bypass", bypassing_command())
     monkeypatch.setitem(cli.COMMANDS, "bypass", "a command that skips the door (test only)")

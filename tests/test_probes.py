@@ -56,3 +56,41 @@ def test_limits_removal_and_arrays_round_trip():
     assert [(q.x, q.y, q.time, q.ux) for q in again] == [(q.x, q.y, q.time, q.ux) for q in probes]
     assert probes.remove_near(5.3, 5.2) and len(probes) == MAX_PROBES - 1
     assert not probes.remove_near(19.0, 1.0)
+
+
+def test_probes_travel_in_a_session_file(tmp_path):
+    """The optional probes.npz member: written with the recording, read back, checked."""
+    import zipfile
+
+    from feelflow.app.sessions import SessionError, SessionRecorder, SessionSolver, load_session
+    from feelflow.solver.backend import create_solver
+    from session_scenes import MODELS, drive_moving_cylinder, small_config, start_body
+
+    cfg = small_config()
+    rec = SessionRecorder(cfg, start_body(), MODELS)
+    drive_moving_cylinder(SessionSolver(create_solver("numpy", cfg), rec), steps=5, extras=False)
+    probes = Probes()
+    probes.add(5.0, 16.0, cfg.nx, cfg.ny)
+    probes.sample(3, linear_field(cfg.nx, cfg.ny), 1.0)
+    rec.probes = probes.to_arrays()
+    path = tmp_path / "with-probes.ffsession"
+    rec.save(path)
+    again = Probes.from_arrays(load_session(path).probes)
+    assert [(p.x, p.y, p.time, p.ux) for p in again] == [(p.x, p.y, p.time, p.ux) for p in probes]
+    rec.probes = None                      # without probes: no member, and None back
+    rec.save(tmp_path / "plain.ffsession")
+    assert load_session(tmp_path / "plain.ffsession").probes is None
+    # a damaged member is one line
+    bad = tmp_path / "bad.ffsession"
+    with zipfile.ZipFile(path) as src, zipfile.ZipFile(bad, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            if item.filename == "probes.npz":
+                import io
+
+                buf = io.BytesIO()
+                np.savez(buf, positions=np.array([[np.nan, 1.0]]))
+                data = buf.getvalue()
+            dst.writestr(item, data)
+    with pytest.raises(SessionError, match="positions must be up to 4 finite"):
+        load_session(bad)

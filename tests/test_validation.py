@@ -70,10 +70,23 @@ KNOWN_MISSES = {
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.xfail(strict=True, reason=KNOWN_MISSES[name]))
-                                  if name in KNOWN_MISSES else name for name in CASES])
+                                  if name in KNOWN_MISSES else name for name in CASES
+                                  if not getattr(case_module(name), "NAMED_ONLY", False)])
 def test_full_case_meets_its_targets(name, request):
     r = case_module(name).run(factory("numpy", request), backend="numpy")
     assert r.passed, r.to_dict()
+
+
+@pytest.mark.slow
+def test_cylinder_at_re200_sheds_at_the_published_strouhal_at_10_cells(request):
+    """The high-Reynolds case at its coarsest rung (the whole ladder d = 10, 20, 40 takes hours:
+    `feelflow validate --case cylinder-re200`): St within its 3 % target; C_D is measured 7.8 %
+    high at 10 cells (docs/science/collision-operators.md), outside its 5 % target there, so only
+    its sign and size are held here."""
+    r = case_module("cylinder-re200").run(factory("numpy", request), resolution=10, backend="numpy")
+    q = r.quantities
+    assert q["converged"] == 1.0 and r.check_results()["strouhal"], r.to_dict()
+    assert 0.0 < q["cd_mean"] / 1.34 - 1.0 < 0.10, q
 
 
 @pytest.mark.slow

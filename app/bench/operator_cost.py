@@ -4,7 +4,8 @@ costs per step, on the numpy and the gl backend, in the window's tunnel.
 The tunnel scene of `feelflow bench solver` (app/bench/solver_speed.py: inlet, pressure outlet with
 its sponge, a cylinder moved every 10 steps, the reference force every step) at the window's
 default grid 256 x 128, float32, with each operator of solver/operator_choice.py and the others:
-TRT, BGK, recursive-regularised BGK (rr), rr with a Smagorinsky constant 0.1. Operators run in
+TRT, BGK, recursive-regularised BGK (rr), rr with a Smagorinsky constant 0.1, and entropic KBC
+with and without it (numpy only: solver/kbc.py). Operators run in
 alternating rounds; the table gives median steps per second and, per backend, the cost of a
 step relative to TRT's measured in the same run (the chooser's "cheapest" is read from it).
 """
@@ -15,7 +16,7 @@ import time
 
 from feelflow.app.bench.solver_speed import SceneRun, machine, scene_config
 
-OPERATORS = (("trt", 0.0), ("bgk", 0.0), ("rr", 0.0), ("rr", 0.1))
+OPERATORS = (("trt", 0.0), ("bgk", 0.0), ("rr", 0.0), ("rr", 0.1), ("kbc", 0.0), ("kbc", 0.1))
 GRID = (256, 128)
 
 
@@ -48,15 +49,21 @@ def main(args) -> int:
     quick = bool(getattr(args, "quick", False))
     rounds = getattr(args, "rounds", None) or (1 if quick else 3)
     steps = {"numpy": 60 if quick else 300, "gl": 200 if quick else 1000}
-    rates = {(b, op): [] for b in steps for op in OPERATORS}
+    from feelflow.solver.backend import NUMPY_ONLY_COLLISIONS
+
+    def runs_on(backend, op):
+        return backend == "numpy" or op[0] not in NUMPY_ONLY_COLLISIONS
+
+    rates = {(b, op): [] for b in steps for op in OPERATORS if runs_on(b, op)}
     for _ in range(rounds):
         for backend in steps:
             for op in OPERATORS:
-                rates[(backend, op)].append(measure(backend, *op, steps[backend]))
+                if runs_on(backend, op):
+                    rates[(backend, op)].append(measure(backend, *op, steps[backend]))
     rows = []
     for backend in steps:
         base = statistics.median(rates[(backend, OPERATORS[0])])
-        for op in OPERATORS:
+        for op in (op for op in OPERATORS if runs_on(backend, op)):
             rate = statistics.median(rates[(backend, op)])
             rows.append({"backend": backend, "operator": label(*op), "steps_per_s": rate,
                          "mlups": rate * GRID[0] * GRID[1] / 1e6, "cost_vs_trt": base / rate})

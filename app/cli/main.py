@@ -41,6 +41,12 @@ def build_parser() -> argparse.ArgumentParser:
                         help="open the real window, exercise it and exit 0 only if everything worked")
     parser.add_argument("--screenshot", metavar="PATH", help="with --selftest: save a screenshot")
     parser.add_argument("--seconds", type=float, default=8.0, help="with --selftest: how long to run")
+    parser.add_argument("--lesson", default=None, metavar="KEY",
+                        help="with --selftest: run this lesson (app/model/presets.py) for --seconds instead of the "
+                             "default script, then save the screenshot (e.g. polar)")
+    parser.add_argument("--plot-view", default=None, metavar="VIEW",
+                        help="with --selftest --lesson: the force plot's view for the screenshot (time, speed, polar, "
+                             "drag_polar, cp)")
     parser.add_argument("--frame-profile", action="store_true",
                         help="with --selftest: also print where a frame's time goes (solver, drawing, plot, Qt)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")

@@ -63,8 +63,10 @@ class SelfTest:
     """Drives the window from a timer; `exit_code` is set when the application quits."""
 
     def __init__(self, window, seconds: float = 8.0, screenshot: str | None = None, out=sys.stdout,
-                 replay: bool = False, frame_profile: bool = False):
+                 replay: bool = False, frame_profile: bool = False, lesson: str | None = None,
+                 plot_view: str | None = None):
         self.window, self.seconds, self.screenshot, self.out = window, max(4.0, seconds), screenshot, out
+        self.lesson, self.plot_view = lesson, plot_view   # --lesson: run a lesson for the screenshot
         self.replay = replay   # the window replays a session (feelflow --selftest gui SESSION): measure that
         self.profile = None    # a FrameProfile over the measured frames (--frame-profile), or None
         if frame_profile and not replay:
@@ -104,6 +106,9 @@ class SelfTest:
             yield
         if self.replay:
             yield from self._replay_script()
+            return
+        if self.lesson is not None:
+            yield from self._lesson_script()
             return
         yield from self._wait(1.0)                      # warm-up: shader compile, adaptive stepping
         sim = w.sim
@@ -148,6 +153,32 @@ class SelfTest:
         if len(fresh) == 0 or not np.isfinite(fresh).any():
             self.failures.append("the plot got no data from the pressure model")
         w.loop.refresh_readouts()
+        self._save_screenshot()
+
+    def _lesson_script(self):
+        """Run a lesson for `seconds`, show the plot view asked for, check the plot has data from
+        the flow, save the screenshot (how docs/guide's lesson screenshots are made)."""
+        w = self.window
+        if not w.lessons.apply(self.lesson):
+            self.failures.append(f"the lesson {self.lesson} did not start")
+            return
+        sim = w.sim
+        yield from self._wait(self.seconds)
+        if self.plot_view is not None:
+            index = w.plot.view.findData(self.plot_view)
+            if index < 0:
+                self.failures.append(f"the plot has no view {self.plot_view!r}")
+                return
+            w.plot.view.setCurrentIndex(index)
+            yield from self._wait(1.5)
+        w.loop.refresh_readouts()
+        w.plot.refresh(force=True)
+        self.results["grid"] = f"{sim.config.nx}x{sim.config.ny}"
+        polar = sim.polar
+        if polar is not None:
+            self.results["polar_points"] = len(polar.sweep.points)
+        if len(sim.history) == 0:
+            self.failures.append("the plot got no data")
         self._save_screenshot()
 
     def _replay_script(self):
@@ -198,6 +229,8 @@ class SelfTest:
         if "replay_step" in r:
             print(f"selftest: replay at step {r['replay_step']} of {r['replay_total']}, "
                   f"{r['replay_rows']} force rows replayed", file=self.out)
+        if "polar_points" in r:
+            print(f"selftest: the polar has {r['polar_points']} settled angles", file=self.out)
         if "body_moved_cells" in r:
             print(f"selftest: body moved {r['body_moved_cells']:.1f} cells when dragged", file=self.out)
         if "screenshot" in r:

@@ -12,7 +12,6 @@ choice is used as it is: nothing re-times or switches while a lesson runs.
 """
 from __future__ import annotations
 
-import json
 import os
 import re
 import time
@@ -68,9 +67,14 @@ class JsonFileStore:
         self.path = Path(path)
 
     def _read(self) -> dict:
-        try:
-            data = json.loads(self.path.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+        from feelflow.app.errors import UserError
+        from feelflow.app.inputs import exists, load_json
+
+        if not exists(self.path):
+            return {}
+        try:   # the one bounded reader (app/inputs.py): a pipe or a huge file is an empty store
+            data = load_json(self.path, "backend choice file", 1 << 20)
+        except UserError:
             return {}
         return data if isinstance(data, dict) else {}
 

@@ -145,10 +145,13 @@ def save_part(folder: Path, data: dict) -> None:
 
 
 def _read_json(path: Path) -> dict:
+    """A stored series, through the one bounded reader (app/inputs.py)."""
+    from feelflow.app.inputs import load_json
+
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as exc:
-        raise UserError(f"{path}: not valid JSON ({exc.msg}); run that part again") from None
+        return load_json(path, "stored series", 256 << 20, allow_nan=True, max_items=10 ** 8)
+    except UserError as exc:
+        raise UserError(f"{exc}; run that part again") from None
 
 
 def load_parts(folder: Path) -> dict:

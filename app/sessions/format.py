@@ -39,6 +39,12 @@ PARAMETERS = "parameters.json"
 INPUTS = "inputs.npz"
 FORCES = "forces.npz"
 STATE = "state.npz"  # only when the recording started on a running flow (manifest "start")
+#: optional: the probes placed in the window while it recorded (app/model/probes.py `to_arrays`):
+#: `positions` (k, 2) lattice cells, `probe0`..`probe3` (n, 4) rows of step, ux, uy, p. A reader
+#: without probes ignores it, so it needs no new format version.
+PROBES = "probes.npz"
+PROBES_MAX_BYTES = 16 << 20
+PROBE_NAMES = ("positions", "probe0", "probe1", "probe2", "probe3")
 MEMBERS = (MANIFEST, PARAMETERS, INPUTS, FORCES)
 #: largest uncompressed member we read (a zip bomb is refused before it is inflated); the
 #: array members are bounded tighter, by the rows and grid the manifest declares
@@ -159,6 +165,7 @@ class Session:
     start: dict | None = None        # manifest "start": recording began on a running flow
     state: np.ndarray | None = None  # then its populations f (9, ny, nx), from state.npz
     inlet_reference: np.ndarray | None = None  # and the quiet inlet's reference (ny,), if it has one
+    probes: dict | None = None       # the window's probes, from the optional probes.npz (PROBES)
     source: str = field(default="session", compare=False)
 
     @property
@@ -236,6 +243,8 @@ def session_bytes(session: Session) -> bytes:
             if session.inlet_reference is not None:
                 arrays[INLET_REFERENCE] = np.asarray(session.inlet_reference, dtype=np.float64)
             zf.writestr(STATE, _npz_bytes(arrays))
+        if session.probes:
+            zf.writestr(PROBES, _npz_bytes(session.probes))
     return buf.getvalue()
 
 
@@ -295,19 +304,46 @@ def load_session(path) -> Session:
         limits = member_limits(manifest, fail, MANIFEST, (INPUTS, FORCES, STATE))
         for member in (INPUTS, FORCES) + ((STATE,) if STATE in names else ()):
             read(member, limits[member])
+        if PROBES in names:
+            read(PROBES, PROBES_MAX_BYTES)
     parameters = _json_member(data[PARAMETERS], PARAMETERS, fail)
     starts = isinstance(manifest, dict) and manifest.get("start") is not None
     if starts and STATE not in data:
         fail(f"the recording starts on a running flow but member {STATE} is missing")
     state = _npz_member(data[STATE], STATE, STATE_ARRAYS, fail)["f"] if starts else None
     reference = _optional_array(data[STATE], STATE, INLET_REFERENCE, fail) if starts else None
+    probes = _probe_arrays(data[PROBES], fail) if PROBES in data else None
     try:
-        return _validate(manifest, parameters, _npz_member(data[INPUTS], INPUTS, INPUT_ARRAYS, fail),
-                         _npz_member(data[FORCES], FORCES, FORCE_ARRAYS, fail), src, state, reference)
+        session = _validate(manifest, parameters, _npz_member(data[INPUTS], INPUTS, INPUT_ARRAYS, fail),
+                            _npz_member(data[FORCES], FORCES, FORCE_ARRAYS, fail), src, state, reference)
+        session.probes = probes
+        return session
     except SessionError as exc:
         if str(exc).startswith(src + ": "):
             raise
         fail(str(exc))
+
+
+def _probe_arrays(raw: bytes, fail) -> dict:
+    """The optional probes member: `positions` (k <= 4, 2) finite, `probeK` (n, 4) float64 for
+    K < k; nothing else (no pickle)."""
+    check_npz(raw, PROBES, fail)
+    try:
+        with np.load(io.BytesIO(raw), allow_pickle=False) as npz:
+            names = set(npz.files)
+            if "positions" not in names or not names <= set(PROBE_NAMES):
+                fail(f"{PROBES} holds {sorted(names)}; expected positions and probe0..probe3")
+            arrays = {k: npz[k] for k in names}
+    except (ValueError, OSError, zipfile.BadZipFile, EOFError) as exc:
+        fail(f"{PROBES} is not a readable .npz archive ({type(exc).__name__})")
+    pos = arrays["positions"]
+    if pos.dtype != np.float64 or pos.ndim != 2 or pos.shape[1] != 2 or len(pos) > 4 or not np.isfinite(pos).all():
+        fail(f"{PROBES}: positions must be up to 4 finite (x, y) pairs, got {pos.dtype} {pos.shape}")
+    for k in range(len(pos)):
+        a = arrays.get(f"probe{k}")
+        if a is None or a.dtype != np.float64 or a.ndim != 2 or a.shape[1] != 4:
+            fail(f"{PROBES}: probe{k} must be (n, 4) float64 rows of step, ux, uy, p")
+    return arrays
 
 
 def _json_member(raw: bytes, member: str, fail):

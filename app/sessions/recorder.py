@@ -33,6 +33,7 @@ class SessionRecorder:
         self.body = body
         self.force_models = tuple(force_models)
         self.backend = backend
+        self.probes: dict | None = None   # the window's probes (app/model/probes.py to_arrays), saved with it
         self.renderer = renderer or ("none (numpy on the CPU)" if backend == "numpy" else "unknown")
         self.scene_toml = scene_toml
         self.scene_source = scene_source
@@ -128,6 +129,7 @@ class SessionRecorder:
                     "body": np.array([r[3] for r in self._forces], dtype=np.float64).reshape(nf, 4),
                     "values": values},
             models=tuple(self._models), start=self.start, state=self.state, inlet_reference=self.inlet_reference,
+            probes=self.probes,
         )
 
     def _manifest(self) -> dict:

@@ -65,7 +65,7 @@ QUIET_INLET_RATE = 1e-3
 SCENES = ("plate45", "cylinder_impulsive", "cylinder_shaken", "wedge_upstream")
 COLLISIONS = ("bgk", "trt")
 #: every operator a single point can run (`main`); the scan keeps COLLISIONS
-ALL_COLLISIONS = ("bgk", "trt", "rr")
+ALL_COLLISIONS = ("bgk", "trt", "rr", "kbc")
 VISCOSITIES = (0.002, 0.003, 0.004, 0.006, 0.008, 0.012, 0.018, 0.027, 0.04)
 SPEEDS = (0.02, 0.035, 0.05, 0.07, 0.09)
 SIZE_CHECK = (10, 40)

@@ -126,8 +126,14 @@ def main(args) -> int:
     if selftest:
         from feelflow.app.gui.selftest import SelfTest
 
+        lesson = getattr(args, "lesson", None)
+        from feelflow.app.model.presets import PRESETS
+
+        if lesson is not None and lesson not in PRESETS:
+            raise UserError(f"--lesson: one of {', '.join(PRESETS)}, got {lesson!r}")
         test = SelfTest(window, seconds=args.seconds, screenshot=args.screenshot, replay=session is not None,
-                        frame_profile=getattr(args, "frame_profile", False))
+                        frame_profile=getattr(args, "frame_profile", False), lesson=lesson,
+                        plot_view=getattr(args, "plot_view", None))
         window.show()
         app.exec()
         if window.startup_error:

@@ -124,6 +124,11 @@ def main(args) -> int:
             shape.moved(angle=-math.radians(a)).validate(config.nx, config.ny)
     except Exception as exc:   # ShapeError, ConfigError: one line
         raise UserError(f"{args.scene}: {str(exc).splitlines()[0]}") from None
+    from feelflow.app.inputs import check_memory, check_work
+
+    # the scaled grid: the scene files' node bound and the memory it needs, before the run
+    check_work(config.nx, config.ny, 0, f"{args.scene} at --scale {factor}", "grid")
+    check_memory(config.nx, config.ny, f"{args.scene} at --scale {factor}", "grid")
 
     speed = config.inflow_speed
     chord = chord_of(shape)

@@ -25,11 +25,11 @@ def add_arguments(parser):
                              "is 4.1 diameters high; channel width for poiseuille, grid size for taylor-green); "
                              "default: each case's own")
     parser.add_argument("--backend", default="numpy", metavar="numpy|cpu|gl", help="solver backend (default: numpy)")
-    parser.add_argument("--collision", default=None, metavar="bgk|trt|rr",
+    parser.add_argument("--collision", default=None, metavar="bgk|trt|rr|kbc",
                         help="run the cases with this collision operator instead of their own (not the stability "
                              "case, which names its operators)")
     parser.add_argument("--smagorinsky", default=0.0, type=float, metavar="C",
-                        help="Smagorinsky constant with --collision rr (default 0: none)")
+                        help="Smagorinsky constant with --collision rr or kbc (default 0: none)")
     parser.add_argument("--json", default=None, metavar="PATH", help="also write the results as JSON")
     parser.add_argument("--force", action="store_true", help="replace --json if it exists")
     parser.add_argument("--quick", action="store_true", help="small grids and short runs (the test-suite versions)")
@@ -128,7 +128,7 @@ def operator_override(args) -> dict:
     smagorinsky = float(getattr(args, "smagorinsky", 0.0) or 0.0)
     if collision is None:
         if smagorinsky:
-            raise UserError("--smagorinsky: needs --collision rr")
+            raise UserError("--smagorinsky: needs --collision rr or kbc")
         return {}
     if collision not in COLLISIONS:
         raise UserError(f"--collision: must be one of {', '.join(COLLISIONS)}, got {collision!r}")

@@ -30,6 +30,7 @@ class ProbeController:
         self.timer = QTimer(window)
         self.timer.setInterval(PLOT_REFRESH_MS)
         self.timer.timeout.connect(self.plot.refresh)
+        window.events.shownChanged.connect(self.model_changed)
 
     def _ensure_dock(self):
         if self.dock is not None:
@@ -105,7 +106,22 @@ class ProbeController:
         times = model.history.time   # the forces' sample of this frame: the CSV joins on it
         self.probes.sample(times[-1] if times else model.solver.time, rgba, readouts.free_stream_density(rgba))
 
-    def model_changed(self):
-        """A replay started or stopped: the series start again at its steps."""
+    def session_arrays(self) -> dict | None:
+        """The probes and their series for a session file (None without probes)."""
+        return self.probes.to_arrays() if len(self.probes) else None
+
+    def model_changed(self, model):
+        """A replay started or stopped: the series start again at its steps; a session that
+        was recorded with probes puts them back where they stood."""
+        session = getattr(getattr(model, "player", None), "session", None)
+        arrays = getattr(session, "probes", None)
+        if arrays is not None:
+            restored = Probes.from_arrays(arrays)
+            self.probes.items[:] = restored.items
         self.probes.clear_series()
+        self.show_marks()
+        if len(self.probes):
+            self._ensure_dock()
+            self.dock.show()
+            self.timer.start()
         self.plot.refresh(force=True)

@@ -47,6 +47,7 @@ class ReplayController:
         recorder = solver.stop_recording()
         path, _ = QFileDialog.getSaveFileName(w, "Save session", "lesson.ffsession", "Sessions (*.ffsession)")
         if path:
+            recorder.probes = w.probes.session_arrays()   # the probes placed while it recorded, if any
             attempt(w, lambda: recorder.save(path), "Could not save the session")
 
     # --- replaying ----------------------------------------------------------------------------
