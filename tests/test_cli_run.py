@@ -185,20 +185,24 @@ def test_validate_reports_a_blow_up_as_a_failed_case():
 
 
 def test_run_record_replays_to_the_same_forces(tmp_path):
-    """`run --record` writes a session whose numpy replay reproduces the run's forces exactly.
+    """`run --record` writes a session whose numpy replay reproduces the run's forces exactly
+    (with `--si` the units are recorded too and change nothing in the replay).
     Its export has one row per solver call (finer than the run's interval means): where both
     have a row the velocity agrees (the export's pose is the pose during the call, the run's the
     pose after it: docs/reference/session-format.md), and over the first interval (one call) the forces too."""
     scene = write(tmp_path, SMALL)
     out, session = tmp_path / "forces.csv", tmp_path / "run.ffsession"
-    result = feelflow("run", scene, "--out", out, "--record", session, "--backend", "numpy")
+    result = feelflow("run", scene, "--out", out, "--record", session, "--si", "water:0.01", "--backend", "numpy")
     assert result.returncode == 0, result.stderr
+    from feelflow.app.sessions import load_session
+    assert load_session(session).units == {"fluid": "water", "size_m": 0.01, "span_m": 0.1}   # --si recorded
     check = feelflow("session", "replay", session, "--check", "--tolerance", "0")
     assert check.returncode == 0, check.stdout + check.stderr
     exported = tmp_path / "export.csv"
     assert feelflow("session", "export", session, "--csv", exported).returncode == 0
-    run_rows = [[float(v) for v in r] for r in list(csv.reader(out.open()))[1:]]
     export_rows = [[float(v) for v in r] for r in list(csv.reader(exported.open()))[1:]]
+    lattice = len(export_rows[0])   # the run's lattice columns; its SI ones (--si) follow them
+    run_rows = [[float(v) for v in r[:lattice]] for r in list(csv.reader(out.open()))[1:]]
     by_step = {r[0]: r for r in export_rows}
     assert set(r[0] for r in run_rows) <= set(by_step)
     for row in run_rows:

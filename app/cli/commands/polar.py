@@ -130,6 +130,9 @@ def main(args) -> int:
     check_work(config.nx, config.ny, 0, f"{args.scene} at --scale {factor}", "grid")
     check_memory(config.nx, config.ny, f"{args.scene} at --scale {factor}", "grid")
 
+    from feelflow.app.cli.commands.run import warn_outside_stable_region
+
+    warn_outside_stable_region(scene, args.scene)
     speed = config.inflow_speed
     chord = chord_of(shape)
     sweep = PolarSweep(angles, speed, chord, sample_steps=max(10, 25 * factor), tolerance=args.tolerance)

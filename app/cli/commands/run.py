@@ -99,6 +99,10 @@ def main(args) -> int:
 
         toml_text = read_bytes(args.scene, "scene file").decode("utf-8")
         solver, recorder = record_headless(solver, scene, scene_toml=toml_text)
+        if si is not None:   # the units chosen, for a replay in the window (session-format.md, "units")
+            from feelflow.app.model.display_units import choice_to_dict
+
+            recorder.units = choice_to_dict(choice)
     try:
         # a blow-up is detected and reported in one line, not as floating-point warnings
         with warnings.catch_warnings(), np.errstate(all="ignore"):
