@@ -65,3 +65,22 @@ def test_cylinder_drag_against_speed_shows_the_published_curve(window, qtbot):
 
     k = int(np.argmin(abs(re - 40)))
     assert fs[k] == pytest.approx(0.5 * published_drag(re[k])[0] * us[k] ** 2 * d)
+
+
+def test_cylinder_readout_shows_the_measured_and_published_strouhal_number(window, qtbot):
+    """A cylinder whose lift swings: the readout gives its St beside Williamson's at that Re
+    (the history here is a swing at St 0.17 fed to the real plot; the vortex street lesson makes
+    one in a few thousand steps)."""
+    window.loop.set_paused(True)
+    sim = window.sim
+    assert sim.shape.kind == "cylinder"
+    sim.history.clear()
+    d, u = sim.shape.diameter, sim.params.wind
+    for t in np.arange(0, 40000, 20.0):
+        lift = 0.01 * np.sin(2 * np.pi * t * 0.17 * u / d)
+        sim.history.add(t, (0.0, 0.0), (u, 0.0), {sim.params.force_model: (0.02, lift)})
+    window.plot.refresh(force=True)
+    text = window.plot.reference_label.text()
+    assert "St 0.170" in text
+    if 49 <= sim.reynolds() <= 178:
+        assert "Williamson 1989" in text

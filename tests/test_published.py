@@ -36,3 +36,14 @@ def test_drag_interpolates_between_the_points_and_stays_inside():
     assert pub.published_drag(10.0) is None and pub.published_drag(150.0) is None
     us, fs = pub.published_drag_force([0.01, 0.02, 0.05, 0.2], diameter=20.0, nu=0.02)
     assert list(us) == [0.02, 0.05] and fs[0] == pytest.approx(0.5 * 2.045 * 0.02 ** 2 * 20.0)
+
+
+def test_the_measured_strouhal_number_of_a_swinging_lift():
+    """A lift swinging at St 0.17 for D 20 at U 0.05 (period D / (St U) = 2353 steps), sampled
+    every 20 steps: measured back to 1 %; a steady lift has none."""
+    t = np.arange(0, 40000, 20.0)
+    lift = 0.3 * np.sin(2 * np.pi * t / (20 / (0.17 * 0.05))) + 0.01
+    assert pub.measured_strouhal(t, lift, 20.0, 0.05) == pytest.approx(0.17, rel=0.01)
+    assert pub.measured_strouhal(t, np.full_like(t, 0.2), 20.0, 0.05) is None
+    assert pub.measured_strouhal(t[:100], lift[:100], 20.0, 0.05) is None   # not three periods yet
+    assert pub.published_strouhal(100.1) == (0.1604, "Williamson 1989") and pub.published_strouhal(40) is None

@@ -109,3 +109,15 @@ def test_scene_panel_and_exercise_know_the_kind(tmp_path):
     assert "naca" in EDIT_KINDS
     with pytest.raises(ValueError, match="cannot be edited here"):
         params_for_shape(NacaAirfoil(40.0, 0.13))
+
+
+def test_an_exercise_may_offer_naca_sections():
+    import tomllib
+    from pathlib import Path
+
+    from feelflow.app.exercises.format import exercise_from_dict
+
+    path = Path(__file__).resolve().parents[1] / "exercises" / "lift_to_drag.toml"
+    data = tomllib.loads(path.read_text())
+    data["edit"]["kinds"] = ["half_airfoil", "naca"]
+    assert list(exercise_from_dict(data, str(path), path).kinds) == ["half_airfoil", "naca"]

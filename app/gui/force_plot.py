@@ -15,7 +15,7 @@ from PySide6.QtWidgets import (QCheckBox, QComboBox, QHBoxLayout, QLabel, QPushB
 from feelflow.app.files import atomic_path, write_text_atomic
 from feelflow.app.gui.polar_views import VIEWS as LIFT_VIEWS, LiftViews
 from feelflow.app.model.power_law import fit_power_law
-from feelflow.app.model import readouts
+from feelflow.app.model import published, readouts
 from feelflow.app.model.display_units import DisplayUnits, si_columns
 from feelflow.app.model.readouts import start_pulse_steps
 from feelflow.app.model.force_history import History
@@ -221,7 +221,18 @@ class ForcePlot(QWidget):
         r = self.readout()
         fmt = readouts.format_coefficient
         self.readout_label.setText(f"C<sub>D</sub> = {fmt(r.cd)} &nbsp; C<sub>L</sub> = {fmt(r.cl)}")
-        self.reference_label.setText(r.reference_text())
+        self.reference_label.setText(r.reference_text() + self._strouhal_text())
+
+    def _strouhal_text(self) -> str:
+        """For a cylinder whose lift swings: its Strouhal number beside the published one
+        (app/model/published.py)."""
+        sim = self.sim
+        shape = getattr(sim, "shape", None)
+        if getattr(shape, "kind", None) != "cylinder":
+            return ""
+        t, _, lift = sim.history.drag_lift(sim.params.force_model)
+        text = published.strouhal_text(t, lift, shape.diameter, sim.params.wind, sim.reynolds())
+        return f"; {text}" if text else ""
 
     def _curve(self, key, pen, name):
         if key not in self.curves:

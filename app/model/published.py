@@ -111,3 +111,42 @@ def published_drag_force(speeds, diameter: float, nu: float):
             us.append(u)
             fs.append(0.5 * got[0] * u * u * diameter)
     return np.array(us), np.array(fs)
+
+
+def published_strouhal(re: float):
+    """(St, source) at `re`: Williamson's measurements interpolated (Re 49 - 178), else None."""
+    res, st = WILLIAMSON_1989.arrays()
+    if not (res[0] <= re <= res[-1]):
+        return None
+    return float(np.interp(re, res, st)), "Williamson 1989"
+
+
+def measured_strouhal(time, lift, diameter: float, speed: float, periods: int = 3):
+    """St = f D / U of the lift's swing over the history (time in steps, lift per sample), from
+    the upward zero crossings of lift - mean over its last half (interpolated, as
+    solver/validation/strouhal.py does); None until `periods` full periods are in it."""
+    from feelflow.solver.validation.strouhal import shedding_period
+
+    t, cl = np.asarray(time, dtype=np.float64), np.asarray(lift, dtype=np.float64)
+    ok = np.isfinite(cl)
+    t, cl = t[ok], cl[ok]
+    if len(t) < 8 or speed <= 0:
+        return None
+    half = len(t) // 2
+    swing = cl[half:] - cl[half:].mean()
+    if np.abs(swing).max() < 1e-9:
+        return None
+    got = shedding_period(t[half:], cl[half:])
+    if len(got) < periods:
+        return None
+    return diameter / (float(np.median(got)) * speed)
+
+
+def strouhal_text(time, lift, diameter: float, speed: float, re: float) -> str:
+    """The readout beside a cylinder's coefficients: the measured St and, where the published
+    measurements cover Re, theirs ("" until the lift swings)."""
+    st = measured_strouhal(time, lift, diameter, speed)
+    if st is None:
+        return ""
+    ref = published_strouhal(re)
+    return f"St {st:.3f}" + (f" (measured at Re {re:.0f}: {ref[0]:.3f}, {ref[1]})" if ref is not None else "")

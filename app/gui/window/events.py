@@ -7,6 +7,7 @@ controller calls another's methods to keep it in step.
 | --- | --- | --- |
 | `replayStarted` | ReplayController, before the replay takes over | bodies (editing ends, a drag is cancelled), inputs (the body is let go, a device's force fades), the frame loop (runs at full rate) |
 | `replayStopped(paused)` | ReplayController, back on the live tunnel | inputs (a device as the live tunnel's pause says), the frame loop (its pace), flow (the panel shows the live parameters again) |
+| `flowChanged` | FlowController (`after_rebuild`, `reset`), for every controller that changed the tunnel | inputs (the device's workspace), the frame loop (the field, the readouts, a redraw) |
 | `shownChanged(model)` | ReplayController, MainWindow once the live tunnel exists | the frame loop: the viewport and the plot show `model` (a TunnelModel) |
 """
 from __future__ import annotations
@@ -20,3 +21,4 @@ class WindowEvents(QObject):
     replayStarted = Signal()
     replayStopped = Signal(bool)     # whether the live tunnel is paused
     shownChanged = Signal(object)    # the TunnelModel drawn now
+    flowChanged = Signal()           # the live tunnel changed (rebuilt, reset, a lesson or an exercise)

@@ -71,8 +71,7 @@ class FlowController:
         w.make_current()
         w.sim.reset_flow()
         w.viewport.tracers = None
-        w.loop.upload_field()
-        w.loop.refresh_readouts()
+        w.events.flowChanged.emit()
 
     def say_guard(self) -> bool:
         """Show in the status bar what the stability guard changed (app/model/flow_choice.py stable_params)."""
@@ -82,12 +81,9 @@ class FlowController:
         return bool(note)
 
     def after_rebuild(self):
-        """After the tunnel changed: the device's workspace, the field, the readouts, a redraw."""
-        w = self.w
-        w.inputs.tunnel_changed()
-        w.loop.upload_field()
-        w.loop.refresh_readouts()
-        w.viewport.update()
+        """After the tunnel changed: `window.events.flowChanged` (the device's workspace, the
+        field, the readouts, a redraw follow it)."""
+        self.w.events.flowChanged.emit()
 
     def refuse_dialog(self, title, exc):
         """A change the model refused: one-line dialog, the panel back at the model's values."""

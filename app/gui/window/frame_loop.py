@@ -65,6 +65,7 @@ class FrameLoop:
         window.events.shownChanged.connect(self.show_model)
         window.events.replayStarted.connect(lambda: self.timer.setInterval(0))
         window.events.replayStopped.connect(self._replay_stopped)
+        window.events.flowChanged.connect(self._flow_changed)
 
     def start(self):
         if self.w.sim is not None:
@@ -87,6 +88,12 @@ class FrameLoop:
         self.upload_field()
         w.plot.refresh(force=True)
         vp.update()
+
+    def _flow_changed(self):
+        """The live tunnel changed: its field, the readouts and a redraw."""
+        self.upload_field()
+        self.refresh_readouts()
+        self.w.viewport.update()
 
     def _replay_stopped(self, paused: bool):
         """Back on the live tunnel: its own pace and pause."""
@@ -290,8 +297,9 @@ class FrameLoop:
             return
         p, panel = model.params, w.panel
         live = model is w.sim
-        if live and (abs(panel.wind.value() - p.wind) > 5e-4   # a sweep, a lesson or the guard
-                     or abs(panel.viscosity.value() - p.nu) > 5e-5):
+        wind, nu = panel.flow_shown     # lattice units, whatever units the boxes show
+        if live and (abs(wind - p.wind) > 5e-4   # a sweep, a lesson or the guard
+                     or abs(nu - p.nu) > 5e-5):
             panel.show_params(p, self.display_mode)
         elif live and not panel.angle.hasFocus():   # the wheel or the handle turned the body
             panel.show_angle(p.angle_deg)

@@ -29,6 +29,7 @@ class InputController:
         self.w = window
         window.events.replayStarted.connect(self.replay_started)
         window.events.replayStopped.connect(self.replay_stopped)
+        window.events.flowChanged.connect(self.tunnel_changed)
         self.device: DeviceInput | None = None
         self._device_seen = None     # the device's target when the replay began
 
