@@ -46,7 +46,9 @@ class Collider:
         dt = self.dtype
 
         def coef(x):
-            return x if np.isscalar(x) else np.asarray(x, dtype=dt)
+            # in the storage's type, scalars too: a float64 scalar (numpy's W[k] is one) would
+            # make every ufunc below loop in float64 on float32 arrays and cast back (NEP 50)
+            return dt.type(x) if np.isscalar(x) else np.asarray(x, dtype=dt)
 
         op = omega_p if np.isscalar(omega_p) else np.asarray(omega_p, dtype=np.float64)
         om = omega_m if np.isscalar(omega_m) else np.asarray(omega_m, dtype=np.float64)

@@ -1,27 +1,44 @@
-"""The compiled CPU backend: the numpy reference's algorithm (docs/algorithm.md), its hot loop
-compiled with numba (solver/cpu_kernels.py).
+"""The compiled CPU backend: the numpy reference's algorithm (docs/science/algorithm.md), each
+step two compiled calls (numba, solver/cpu_kernels.py).
 
-One fused pass pulls every population from its upwind neighbour (periodic in x and y) and
-collides, rows in parallel, writing the other of two float32 (or float64) buffers. What the
-boundaries own (outlet d, inlet c, walls b, body links a) the numpy backend's own code writes
-into a third buffer, `pre`, from the same post-collision state; a second, small pass then redoes
-exactly the nodes that own such a population (a per-node bit mask, rebuilt when the body's links
-change) with those values in place of the periodic pull. The moving body's cover/uncover
-bookkeeping, the frozen solid nodes, the force models and the fields are the numpy backend's
-(this class is a NumpySolver whose step is compiled), so both compute the same numbers to
-float32 rounding (tests/test_cpu_vs_numpy.py).
+The first pulls every population from its upwind neighbour (periodic in x and y) and collides,
+blocks of rows in parallel, writing the other of two float32 (or float64) buffers. The second,
+serial, does what the boundaries own in the numpy backend's order (outlet d, inlet c with the
+quiet inlet's correction, walls b, body links a with the moving-wall term) into a third buffer,
+`pre`, from the same post-collision state, sums the momentum exchange on the body links as it
+goes, collides again exactly the nodes that own such a population (a list of nodes and bit
+masks, rebuilt when the body's links change) and resets the solid nodes. Every operator is
+compiled: BGK, TRT and recursive-regularised BGK (with or without the Smagorinsky viscosity).
+The moving body's cover/uncover bookkeeping and refill, the force models other than the
+momentum exchanges and the fields are the numpy backend's (this class is a NumpySolver whose
+step is compiled), so both compute the same numbers to float32 rounding
+(tests/test_cpu_vs_numpy.py). docs/science/cpu-backend.md says why this layout.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from feelflow.solver.backend import SolverDiverged
+from feelflow.solver.forces.momentum_exchange import ClassicMomentumExchange, GalileanMomentumExchange
 from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS
 from feelflow.solver.numpy_backend import NumpySolver, absorb_keep, relaxation_rates
+from feelflow.solver.quiet_inlet import CS_OVER_RHO0
+from feelflow.solver.regularised import smagorinsky_factor
+
+_EMPTY_I = np.zeros(0, np.int64)
+_EMPTY_F = np.zeros(0, np.float64)
+#: the momentum-exchange models the boundary pass sums: model class -> slice of its (4,) sums
+_LINK_SUMS = {GalileanMomentumExchange: slice(0, 2), ClassicMomentumExchange: slice(2, 4)}
 
 
 def _bits(dirs) -> int:
     return sum(1 << int(i) for i in dirs)
+
+
+def _threads() -> int:
+    import numba
+
+    return max(1, int(numba.get_num_threads()))
 
 
 class CpuSolver(NumpySolver):
@@ -30,15 +47,10 @@ class CpuSolver(NumpySolver):
     name = "cpu"
 
     def __init__(self, config):
-        from feelflow.solver.cpu_kernels import make_kernels
+        from feelflow.solver.cpu_kernels import CHUNK, WALLS, make_kernel
 
         super().__init__(config)
         cfg = self.config
-        #: the recursive-regularised operator is not compiled: it runs numpy's reference step
-        #: (the same numbers, numpy's speed)
-        self._reference_step = cfg.collision == "rr"
-        if self._reference_step:
-            return
         nx, ny = cfg.nx, cfg.ny
         op, om = relaxation_rates(cfg)
         dt = self.dtype  # the kernels compute in the storage's precision, as numpy's Collider
@@ -46,68 +58,150 @@ class CpuSolver(NumpySolver):
         self._om = np.broadcast_to(np.asarray(om, dt), (nx,)).copy()
         keep = absorb_keep(cfg)
         self._keep = np.ones(nx, dt) if keep is None else np.asarray(keep, dt)
-        # columns 1 .. xs-1 share column 1's rates and have no absorbing layer: the chunked,
-        # vectorised part of the kernel; xs .. nx-1 (the sponge, the last column) node by node
+        # columns 1 .. xs-1 share column 1's rates and have no absorbing layer: the kernel's
+        # chunks with scalar rates; xs .. nx-2 (the sponge) chunks with per-column rates
         plain = (self._op == self._op[min(1, nx - 1)]) & (self._om == self._om[min(1, nx - 1)]) & (self._keep == 1.0)
         plain[0] = True
         xs = 1
         while xs < nx - 1 and plain[xs]:
             xs += 1
         self._xs = xs
-        self._no_target = np.zeros(ny, dt)
+        self._target = np.zeros(ny, dt)  # the absorbing layer's target u_in(iy, t)
         self._fx, self._fy = (dt.type(v) for v in cfg.body_force)
-        self._stream_collide, self._redo_kernel = make_kernels(
-            cfg.collision == "trt", bool(cfg.incompressible), keep is not None,
-            tuple(cfg.body_force) != (0.0, 0.0), dt.name)
+        smag = cfg.collision == "rr" and cfg.smagorinsky > 0
+        self._smag = float(smagorinsky_factor(cfg.smagorinsky)) if smag else 0.0
+        self._advance = make_kernel(cfg.collision, bool(cfg.incompressible), keep is not None,
+                                    tuple(cfg.body_force) != (0.0, 0.0), dt.name, smag)
+        blocks = _threads()
+        self._scratch = np.zeros((blocks, 2, 9, CHUNK), dt)
+        self._block_sums = np.zeros(blocks)
         self._pre = np.zeros_like(self.g)
-        self._edge_bits = self._boundary_bits()
+        self._tunnel = cfg.x_boundary == "tunnel"
+        self._walls_kind = WALLS[cfg.y_boundary]
+        self._periodic_x = cfg.x_boundary == "periodic"
+        self._quiet = self._tunnel and cfg.inlet_nonreflecting > 0
+        self._no_profile = np.zeros((3, ny))
+        self._target_zero = np.zeros(ny)
+        self._empty_solid = np.zeros((9, 0), dt)
+        self._link_force = np.zeros(4)
+        self._edge_grid, self._edge_nodes = self._boundary_nodes()
         self._mask_links = None
         self._redo = None
+        self._link_arrays = None
 
-    def _boundary_bits(self) -> np.ndarray:
-        """(ny, nx) uint16: bit i set where a domain boundary rule (c, d, b) writes population i."""
+    def _boundary_nodes(self):
+        """((ny, nx) bits, (iy, ix, bits) of the node pass): bit i set where a domain boundary
+        rule (c, d, b) writes population i; the node pass takes those nodes and every node of
+        the first and last column (solver/cpu_kernels.py advance, step 3)."""
         cfg = self.config
-        bits = np.zeros((cfg.ny, cfg.nx), np.uint16)
+        bits = np.zeros((cfg.ny, cfg.nx), np.int64)
         if cfg.x_boundary == "tunnel":
             bits[:, 0] |= _bits(INLET_DIRECTIONS)
             bits[:, -1] |= _bits(OUTLET_DIRECTIONS)
         if cfg.y_boundary != "periodic":
             bits[0, :] |= _bits((2, 5, 6))
             bits[-1, :] |= _bits((4, 7, 8))
-        return bits
+        listed = bits != 0
+        listed[:, 0] = listed[:, -1] = True  # the seam columns are always collided in the node pass
+        iy, ix = np.nonzero(listed)
+        return bits, (iy.astype(np.int64), ix.astype(np.int64), bits[iy, ix])
 
     def _redo_nodes(self):
-        """(iy, ix, bits) of every node a boundary rule or a body link touches, rebuilt when
-        the body's links change."""
+        """(iy, ix, bits) of every node a boundary rule or a body link writes a population of,
+        and the links as flat arrays in grid coordinates; rebuilt when the body's links change,
+        from the links and the body window alone. A link node on the domain's edge comes twice,
+        the second time (the links' part, later in the list) with every bit, so it wins."""
         b = self.body
         links = None if b is None else b.links
         if self._redo is not None and links is self._mask_links:
-            return self._redo
-        bits = self._edge_bits
+            return self._redo, self._link_arrays
+        ey, ex, ebits = self._edge_nodes
         if links is not None and len(links):
-            bits = bits.copy()
-            np.bitwise_or.at(bits, (links.iy + b.window[1], links.ix + b.window[0]),
-                             (1 << links.i.astype(np.int64)).astype(np.uint16))
-        iy, ix = np.nonzero(bits)
-        self._redo = (iy.astype(np.int64), ix.astype(np.int64), bits[iy, ix].astype(np.int64))
+            x0, y0 = b.window[0], b.window[1]
+            h, w = b.window[3] - y0, b.window[2] - x0
+            win = np.zeros((h, w), np.int64)
+            for i in range(1, 9):  # a node has at most one link per direction
+                sel = links.i == i
+                win[links.iy[sel], links.ix[sel]] |= 1 << i
+            wy, wx = np.nonzero(win)
+            ly, lx = wy + y0, wx + x0
+            nodes = (np.concatenate([ey, ly]), np.concatenate([ex, lx]),
+                     np.concatenate([ebits, win[wy, wx] | self._edge_grid[ly, lx]]))
+            i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
+            f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
+            self._link_arrays = (i64(links.i), i64(links.iy + y0), i64(links.ix + x0), i64(links.fy + y0),
+                                 i64(links.fx + x0), f64(links.a), f64(links.b), f64(links.c),
+                                 f64(links.d), f64(links.uw[:, 0]), f64(links.uw[:, 1]))
+        else:
+            nodes = (ey, ex, ebits)
+            self._link_arrays = (_EMPTY_I,) * 5 + (_EMPTY_F,) * 6
+        self._redo = tuple(np.ascontiguousarray(a, dtype=np.int64) for a in nodes)
         self._mask_links = links
-        return self._redo
+        return self._redo, self._link_arrays
+
+    # --- stepping -------------------------------------------------------------
+    def step(self, n: int = 1) -> None:
+        """As NumpySolver.step. The momentum exchanges come from the compiled step's link sums
+        (the same formulas on the same state), so with only those models enabled the n steps
+        are one compiled call; any other model needs the body window before each step, and
+        then each step is one call."""
+        n = int(n)
+        link_models = {name: _LINK_SUMS[type(m)] for name, m in self._models.items() if type(m) in _LINK_SUMS}
+        others = {name: m for name, m in self._models.items() if name not in link_models}
+        sums = {name: [0.0, 0.0] for name in self._models}
+        impulse = self._impulse
+        self._impulse = (0.0, 0.0)
+        done = 0
+        while done < n:
+            if others:
+                win = self.body_window()
+                if win is not None:
+                    for name, model in others.items():
+                        fx, fy = model.compute(win)
+                        sums[name][0] += fx
+                        sums[name][1] += fy
+            k = 1 if others else n
+            self._advance_steps(k)
+            done += k
+            if link_models and self.body is not None:
+                for name, part in link_models.items():
+                    fx, fy = self._link_force[part]
+                    sums[name][0] += fx
+                    sums[name][1] += fy
+        if n > 0:
+            if self.body is not None:  # the Galilean form books the cover/uncover impulse
+                for name, part in link_models.items():
+                    if part.start == 0:
+                        sums[name][0] += impulse[0]
+                        sums[name][1] += impulse[1]
+            self._forces = {name: (s[0] / n, s[1] / n) for name, s in sums.items()}
 
     def _step_once(self) -> None:
-        if self._reference_step:
-            return NumpySolver._step_once(self)
-        g, out, pre = self.g, self._gin, self._pre
+        self._advance_steps(1)
+
+    def _advance_steps(self, n: int) -> None:
+        """n steps in one compiled call (solver/cpu_kernels.py advance)."""
+        cfg = self.config
         t = self.time
-        u_in = self._boundaries(g, pre, t)
-        target = self._no_target if u_in is None else np.asarray(u_in, self.dtype)
-        rates = (self._op, self._om, self._keep, target)
-        total = self._stream_collide(g, out, *rates, self._xs, self._fx, self._fy)
-        iy, ix, bits = self._redo_nodes()
-        if len(iy):
-            total += self._redo_kernel(g, pre, bits, iy, ix, out, *rates, self._fx, self._fy)
+        wall_profile, profile, rate = self._no_profile, self._target_zero, 0.0
+        if self._tunnel:
+            self._inflow_ramp(t)  # rebuilds the cached profiles when the speed changed
+            wall_profile, profile = self._inlet_wall_profile, self._inflow_profile
+            if self._quiet:
+                rate = cfg.inlet_nonreflecting
+        (ry, rx, rbits), links = self._redo_nodes()
         if self._solid_idx is not None:
-            out[:, self._solid_idx[0], self._solid_idx[1]] = self._solid_g
-        self.g, self._gin = out, g
-        self.time = t + 1
-        if not np.isfinite(total):
-            raise SolverDiverged(t + 1, "density is no longer finite")
+            sy, sx, solid_g = self._solid_idx[0], self._solid_idx[1], self._solid_g
+        else:
+            sy, sx, solid_g = _EMPTY_I, _EMPTY_I, self._empty_solid
+        dt = self.dtype.type
+        done, finite = self._advance(n, t, cfg.inflow_ramp_steps, self.g, self._gin, self._pre, self._op, self._om,
+                             self._keep, self._target, self._xs, self._fx, self._fy, self._smag, self._scratch,
+                             self._block_sums, self._tunnel, self._walls_kind, self._periodic_x, profile,
+                             wall_profile, dt(rate), dt(CS_OVER_RHO0), self._drho_ref, *links, self._link_force,
+                             ry, rx, rbits, sy, sx, solid_g)
+        if done % 2:
+            self.g, self._gin = self._gin, self.g
+        self.time = t + done
+        if not finite:
+            raise SolverDiverged(t + done, "density is no longer finite")

@@ -1,18 +1,26 @@
-"""The cpu backend's compiled loops (numba): one fused pull-stream + collide pass over the grid,
-and a pass over the few boundary nodes that redoes them with what the boundaries own.
+"""The cpu backend's compiled loops (numba): a tunnel step is two calls, one fused pull-stream +
+collide pass over the grid (rows in parallel) and one serial pass over what the boundaries own.
 
-docs/algorithm.md, steps 1-3; the collision is solver/collision.py's, node by node: BGK
-(Bhatnagar, Gross & Krook 1954) or TRT (Ginzburg, Verhaeghe & d'Humieres 2008), Guo, Zheng &
-Shi (2002) forcing, the compressible or He & Luo (1997) equilibrium, the outlet sponge's
-per-column rates and absorbing layer. Populations are shifted, g_i = f_i - w_i RHO0; the
-arithmetic is in the storage's precision (float32 as numpy's and gl's, or float64), its
-constants a tuple K = (1/2, 1, 3, w0, w1, w5, RHO0) of that type. Lattice order as solver/lattice.py (0 rest, 1-4
-E N W S, 5-8 NE NW SW SE); the module checks that order on import rather than retyping it.
-Compiled with cache=True: the JIT cost (seconds) is paid once per machine.
+docs/science/algorithm.md, steps 1-3, and docs/science/cpu-backend.md. The collision is node by
+node that of solver/collision.py (BGK, Bhatnagar, Gross & Krook 1954; TRT, Ginzburg, Verhaeghe &
+d'Humieres 2008) or of solver/regularised.py (recursive-regularised BGK, Malaspinas 2015, Coreixas
+et al. 2017, with the optional Smagorinsky viscosity), with Guo, Zheng & Shi (2002) forcing, the
+compressible or He & Luo (1997) equilibrium and the outlet sponge's per-column rates and
+absorbing layer (solver/sponge.py). The boundary pass writes what rules d, c, b and a write in
+the numpy backend (solver/inflow.py's outlet and inlet, solver/quiet_inlet.py, the walls,
+solver/bouzidi.py's links with the moving-wall term), sums the momentum exchange on the links
+(solver/forces/momentum_exchange.py), recollides the nodes that own such a population and resets
+the solid nodes. Populations are shifted, g_i = f_i - w_i RHO0; the collision's arithmetic is in
+the storage's precision (float32 as numpy's and gl's, or float64) with its constants in a tuple K
+of that type (`constants`); the boundary rules are evaluated in float64, as numpy's. Lattice order
+as solver/lattice.py (0 rest, 1-4 E N W S, 5-8 NE NW SW SE); the module checks that order on
+import rather than retyping it. Compiled with cache=True: the JIT cost (tens of seconds per
+variant) is paid once per machine; nogil=True, so the window can draw while a step runs.
 """
 from __future__ import annotations
 
 import functools
+import math
 import os
 
 # numba's OpenMP threads sleep between steps instead of spinning: on a busy 2-core machine the
@@ -21,10 +29,10 @@ import os
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import numba  # noqa: E402
-import numpy as np
+import numpy as np  # noqa: E402
 from numba import prange  # noqa: E402
 
-from feelflow.solver.lattice import C, RHO0, W  # noqa: E402
+from feelflow.solver.lattice import C, OPP, RHO0, W  # noqa: E402
 
 # The kernels spell the directions out (pull from x - c_i) for speed: hold them to the one
 # definition of the lattice.
@@ -33,8 +41,24 @@ if tuple(map(tuple, C.tolist())) != _ORDER:
     raise ImportError("solver/cpu_kernels.py spells out a lattice order solver/lattice.py no longer has")
 W0, W1, W5 = float(W[0]), float(W[1]), float(W[5])
 R0 = float(RHO0)
+#: the lattice as arrays for the boundary pass (float64, as numpy's boundary rules)
+_CX = C[:, 0].astype(np.float64)
+_CY = C[:, 1].astype(np.float64)
+_W = W.astype(np.float64)
+_OPP = OPP.astype(np.int64)
+#: i -> j with c_j = (c_i,x, -c_i,y): specular reflection at a horizontal wall (as numpy_backend)
+_MIRROR_Y = np.array([0, 1, 4, 3, 2, 8, 7, 6, 5], dtype=np.int64)
+#: walls: 0 periodic in y, 1 no-slip, 2 free-slip
+WALLS = {"periodic": 0, "no_slip": 1, "free_slip": 2}
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy", fastmath={"contract", "arcp", "nsz", "reassoc"})
+
+
+def constants(dtype) -> tuple:
+    """K: the collision's constants in the storage's type, (1/2, 1, 3, w0, w1, w5, RHO0, 1/3,
+    3/2, 9/2, 9, 2)."""
+    T = np.dtype(dtype).type
+    return (T(0.5), T(1.0), T(3.0), T(W0), T(W1), T(W5), T(R0), T(1.0 / 3.0), T(1.5), T(4.5), T(9.0), T(2.0))
 
 
 @numba.njit(inline="always", **_JIT)
@@ -62,8 +86,8 @@ def _pair(fi, fb, cu, deq, hrho, q2, rho, w, op, om, trt, uF, cF, has_force, K):
 @numba.njit(inline="always", **_JIT)
 def _collide(f0, f1, f2, f3, f4, f5, f6, f7, f8, op, om, keep, target, trt, incomp, has_keep,
              Fx, Fy, has_force, K):
-    """One node's collision of shifted pre-collision populations; returns (f*0..f*8, drho)."""
-    half, one, three, w0, w1, w5, r0 = K
+    """BGK / TRT: one node's collision of shifted pre-collision populations; returns (f*0..f*8, drho)."""
+    half, one, three, w0, w1, w5, r0 = K[0], K[1], K[2], K[3], K[4], K[5], K[6]
     drho = f0 + f1 + f2 + f3 + f4 + f5 + f6 + f7 + f8
     rho = r0 if incomp else r0 + drho
     jx = f1 - f3 + f5 - f6 - f7 + f8
@@ -92,6 +116,86 @@ def _collide(f0, f1, f2, f3, f4, f5, f6, f7, f8, op, om, keep, target, trt, inco
 
 
 @numba.njit(inline="always", **_JIT)
+def _rr_pair(cu, cF, even, odd, odd_eq, base, rho, kn, w, src, uF, has_force, K):
+    """The regularised pair (i, ib): f*_i = w (feq_i + (1 - omega) reg_i) + Guo's source, with
+    reg_i = even + odd, reg_ib = even - odd and odd_eq the equilibrium's third-order part
+    (odd in c_i) (solver/regularised.py)."""
+    half, three = K[0], K[2]
+    fe = base + half * rho * cu * cu + kn * even
+    fo = rho * cu + odd_eq + kn * odd
+    ni = w * (fe + fo)
+    nb = w * (fe - fo)
+    if has_force:
+        ev = src * w * (three * cu * cF - three * uF)
+        od = src * w * three * cF
+        ni += ev + od
+        nb += ev - od
+    return ni, nb
+
+
+@numba.njit(inline="always", **_JIT)
+def _collide_rr(f0, f1, f2, f3, f4, f5, f6, f7, f8, omega, keep, target, incomp, has_keep,
+                Fx, Fy, has_force, smag, K):
+    """Recursive-regularised BGK with the third-order equilibrium (solver/regularised.py, its
+    moments and Hermite coefficients spelled out per opposite pair), optionally with the Smagorinsky rate (smag = 18 sqrt(2) C^2,
+    smag > 0 only in the variant compiled for it); returns (f*0..f*8, drho)."""
+    half, one, three, w0, w1, w5, r0 = K[0], K[1], K[2], K[3], K[4], K[5], K[6]
+    third, th2, n2, nine, two = K[7], K[8], K[9], K[10], K[11]
+    drho = f0 + f1 + f2 + f3 + f4 + f5 + f6 + f7 + f8
+    rho = r0 if incomp else r0 + drho
+    sx = f1 + f5 + f8
+    wx = f3 + f6 + f7
+    jx = sx - wx
+    jy = (f2 + f5 + f6) - (f4 + f7 + f8)
+    exx = sx + wx
+    eyy = f2 + f4 + f5 + f6 + f7 + f8
+    exy = (f5 + f7) - (f6 + f8)
+    ux = (jx + half * Fx) / rho
+    uy = (jy + half * Fy) / rho
+    deq = drho
+    if has_keep:
+        deq = drho * keep
+        ux = keep * ux + (one - keep) * target
+        uy = keep * uy
+    a0 = drho - deq
+    a1x = jx - rho * ux
+    a1y = jy - rho * uy
+    pxx = exx - deq * third - rho * ux * ux
+    pyy = eyy - deq * third - rho * uy * uy
+    pxy = exy - rho * ux * uy
+    axx = pxx - a0 * third
+    ayy = pyy - a0 * third
+    axxy = two * ux * pxy + uy * axx
+    axyy = two * uy * pxy + ux * ayy
+    if smag > 0:
+        tau0 = one / omega
+        stress = math.sqrt(pxx * pxx + pyy * pyy + two * pxy * pxy)
+        omega = one / (half * (tau0 + math.sqrt(tau0 * tau0 + smag * stress / (drho + r0))))
+    kn = one - omega
+    src = one - half * omega
+    base = deq - rho * th2 * (ux * ux + uy * uy)
+    reg0 = a0 - th2 * (axx + ayy)
+    uF = ux * Fx + uy * Fy
+    n0 = w0 * (base + kn * reg0)
+    if has_force:
+        n0 -= src * w0 * three * uF
+    ed = reg0 + n2 * (axx + ayy)
+    # third order: the equilibrium's 27/2 rho (H_xxy ux^2 uy + H_xyy ux uy^2) shares its
+    # Hermite coefficients with the recursive a_xxy, a_xyy
+    eq_xxy = rho * ux * uy * ux
+    eq_xyy = rho * ux * uy * uy
+    n1, n3 = _rr_pair(three * ux, Fx, reg0 + n2 * axx, three * a1x - n2 * axyy, -n2 * eq_xyy, base, rho, kn,
+                      w1, src, uF, has_force, K)
+    n2_, n4 = _rr_pair(three * uy, Fy, reg0 + n2 * ayy, three * a1y - n2 * axxy, -n2 * eq_xxy, base, rho, kn,
+                       w1, src, uF, has_force, K)
+    n5, n7 = _rr_pair(three * (ux + uy), Fx + Fy, ed + nine * pxy, three * (a1x + a1y) + nine * (axyy + axxy),
+                      nine * (eq_xyy + eq_xxy), base, rho, kn, w5, src, uF, has_force, K)
+    n6, n8 = _rr_pair(three * (uy - ux), Fy - Fx, ed - nine * pxy, three * (a1y - a1x) + nine * (axxy - axyy),
+                      nine * (eq_xxy - eq_xyy), base, rho, kn, w5, src, uF, has_force, K)
+    return n0, n1, n2_, n3, n4, n5, n6, n7, n8, drho
+
+
+@numba.njit(inline="always", **_JIT)
 def _store(out, y, x, r):
     out[0, y, x] = r[0]
     out[1, y, x] = r[1]
@@ -102,24 +206,6 @@ def _store(out, y, x, r):
     out[6, y, x] = r[6]
     out[7, y, x] = r[7]
     out[8, y, x] = r[8]
-
-
-#: columns per chunk: the pulled populations and the results of a chunk stay in L1
-CHUNK = 128
-
-
-@numba.njit(inline="always", **_JIT)
-def _chunk(b, o, n, op, om, t, trt, incomp, Fx, Fy, has_force, K):
-    """Collide n nodes of the gathered populations b (9, CHUNK) into o, one pair of rates (op,
-    om) for all: written without per-node branches or arrays beside b and o, so LLVM
-    vectorises it. Returns sum drho."""
-    s = 0.0
-    for k in range(n):
-        r = _collide(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
-                     op, om, op, t, trt, incomp, False, Fx, Fy, has_force, K)
-        _store_k(o, k, r)
-        s += r[9]
-    return s
 
 
 @numba.njit(inline="always", **_JIT)
@@ -135,6 +221,78 @@ def _store_k(o, k, r):
     o[8, k] = r[8]
 
 
+#: columns per chunk: the pulled populations and the results of a chunk stay in L1
+CHUNK = 128
+
+
+@numba.njit(inline="always", **_JIT)
+def _gather(g, b, y, ym, yp, x0, n):
+    """b[:, :n] = the populations pulled to nodes (y, x0 .. x0+n-1), 1 <= x0, x0 + n < nx."""
+    x1 = x0 + n
+    b[0, :n] = g[0, y, x0:x1]
+    b[1, :n] = g[1, y, x0 - 1:x1 - 1]
+    b[2, :n] = g[2, ym, x0:x1]
+    b[3, :n] = g[3, y, x0 + 1:x1 + 1]
+    b[4, :n] = g[4, yp, x0:x1]
+    b[5, :n] = g[5, ym, x0 - 1:x1 - 1]
+    b[6, :n] = g[6, ym, x0 + 1:x1 + 1]
+    b[7, :n] = g[7, yp, x0 + 1:x1 + 1]
+    b[8, :n] = g[8, yp, x0 - 1:x1 - 1]
+
+
+@numba.njit(inline="always", **_JIT)
+def _chunk(b, o, n, op, om, t, trt, incomp, Fx, Fy, has_force, K):
+    """BGK / TRT: collide n gathered nodes b (9, CHUNK) into o with one pair of rates (op, om)
+    for all: written without per-node branches or arrays beside b and o, so LLVM vectorises it.
+    Returns sum drho."""
+    s = 0.0
+    for k in range(n):
+        r = _collide(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
+                     op, om, op, t, trt, incomp, False, Fx, Fy, has_force, K)
+        _store_k(o, k, r)
+        s += r[9]
+    return s
+
+
+@numba.njit(inline="always", **_JIT)
+def _chunk_rr(b, o, n, op, t, incomp, Fx, Fy, has_force, smag, K):
+    """As _chunk for the recursive-regularised operator."""
+    s = 0.0
+    for k in range(n):
+        r = _collide_rr(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
+                        op, op, t, incomp, False, Fx, Fy, has_force, smag, K)
+        _store_k(o, k, r)
+        s += r[9]
+    return s
+
+
+@numba.njit(inline="always", **_JIT)
+def _columns(b, o, n, cols, op, om, keep, t, trt, incomp, has_keep, Fx, Fy, has_force, K):
+    """BGK / TRT: as _chunk with node k in column cols[k] (its own rates and absorbing layer:
+    the sponge's columns; the seam columns; the boundary nodes). Returns sum drho."""
+    s = 0.0
+    for k in range(n):
+        x = cols[k]
+        r = _collide(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
+                     op[x], om[x], keep[x], t, trt, incomp, has_keep, Fx, Fy, has_force, K)
+        _store_k(o, k, r)
+        s += r[9]
+    return s
+
+
+@numba.njit(inline="always", **_JIT)
+def _columns_rr(b, o, n, cols, op, keep, t, incomp, has_keep, Fx, Fy, has_force, smag, K):
+    """As _columns for the recursive-regularised operator."""
+    s = 0.0
+    for k in range(n):
+        x = cols[k]
+        r = _collide_rr(b[0, k], b[1, k], b[2, k], b[3, k], b[4, k], b[5, k], b[6, k], b[7, k], b[8, k],
+                        op[x], keep[x], t, incomp, has_keep, Fx, Fy, has_force, smag, K)
+        _store_k(o, k, r)
+        s += r[9]
+    return s
+
+
 @numba.njit(inline="always", **_JIT)
 def _pull(g, y, ym, yp, x, xm, xp):
     return (g[0, y, x], g[1, y, xm], g[2, ym, x], g[3, y, xp], g[4, yp, x],
@@ -142,83 +300,244 @@ def _pull(g, y, ym, yp, x, xm, xp):
 
 
 @numba.njit(inline="always", **_JIT)
-def _edge(g, out, y, ym, yp, x, op, om, keep, t, Fx, Fy, trt, incomp, has_keep, has_force, K):
-    """One node with periodic neighbours and its own column's rates; returns drho."""
+def _gather_node(g, b, k, y, ym, yp, x):
+    """b[:, k] = the populations pulled to node (y, x), periodic neighbours."""
     nx = g.shape[2]
-    f = _pull(g, y, ym, yp, x, x - 1 if x > 0 else nx - 1, x + 1 if x < nx - 1 else 0)
-    r = _collide(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], op[x], om[x], keep[x], t,
-                 trt, incomp, has_keep, Fx, Fy, has_force, K)
-    _store(out, y, x, r)
-    return r[9]
+    xm = x - 1 if x > 0 else nx - 1
+    xp = x + 1 if x < nx - 1 else 0
+    b[0, k] = g[0, y, x]
+    b[1, k] = g[1, y, xm]
+    b[2, k] = g[2, ym, x]
+    b[3, k] = g[3, y, xp]
+    b[4, k] = g[4, yp, x]
+    b[5, k] = g[5, ym, xm]
+    b[6, k] = g[6, ym, xp]
+    b[7, k] = g[7, yp, xp]
+    b[8, k] = g[8, yp, xm]
+
+
+@numba.njit(inline="always", **_JIT)
+def _velocity(g, y, x):
+    """u = sum c f / sum f at one node, in float64."""
+    rho = R0
+    jx = 0.0
+    jy = 0.0
+    for i in range(9):
+        v = np.float64(g[i, y, x])
+        rho += v
+        jx += _CX[i] * v
+        jy += _CY[i] * v
+    return jx / rho, jy / rho
+
+
+@numba.njit(**_JIT)
+def _outlet(g, pre):
+    """Rule d (solver/inflow.py outlet_incoming), anti-bounce-back at x = nx - 1/2, in float64."""
+    ny, nx = g.shape[1], g.shape[2]
+    for y in range(ny):
+        ux0, uy0 = _velocity(g, y, nx - 2)
+        ux1, uy1 = _velocity(g, y, nx - 1)
+        bx = 1.5 * ux1 - 0.5 * ux0
+        by = 1.5 * uy1 - 0.5 * uy0
+        usq = bx * bx + by * by
+        for i in (3, 6, 7):
+            cu = _CX[i] * bx + _CY[i] * by
+            pre[i, y, nx - 1] = -np.float64(g[_OPP[i], y, nx - 1]) + 2.0 * _W[i] * R0 * (4.5 * cu * cu - 1.5 * usq)
+
+
+@numba.njit(**_JIT)
+def _inlet(g, pre, r, wall_profile, quiet, rate, coefficient, drho_ref):
+    """Rule c (moving-wall half-way bounce-back at x = -1/2, each link with its own inflow) and
+    the quiet inlet's correction (solver/quiet_inlet.py; drho_ref updated in place)."""
+    ny = g.shape[1]
+    for y in range(ny):
+        corr = 0.0
+        if quiet:
+            d = g[0, y, 0]
+            for i in range(1, 9):
+                d += g[i, y, 0]
+            drho_ref[y] += rate * (d - drho_ref[y])
+            corr = -coefficient * (d - drho_ref[y])
+        for k in range(3):
+            i = (1, 5, 8)[k]
+            c = 6.0 * _W[i] * R0
+            pre[i, y, 0] = np.float64(g[_OPP[i], y, 0]) + c * r * wall_profile[k, y] + c * corr
+
+
+@numba.njit(**_JIT)
+def _walls(g, pre, walls, periodic_x):
+    """Rule b: half-way bounce-back (walls 1) or specular reflection (walls 2) at y = -1/2 and
+    ny - 1/2; a free-slip tunnel corner keeps the inlet/outlet rule."""
+    ny, nx = g.shape[1], g.shape[2]
+    for side in range(2):
+        row = 0 if side == 0 else ny - 1
+        for k in range(3):
+            i = (2, 5, 6)[k] if side == 0 else (4, 7, 8)[k]
+            if walls == 1:
+                ib = _OPP[i]
+                for x in range(nx):
+                    pre[i, row, x] = g[ib, row, x]
+                continue
+            j = _MIRROR_Y[i]
+            cx = int(_CX[i])
+            if cx == 0:
+                for x in range(nx):
+                    pre[i, row, x] = g[j, row, x]
+            elif cx == 1:
+                for x in range(1, nx):
+                    pre[i, row, x] = g[j, row, x - 1]
+                if periodic_x:
+                    pre[i, row, 0] = g[j, row, nx - 1]
+            else:
+                for x in range(nx - 1):
+                    pre[i, row, x] = g[j, row, x + 1]
+                if periodic_x:
+                    pre[i, row, nx - 1] = g[j, row, 0]
+
+
+@numba.njit(**_JIT)
+def _links(g, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, sums):
+    """Rule a (solver/bouzidi.py incoming, float64) on every body link, and the momentum
+    exchange on them (solver/forces/momentum_exchange.py, full f = g + w RHO0):
+    sums += (Galilean fx, fy, classic fx, fy) without the cover/uncover impulse."""
+    for k in range(len(li)):
+        i = li[k]
+        ib = _OPP[i]
+        y, x = ly[k], lx[k]
+        g_out = np.float64(g[ib, y, x])
+        v = la[k] * g_out + lb[k] * np.float64(g[ib, lfy[k], lfx[k]]) + lc[k] * np.float64(g[i, y, x]) + ld[k]
+        pre[i, y, x] = v
+        wr = _W[i] * R0
+        f_out = g_out + wr
+        f_in = v + wr
+        cx, cy = _CX[i], _CY[i]
+        sums[0] += (-cx - luwx[k]) * f_out - (cx - luwx[k]) * f_in
+        sums[1] += (-cy - luwy[k]) * f_out - (cy - luwy[k]) * f_in
+        sums[2] -= cx * (f_out + f_in)
+        sums[3] -= cy * (f_out + f_in)
+
+
+@numba.njit(inline="always", **_JIT)
+def _ramp(t, ramp_steps):
+    """solver/inflow.py ramp: (1 - cos(pi t / T)) / 2 for t < T, else 1."""
+    if ramp_steps <= 0 or t >= ramp_steps:
+        return 1.0
+    return 0.5 * (1.0 - math.cos(math.pi * t / ramp_steps))
 
 
 @functools.lru_cache(maxsize=None)
-def make_kernels(trt: bool, incomp: bool, has_keep: bool, has_force: bool, dtype: str = "float32"):
-    """(stream_collide, redo_nodes) compiled for one collision variant and storage type: the
-    flags and constants are constants of the compiled code, so the inner loop has no branches
-    (cached per variant). The rates, keep, target and force passed to them are of `dtype`.
-    Their closures hold only these flags and constants, never another compiled function: numba's
+def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype: str = "float32",
+                smagorinsky: bool = False):
+    """`advance`, compiled for one collision variant (kind "bgk", "trt" or "rr"; rr with or
+    without the Smagorinsky viscosity) and storage type: the flags and constants are constants
+    of the compiled code, so the inner loop has no branches (cached per variant). The rates,
+    keep, target and force passed to it are of `dtype`.
+    Its closure holds only these flags and constants, never another compiled function: numba's
     on-disk cache keys a closure by its variables' pickled bytes, and a compiled function pickles
     with an id that is new in every process, so such a closure would compile again at every start."""
-    T = np.dtype(dtype).type
-    K = (T(0.5), T(1.0), T(3.0), T(W0), T(W1), T(W5), T(R0))
+    if kind not in ("bgk", "trt", "rr"):
+        raise ValueError(f"the cpu backend compiles bgk, trt and rr, not {kind!r}")
+    K = constants(dtype)
+    rr = kind == "rr"   # the closure's branches on these constants are pruned before inlining,
+    trt = kind == "trt"  # so each variant compiles one operator
+    smag_on = bool(smagorinsky) and rr
 
     @numba.njit(parallel=True, **_JIT)
-    def stream_collide(g, out, op, om, keep, target, xs, Fx, Fy):
-        """out = collide(pull(g)) over the whole grid, periodic in x and y, rows in parallel.
-        Columns 1 .. xs-1 share the rates op[1], om[1] (no sponge there) and run in chunks;
-        column 0 and xs .. nx-1 (the sponge: per-column rates, the absorbing layer) node by
-        node. target: (ny,) the absorbing layer's x-velocity. Returns sum drho."""
+    def advance(n, t0, ramp_steps, g, out, pre, op, om, keep, target, xs, Fx, Fy, smag, scratch, sums,
+                tunnel, walls, periodic_x, profile, wall_profile, quiet_rate, quiet_coefficient, drho_ref,
+                li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, force,
+                ry, rx, rbits, sy, sx, solid_g):
+        """n steps from time t0, the state in g (post-collision), ping-ponging with out; returns
+        (steps done, finite): it stops after the first step whose density is not finite (that
+        state is kept). After an odd number of steps done the state is in out. Each step, in
+        the numpy backend's order:
+        1. rules d (outlet), c (inlet with the ramp r(t) of `ramp_steps`, each link's inflow
+           r wall_profile, the quiet inlet's correction once the ramp is over: quiet_rate > 0),
+           b (walls: 0 periodic, 1 no-slip, 2 free-slip) and a (the body links li..luwy, in grid
+           coordinates) into pre, from the post-collision state; the momentum exchange summed
+           into force (4,) over the n steps (Galilean fx, fy, classic fx, fy, no impulse);
+        2. pull-stream + collide of columns 1 .. nx-2, blocks of rows in parallel (scratch (B,
+           2, 9, CHUNK): each block's gather and result buffers, nothing allocated in the
+           parallel loop; sums (B,) each block's sum drho): columns 1 .. xs-1 share the rates
+           op[1], om[1]; xs .. nx-2 (the sponge) take their own column's; target (ny,) the
+           absorbing layer's x-velocity r profile;
+        3. the nodes (ry[k], rx[k]), serially: every node of columns 0 and nx-1 (they pull
+           across the periodic seam) and every node that owns a boundary population, pulled and
+           collided with population i from pre where bit i of rbits[k] is set;
+        4. the solid nodes (sy, sx) reset to solid_g."""
         ny, nx = g.shape[1], g.shape[2]
-        rows = np.zeros(ny)
+        nb = scratch.shape[0]
+        per = (ny + nb - 1) // nb
         op0, om0 = op[min(1, nx - 1)], om[min(1, nx - 1)]
-        for y in prange(ny):
-            ym = y - 1 if y > 0 else ny - 1
-            yp = y + 1 if y < ny - 1 else 0
-            t = target[y]
-            b = np.empty((9, CHUNK), g.dtype)
-            o = np.empty((9, CHUNK), g.dtype)
-            s = 0.0
-            for x0 in range(1, xs, CHUNK):
-                n = min(CHUNK, xs - x0)
-                x1 = x0 + n
-                b[0, :n] = g[0, y, x0:x1]
-                b[1, :n] = g[1, y, x0 - 1:x1 - 1]
-                b[2, :n] = g[2, ym, x0:x1]
-                b[3, :n] = g[3, y, x0 + 1:x1 + 1]
-                b[4, :n] = g[4, yp, x0:x1]
-                b[5, :n] = g[5, ym, x0 - 1:x1 - 1]
-                b[6, :n] = g[6, ym, x0 + 1:x1 + 1]
-                b[7, :n] = g[7, yp, x0 + 1:x1 + 1]
-                b[8, :n] = g[8, yp, x0 - 1:x1 - 1]
-                s += _chunk(b, o, n, op0, om0, t, trt, incomp, Fx, Fy, has_force, K)
-                out[:, y, x0:x1] = o[:, :n]
-            s += _edge(g, out, y, ym, yp, 0, op, om, keep, t, Fx, Fy, trt, incomp, has_keep, has_force, K)
-            for x in range(xs, nx):
-                s += _edge(g, out, y, ym, yp, x, op, om, keep, t, Fx, Fy, trt, incomp, has_keep, has_force, K)
-            rows[y] = s
-        return rows.sum()
+        sm = smag if smag_on else 0.0
+        cols = np.arange(nx)
+        force[:] = 0.0
+        a = g
+        b_ = out
+        for step in range(n):
+            t = t0 + step
+            if tunnel:
+                r = _ramp(t, ramp_steps)
+                for y in range(ny):
+                    target[y] = r * profile[y]
+                _outlet(a, pre)
+                quiet = quiet_rate > 0 and r >= 1.0
+                _inlet(a, pre, r, wall_profile, quiet, quiet_rate, quiet_coefficient, drho_ref)
+            if walls != 0:
+                _walls(a, pre, walls, periodic_x)
+            _links(a, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, force)
+            for blk in prange(nb):
+                bb = scratch[blk, 0]
+                o = scratch[blk, 1]
+                s = 0.0
+                for y in range(blk * per, min(ny, (blk + 1) * per)):
+                    ym = y - 1 if y > 0 else ny - 1
+                    yp = y + 1 if y < ny - 1 else 0
+                    tg = target[y]
+                    x0 = 1
+                    while x0 < nx - 1:   # chunks end at xs: the sponge starts a chunk
+                        m = min(CHUNK, (xs if x0 < xs else nx - 1) - x0)
+                        _gather(a, bb, y, ym, yp, x0, m)
+                        if x0 < xs:        # the rates of column 1 for the whole chunk
+                            if rr:
+                                s += _chunk_rr(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm, K)
+                            else:
+                                s += _chunk(bb, o, m, op0, om0, tg, trt, incomp, Fx, Fy, has_force, K)
+                        else:              # each column its own rates (the sponge)
+                            c = cols[x0:x0 + m]
+                            if rr:
+                                s += _columns_rr(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force,
+                                                 sm, K)
+                            else:
+                                s += _columns(bb, o, m, c, op, om, keep, tg, trt, incomp, has_keep, Fx, Fy,
+                                              has_force, K)
+                        b_[:, y, x0:x0 + m] = o[:, :m]
+                        x0 += m
+                sums[blk] = s
+            total = sums.sum()
+            bb = scratch[0, 0]
+            o = scratch[0, 1]
+            for k in range(len(ry)):
+                y, x, bits = ry[k], rx[k], rbits[k]
+                _gather_node(a, bb, 0, y, y - 1 if y > 0 else ny - 1, y + 1 if y < ny - 1 else 0, x)
+                for i in range(9):
+                    if (bits >> i) & 1:
+                        bb[i, 0] = pre[i, y, x]
+                c = cols[x:x + 1]
+                if rr:
+                    total += _columns_rr(bb, o, 1, c, op, keep, target[y], incomp, has_keep, Fx, Fy, has_force,
+                                         sm, K)
+                else:
+                    total += _columns(bb, o, 1, c, op, om, keep, target[y], trt, incomp, has_keep, Fx, Fy,
+                                      has_force, K)
+                for i in range(9):
+                    b_[i, y, x] = o[i, 0]
+            for k in range(len(sy)):
+                for i in range(9):
+                    b_[i, sy[k], sx[k]] = solid_g[i, k]
+            a, b_ = b_, a
+            if not np.isfinite(total):
+                return step + 1, False
+        return n, True
 
-    @numba.njit(**_JIT)
-    def redo_nodes(g, pre, over, ny_, nx_, out, op, om, keep, target, Fx, Fy):
-        """For each node (ny_[k], nx_[k]) whose bit i of over[k] is set, population i comes from
-        `pre` (what a boundary rule wrote) instead of the periodic pull; collide and store.
-        Returns sum drho over those nodes."""
-        ny, nx = g.shape[1], g.shape[2]
-        f = np.empty(9, g.dtype)
-        total = 0.0
-        for k in range(len(ny_)):
-            y, x, bits = ny_[k], nx_[k], over[k]
-            ym = y - 1 if y > 0 else ny - 1
-            yp = y + 1 if y < ny - 1 else 0
-            p = _pull(g, y, ym, yp, x, x - 1 if x > 0 else nx - 1, x + 1 if x < nx - 1 else 0)
-            for i in range(9):
-                f[i] = pre[i, y, x] if (bits >> i) & 1 else p[i]
-            r = _collide(f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], op[x], om[x], keep[x],
-                         target[y], trt, incomp, has_keep, Fx, Fy, has_force, K)
-            _store(out, y, x, r)
-            total += r[9]
-        return total
-
-    return stream_collide, redo_nodes
-
+    return advance

@@ -147,10 +147,11 @@ class RegularisedCollider:
                 reg = reg + 3.0 * cy * a1y + 4.5 * ayy + hxxy * axxy
             if cx and cy:
                 reg = reg + 9.0 * cx * cy * pxy
-            out = W[i] * (feq + keep_neq * reg)
+            w = float(W[i])  # a Python float: numpy's float64 scalar would lift the float32 arrays to float64
+            out = w * (feq + keep_neq * reg)
             if self.has_force:
                 cF = cx * Fx + cy * Fy
                 cul = 0.0 if cu is None else cu
-                out = out + src * (W[i] * (3.0 * cul * cF - 3.0 * uF + 3.0 * cF))
+                out = out + src * (w * (3.0 * cul * cF - 3.0 * uF + 3.0 * cF))
             f[i] = out
         return float(drho.sum())

@@ -155,10 +155,12 @@ class PhysicalUnits:
     nu: float            # the simulated viscosity, lattice units
 
     def __post_init__(self):
-        for name in ("size_m", "span_m", "size_cells", "speed", "nu"):
+        for name in ("size_m", "span_m", "size_cells", "nu"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v > 0):
                 raise ValueError(f"{name}: must be a positive number, got {v!r}")
+        if not (math.isfinite(self.speed) and self.speed >= 0):   # no wind: still a cell and a step
+            raise ValueError(f"speed: must be a number >= 0, got {self.speed!r}")
 
     @property
     def reynolds(self) -> float:
@@ -176,12 +178,17 @@ class PhysicalUnits:
 
     @property
     def dt(self) -> float:
-        """Seconds per solver step."""
-        return self.speed * self.dx / self.wind_m_s
+        """Seconds per solver step: U dx / U_f, written as nu dx^2 / nu_f (the same, and defined
+        without wind)."""
+        return self.nu * self.dx * self.dx / self.fluid.viscosity
 
     def velocity(self, v):
         """Lattice velocity (cells/step) -> m/s."""
         return v * (self.dx / self.dt)
+
+    def lattice_velocity(self, v_m_s):
+        """m/s -> lattice velocity (cells/step): the inverse of `velocity`."""
+        return v_m_s / (self.dx / self.dt)
 
     def time(self, steps):
         """Solver steps -> seconds."""

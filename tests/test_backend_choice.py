@@ -159,6 +159,6 @@ def test_run_backend_auto_prints_its_choice_in_one_line(tmp_path, monkeypatch, c
     assert f"steps on {backend} " in lines[-1] and out.exists()
     stored = json.loads((tmp_path / "cache" / "feelflow" / "backend-choice.json").read_text())
     assert list(stored.values()) == [backend] and list(stored)[0].endswith("/64x32")
-    # the second run uses the remembered choice
-    assert cli_main(["run", str(scene), "--backend", "auto", "--out", str(out), "--force"]) == 0
+    # the second run, without --backend (the default: auto), uses the remembered choice
+    assert cli_main(["run", str(scene), "--out", str(out), "--force"]) == 0
     assert f"feelflow: backend {backend} (remembered" in capsys.readouterr().out

@@ -114,11 +114,11 @@ def _frame_drag_noise(chunked: bool, frame_steps: int = 5) -> float:
         sim.shape = sim.shape.moved(x, y, sim.angle)
         v, drag = -0.04, []
         target = x - 4.0
-        for frame in range(700 // frame_steps):
+        for frame in range(500 // frame_steps):
             target += frame_steps * v
             sim.drive(BodyInput.pull(target, y, source="device"))
             forces = sim.advance(frame_steps)
-            if frame >= 300 // frame_steps:
+            if frame >= 200 // frame_steps:
                 drag.append(-forces["momentum_exchange"][0] * 0 + forces["momentum_exchange"][0])
     finally:
         if chunked:

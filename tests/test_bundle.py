@@ -60,7 +60,8 @@ def test_bundle_holds_every_package_data_file(bundle):
 def test_run_record_and_open_the_session(bundle, tmp_path):
     scene = tmp_path / "tunnel.toml"
     shutil.copy(ROOT / "scenes" / "cylinder_tunnel.toml", scene)
-    r = feelflow(bundle, tmp_path, "run", scene, "--steps", "300", "--out", "forces.csv", "--record", "s.ffsession")
+    r = feelflow(bundle, tmp_path, "run", scene, "--steps", "300", "--out", "forces.csv", "--record", "s.ffsession",
+                 "--backend", "numpy")
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "forces.csv").read_text().startswith("step,")
     info = feelflow(bundle, tmp_path, "session", "info", "s.ffsession")
@@ -114,7 +115,7 @@ def test_selftest_and_a_session_in_the_window(bundle, tmp_path):
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "renderer no GL, solver backend numpy" in r.stdout and r.stdout.rstrip().endswith("selftest: ok")
-    rec = feelflow(bundle, tmp_path, "run", ROOT / "scenes" / "default.toml", "--steps", "600", "--out", "f.csv",
+    rec = feelflow(bundle, tmp_path, "run", ROOT / "scenes" / "default.toml", "--steps", "600", "--backend", "numpy", "--out", "f.csv",
                    "--record", "lesson.ffsession")
     assert rec.returncode == 0, rec.stderr
     r = feelflow(bundle, tmp_path, "--selftest", "--seconds", "4", "gui", "lesson.ffsession")

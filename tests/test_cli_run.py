@@ -109,7 +109,7 @@ def test_validate_refine_names_what_it_cannot_refine():
 def test_run_writes_the_documented_csv(tmp_path):
     scene = write(tmp_path, SMALL)
     out = tmp_path / "forces.csv"
-    result = feelflow("run", scene, "--out", out)
+    result = feelflow("run", scene, "--out", out, "--backend", "numpy")
     assert result.returncode == 0, result.stderr
     rows = list(csv.reader(out.open()))
     assert rows[0] == ["step", "x", "y", "vx", "vy", "fx_momentum_exchange", "fy_momentum_exchange",
@@ -126,7 +126,7 @@ def test_run_writes_the_documented_csv(tmp_path):
 def test_run_steps_option_overrides_the_scene(tmp_path):
     scene = write(tmp_path, SMALL)
     out = tmp_path / "f.csv"
-    assert feelflow("run", scene, "--steps", "40", "--out", out).returncode == 0
+    assert feelflow("run", scene, "--steps", "40", "--out", out, "--backend", "numpy").returncode == 0
     assert [r[0] for r in list(csv.reader(out.open()))[1:]] == ["20", "40"]
 
 
@@ -134,7 +134,7 @@ def test_divergence_is_one_line_and_exit_1(tmp_path):
     text = SMALL.replace("nu = 0.05", "nu = 0.000001\ncollision = \"bgk\"").replace(
         "inflow_speed = 0.04", "inflow_speed = 0.095").replace("inflow_ramp_steps = 20", "inflow_ramp_steps = 0")
     scene = write(tmp_path, text.replace("[output]", "[run]\nsteps = 3000\n\n[output]"))
-    result = feelflow("run", scene, "--out", tmp_path / "f.csv")
+    result = feelflow("run", scene, "--out", tmp_path / "f.csv", "--backend", "numpy")
     # far outside the measured stable region: run warns first (one line), then, once its flow has
     # left the operator's local region (solver/local_guard.py), says so (one line), then the error
     warning, local, error = result.stderr.strip("\n").split("\n")
@@ -185,20 +185,24 @@ def test_validate_reports_a_blow_up_as_a_failed_case():
 
 
 def test_run_record_replays_to_the_same_forces(tmp_path):
-    """`run --record` writes a session whose numpy replay reproduces the run's forces exactly.
+    """`run --record` writes a session whose numpy replay reproduces the run's forces exactly
+    (with `--si` the units are recorded too and change nothing in the replay).
     Its export has one row per solver call (finer than the run's interval means): where both
     have a row the velocity agrees (the export's pose is the pose during the call, the run's the
     pose after it: docs/reference/session-format.md), and over the first interval (one call) the forces too."""
     scene = write(tmp_path, SMALL)
     out, session = tmp_path / "forces.csv", tmp_path / "run.ffsession"
-    result = feelflow("run", scene, "--out", out, "--record", session)
+    result = feelflow("run", scene, "--out", out, "--record", session, "--si", "water:0.01", "--backend", "numpy")
     assert result.returncode == 0, result.stderr
+    from feelflow.app.sessions import load_session
+    assert load_session(session).units == {"fluid": "water", "size_m": 0.01, "span_m": 0.1}   # --si recorded
     check = feelflow("session", "replay", session, "--check", "--tolerance", "0")
     assert check.returncode == 0, check.stdout + check.stderr
     exported = tmp_path / "export.csv"
     assert feelflow("session", "export", session, "--csv", exported).returncode == 0
-    run_rows = [[float(v) for v in r] for r in list(csv.reader(out.open()))[1:]]
     export_rows = [[float(v) for v in r] for r in list(csv.reader(exported.open()))[1:]]
+    lattice = len(export_rows[0])   # the run's lattice columns; its SI ones (--si) follow them
+    run_rows = [[float(v) for v in r[:lattice]] for r in list(csv.reader(out.open()))[1:]]
     by_step = {r[0]: r for r in export_rows}
     assert set(r[0] for r in run_rows) <= set(by_step)
     for row in run_rows:
@@ -208,7 +212,7 @@ def test_run_record_replays_to_the_same_forces(tmp_path):
 
 def test_run_record_into_missing_directory_is_one_line(tmp_path):
     scene = write(tmp_path, SMALL)
-    result = feelflow("run", scene, "--out", tmp_path / "f.csv", "--record", tmp_path / "nope" / "s.ffsession")
+    result = feelflow("run", scene, "--out", tmp_path / "f.csv", "--record", tmp_path / "nope" / "s.ffsession", "--backend", "numpy")
     assert_one_line_error(result, "nope")
 
 

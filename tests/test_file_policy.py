@@ -201,19 +201,19 @@ def test_run_never_overwrites_its_inputs_or_an_existing_file_without_force(scene
         assert cli_main(argv) == 2, argv
         assert words in one_error_line(capsys.readouterr().err), argv
         assert scene.read_bytes() == original
-    assert cli_main(["run", str(scene), "--out", str(out)]) == 0
+    assert cli_main(["run", str(scene), "--out", str(out), "--backend", "numpy"]) == 0
     first = out.read_bytes()
     capsys.readouterr()
-    assert cli_main(["run", str(scene), "--out", str(out)]) == 2           # exists: refused before the run
+    assert cli_main(["run", str(scene), "--out", str(out), "--backend", "numpy"]) == 2           # exists: refused before the run
     assert "--force" in one_error_line(capsys.readouterr().err)
     assert out.read_bytes() == first
-    assert cli_main(["run", str(scene), "--out", str(out), "--force", "--steps", "5"]) == 0
+    assert cli_main(["run", str(scene), "--out", str(out), "--force", "--steps", "5", "--backend", "numpy"]) == 0
     assert out.read_bytes() != first
 
 
 def test_session_commands_never_destroy_the_session(scene, tmp_path, capsys):
     session = tmp_path / "s.ffsession"
-    assert cli_main(["run", str(scene), "--out", str(tmp_path / "f.csv"), "--record", str(session)]) == 0
+    assert cli_main(["run", str(scene), "--out", str(tmp_path / "f.csv"), "--record", str(session), "--backend", "numpy"]) == 0
     original = session.read_bytes()
     capsys.readouterr()
     for argv in (["session", "replay", str(session), "--out", str(session), "--force"],

@@ -259,7 +259,7 @@ def test_selftest_measures_a_cli_recorded_replay_rows_whole_and_in_parts(tmp_pat
     """`feelflow --selftest gui SESSION` on a session recorded by `feelflow run --record` (a force
     row per 50 steps): the replay runs with rows whole, then in parts, and prints both rates."""
     session = tmp_path / "cli.ffsession"
-    r = subprocess.run([sys.executable, "-m", "feelflow.app", "run", "scenes/default.toml", "--steps", "3000",
+    r = subprocess.run([sys.executable, "-m", "feelflow.app", "run", "scenes/default.toml", "--steps", "3000", "--backend", "numpy",
                         "--out", str(tmp_path / "f.csv"), "--record", str(session)],
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr

@@ -61,3 +61,25 @@ def test_run_si_bad_value_is_one_line(tmp_path):
                         "--out", str(tmp_path / "f.csv")], cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "--si: give FLUID:SIZE_M" in r.stderr and "Traceback" not in r.stderr
     assert not (tmp_path / "f.csv").exists()
+
+
+def test_a_session_file_checks_its_recorded_units():
+    """The optional manifest key `units` (app/sessions/format.py): absent is None; a bad value is
+    one SessionError line naming it."""
+    from feelflow.app.sessions.format import SessionError, _validate_units
+
+    assert _validate_units(None) is None
+    assert _validate_units({"fluid": "air", "size_m": 0.05, "span_m": 1}) == {"fluid": "air", "size_m": 0.05,
+                                                                              "span_m": 1.0}
+    for bad, what in (({"fluid": "mud", "size_m": 1, "span_m": 1}, "units.fluid"),
+                      ({"fluid": "water", "size_m": -1, "span_m": 1}, "units.size_m"),
+                      ({"fluid": "water", "size_m": 0.01, "span_m": float("nan")}, "units.span_m"),
+                      ({"fluid": "water"}, "exactly"), ("water", "exactly")):
+        with pytest.raises(SessionError, match=what):
+            _validate_units(bad)
+
+
+def test_no_wind_still_has_a_cell_and_a_step():
+    u = PhysicalUnits(FLUIDS["water"], 0.01, 0.1, 24, 0.0, 0.012)
+    assert u.wind_m_s == 0.0 and math.isclose(u.dt, 0.012 * (0.01 / 24) ** 2 / FLUIDS["water"].viscosity)
+    assert math.isclose(u.lattice_velocity(u.velocity(0.04)), 0.04)

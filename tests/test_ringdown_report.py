@@ -39,12 +39,12 @@ def test_report_ringdown_refuses_bad_input_in_one_line():
 
 def test_report_towed_quick_runs_held_and_towed_rows():
     """`feelflow report towed --quick` (app/reports/towed.py): the held row and one towed row per
-    impulse scheme asked for; the absolute impulse is the noisy one (a smoke test, not physics)."""
-    r = subprocess.run([*CLI, "report", "towed", "--quick", "--impulse", "relative,absolute"], capture_output=True,
+    impulse scheme asked for (a smoke test of the chain, not physics)."""
+    r = subprocess.run([*CLI, "report", "towed", "--quick", "--impulse", "absolute"], capture_output=True,
                        text=True, cwd=ROOT)
     assert r.returncode == 0, r.stderr
     rows = [line for line in r.stdout.splitlines() if line.startswith("| held") or line.startswith("| towed")]
-    assert len(rows) == 3 and "relative" in rows[1] and "absolute" in rows[2]
+    assert len(rows) == 2 and "absolute" in rows[1]
 
 
 def test_report_towed_refuses_bad_schemes_in_one_line():
@@ -65,3 +65,24 @@ def test_towed_cylinder_drag_is_calm_and_galilean_invariant():
     mea = towed["momentum_exchange"]
     assert mea["mean"] == pytest.approx(held["momentum_exchange"]["mean"], rel=0.02)
     assert mea["noise_1"] <= 0.15 and mea["noise_25"] <= 0.02
+
+
+def test_report_ringdown_runs_a_scene_file_and_refuses_one_that_never_moves(tmp_path):
+    """`feelflow report ringdown --scene FILE --quick`: the scene as it stands (here with no
+    boundary keys: the quiet tunnel by default), one row; a scene whose body never moves is one
+    line, exit 2."""
+    scene = tmp_path / "moved.toml"
+    body = ('[grid]\nnx = 96\nny = 48\n[flow]\nnu = 0.02\ninflow_speed = 0.04\ninflow_ramp_steps = 0\n'
+            'initial_velocity = [0.04, 0.0]\n[body]\nkind = "cylinder"\ndiameter = 8\nx = 30\ny = 24\n')
+    scene.write_text(body + '[[motion]]\nsteps = 20\nmove = "stop"\n[[motion]]\nsteps = 20\nmove = "against"\n'
+                     '[[motion]]\nsteps = 300\nmove = "stop"\n')
+    r = subprocess.run([*CLI, "report", "ringdown", "--scene", str(scene), "--quick"], capture_output=True,
+                       text=True, cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+    row = [line for line in r.stdout.splitlines() if line.startswith("| scene")]
+    assert len(row) == 1 and "| 0.001 | 0.1 |" in row[0]
+    still = tmp_path / "still.toml"
+    still.write_text(body + "[run]\nsteps = 100\n")
+    r = subprocess.run([*CLI, "report", "ringdown", "--scene", str(still), "--quick"], capture_output=True,
+                       text=True, cwd=ROOT)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "never moves" in r.stderr

@@ -162,3 +162,20 @@ def test_an_oscillating_phase_is_duetschs_motion():
         scene_from_dict(minimal(motion=[{"steps": 400, "amplitude": [-3.0, 0.0]}]))
     with pytest.raises(UserError, match="Mach limit"):
         scene_from_dict(minimal(motion=[{"steps": 400, "amplitude": [-30.0, 0.0], "period": 100}]))
+
+
+def test_a_tunnel_scene_without_boundary_keys_gets_the_quiet_tunnel():
+    """docs/reference/scenes.md 'Quiet by default': the window's sponge, absorbing layer and quiet
+    inlet; the quiet inlet only where the ramp allows it (at least 2 nx / c_s steps, or none);
+    naming any boundary key gives exactly what the scene says."""
+    quiet = scene_from_dict(minimal()).config
+    assert (quiet.sponge_cells, quiet.sponge_absorb, quiet.inlet_nonreflecting) == (32, 0.1, 0.001)
+    long_tunnel = scene_from_dict(minimal(grid={"nx": 600, "ny": 80})).config   # 1000-step ramp < 2078
+    assert (long_tunnel.sponge_cells, long_tunnel.inlet_nonreflecting) == (32, 0.0)
+    windy = scene_from_dict(minimal(grid={"nx": 600, "ny": 80},
+                                    flow={"nu": 0.02, "inflow_speed": 0.05, "inflow_ramp_steps": 0})).config
+    assert windy.inlet_nonreflecting == 0.001
+    bare = scene_from_dict(minimal(flow={"nu": 0.02, "inflow_speed": 0.05, "sponge_cells": 0})).config
+    assert (bare.sponge_cells, bare.sponge_absorb, bare.inlet_nonreflecting) == (0, 0.0, 0.0)
+    periodic = scene_from_dict(minimal(flow={"nu": 0.02, "x_boundary": "periodic"})).config
+    assert periodic.sponge_cells == 0 and periodic.inlet_nonreflecting == 0.0

@@ -1,13 +1,17 @@
 """The side panel: body (shape, size, angle, hold still, polygon editor), flow (wind speed,
 viscosity with live Re and Ma, grid, walls), forces (model, compare all, readouts), display mode
 and input (mouse or a haptic device). It only edits values; the window applies them.
+
+In physical units (View > Units) the wind box shows and takes m/s and the viscosity box shows
+the fluid's viscosity, read-only; the conversions are app/model/display_units.py's, and the
+signals always carry the solver's lattice values.
 """
 from __future__ import annotations
 
 import math
 
 from PySide6.QtCore import Qt, Signal
-from PySide6.QtWidgets import (QCheckBox, QComboBox, QDoubleSpinBox, QFormLayout, QGroupBox, QHBoxLayout, QLabel,
+from PySide6.QtWidgets import (QAbstractSpinBox, QCheckBox, QComboBox, QDoubleSpinBox, QFormLayout, QGroupBox, QHBoxLayout, QLabel,
                                QPushButton, QScrollArea, QVBoxLayout, QWidget)
 
 from feelflow.app.model.bodies import SHAPE_LABELS
@@ -65,6 +69,41 @@ TOOLTIPS = {
 }
 
 
+#: the flow boxes in lattice units: (decimals, minimum, maximum, step, suffix)
+WIND_LATTICE = (3, 0.0, 0.09, 0.005, " cells/step")
+VISCOSITY_LATTICE = (4, 0.0005, 0.3, 0.002, " cells\u00b2/step")
+
+
+def _configure(box: QDoubleSpinBox, decimals: int, minimum: float, maximum: float, step: float, suffix: str):
+    box.setDecimals(decimals)
+    box.setRange(minimum, maximum)
+    box.setSingleStep(step)
+    box.setSuffix(suffix)
+
+
+def _decimals_for(maximum: float) -> int:
+    """Decimals that give a value near `maximum` four significant digits."""
+    return max(0, min(12, 3 - math.floor(math.log10(maximum)))) if maximum > 0 else 3
+
+
+class ViscosityBox(QDoubleSpinBox):
+    """The viscosity box: in physical units it shows the fluid's viscosity (1e-6 m^2/s) in
+    scientific notation, which a plain QDoubleSpinBox cannot."""
+
+    scientific = False
+
+    def textFromValue(self, value: float) -> str:
+        return f"{value:.4g}" if self.scientific else super().textFromValue(value)
+
+    def valueFromText(self, text: str) -> float:
+        if self.scientific:
+            try:
+                return float(text)
+            except ValueError:
+                return self.value()
+        return super().valueFromText(text)
+
+
 class SidePanel(QScrollArea):
     """Signals carry the new value; the window applies it and calls `show_*` with the result."""
 
@@ -86,6 +125,8 @@ class SidePanel(QScrollArea):
     def __init__(self, parent=None):
         super().__init__(parent)
         self.units = DisplayUnits()   # lattice or SI (View > Units; app/model/display_units.py)
+        self.flow_shown = (math.nan, math.nan)   # the (wind, nu) the flow boxes stand for, lattice units
+        self._flow_units = None    # the units the flow boxes were last drawn in (`_flow_key`)
         inner = QWidget()
         col = QVBoxLayout(inner)
         col.setSpacing(6)
@@ -119,9 +160,10 @@ class SidePanel(QScrollArea):
         col.addWidget(self._group("Body", body))
 
         # flow
-        self.wind = QDoubleSpinBox(decimals=3, minimum=0.0, maximum=0.09, singleStep=0.005, suffix=" cells/step")
-        self.viscosity = QDoubleSpinBox(decimals=4, minimum=0.0005, maximum=0.3, singleStep=0.002,
-                                        suffix=" cells\u00b2/step")
+        self.wind = QDoubleSpinBox()
+        _configure(self.wind, *WIND_LATTICE)
+        self.viscosity = ViscosityBox()
+        _configure(self.viscosity, *VISCOSITY_LATTICE)
         self.reynolds = QLabel()
         self.mach = QLabel()
         for label in (self.reynolds, self.mach):
@@ -179,8 +221,8 @@ class SidePanel(QScrollArea):
         self.angle.valueChanged.connect(self.angleChanged)
         self.hold_still.toggled.connect(self.holdStillToggled)
         self.edit.toggled.connect(self.editToggled)
-        self.wind.valueChanged.connect(self.windChanged)
-        self.viscosity.valueChanged.connect(self.viscosityChanged)
+        self.wind.valueChanged.connect(self._wind_edited)
+        self.viscosity.valueChanged.connect(self._viscosity_edited)
         self.grid.currentIndexChanged.connect(lambda: self.gridChanged.emit(tuple(int(v) for v in self.grid.currentData().split("x"))))
         self.wall.currentIndexChanged.connect(lambda: self.wallChanged.emit(self.wall.currentData()))
         self.model.currentIndexChanged.connect(lambda: self.forceModelChanged.emit(self.model.currentData()))
@@ -210,8 +252,7 @@ class SidePanel(QScrollArea):
             select_data(self.shape, params.shape)
             self.size.setValue(params.size)
             self.angle.setValue(params.angle_deg)
-            self.wind.setValue(params.wind)
-            self.viscosity.setValue(params.nu)
+            self._show_flow(params.wind, params.nu)
             key = f"{params.grid[0]}x{params.grid[1]}"
             if self.grid.findData(key) < 0:   # a grid from a scene or settings, not a preset
                 self.grid.addItem(f"{params.grid[0]} x {params.grid[1]}", key)
@@ -225,6 +266,64 @@ class SidePanel(QScrollArea):
                 w.blockSignals(False)
         self.edit.setEnabled(params.shape == "polygon")
         self.save_shape.setEnabled(True)
+
+    # --- the flow boxes in the units shown ----------------------------------------------------
+    def _wind_edited(self, shown: float):
+        """The wind box changed: its value back in lattice units (m/s in SI) for the window."""
+        wind = self.units.lattice_speed(shown)
+        self.flow_shown = (wind, self.flow_shown[1])
+        self.windChanged.emit(wind)
+
+    def _viscosity_edited(self, nu: float):
+        if self.units.is_si:    # read-only in SI: the fluid fixes it
+            return
+        self.flow_shown = (self.flow_shown[0], nu)
+        self.viscosityChanged.emit(nu)
+
+    def _flow_key(self):
+        """What the flow boxes' drawing depends on besides the values: lattice, or the SI scale."""
+        u = self.units
+        return (u.physical.fluid.name, u.speed(1.0)) if u.is_si else None
+
+    def _show_flow(self, wind: float, nu: float):
+        """Draw the flow boxes for lattice (wind, nu) in the units shown (signals blocked)."""
+        u = self.units
+        boxes = (self.wind, self.viscosity)
+        for b in boxes:
+            b.blockSignals(True)
+        try:
+            if u.is_si:
+                fluid = u.physical.fluid
+                top = u.speed(WIND_LATTICE[2])
+                _configure(self.wind, _decimals_for(top), 0.0, top, u.speed(WIND_LATTICE[3]), " m/s")
+                self.wind.setValue(u.speed(wind))
+                self.wind.setToolTip(f"Speed of the incoming {fluid.name}, in m/s for the chosen body size "
+                                     f"(View > Units); the solver runs the same Reynolds number at "
+                                     f"{wind:.4g} cells per step")
+                self.viscosity.scientific = True
+                _configure(self.viscosity, 12, 0.0, 1.0, 0.0, " m\u00b2/s")
+                self.viscosity.setValue(u.viscosity(nu))
+                self.viscosity.setReadOnly(True)
+                self.viscosity.setButtonSymbols(QAbstractSpinBox.NoButtons)
+                self.viscosity.setToolTip(f"{fluid.name}'s kinematic viscosity: the fluid fixes it, so it cannot "
+                                          f"be changed here (change the Reynolds number with the wind speed, or "
+                                          f"set the solver's viscosity in lattice units, View > Units); the "
+                                          f"solver runs {nu:.4g} cells\u00b2 per step")
+            else:
+                _configure(self.wind, *WIND_LATTICE)
+                self.wind.setValue(wind)
+                self.wind.setToolTip(TOOLTIPS["wind"])
+                self.viscosity.scientific = False
+                self.viscosity.setReadOnly(False)
+                self.viscosity.setButtonSymbols(QAbstractSpinBox.UpDownArrows)
+                _configure(self.viscosity, *VISCOSITY_LATTICE)
+                self.viscosity.setValue(nu)
+                self.viscosity.setToolTip(TOOLTIPS["viscosity"])
+        finally:
+            for b in boxes:
+                b.blockSignals(False)
+        self.flow_shown = (wind, nu)
+        self._flow_units = self._flow_key()
 
     def show_angle(self, degrees: float):
         """Show the body's angle without emitting angleChanged (the wheel or the handle turned it)."""
@@ -254,9 +353,12 @@ class SidePanel(QScrollArea):
             ph = units.physical
             self.physical.setText(f"<i>Simulates {ph.describe()}: wind {ph.wind_m_s:.3g} m/s, "
                                   f"ν {ph.fluid.viscosity:.3g} m²/s, ρ {ph.fluid.density:g} kg/m³; "
-                                  f"a step is {ph.dt:.3g} s, a cell {ph.dx:.3g} m. The wind and viscosity fields "
-                                  f"above are the solver's (lattice units).</i>")
+                                  f"a step is {ph.dt:.3g} s, a cell {ph.dx:.3g} m. The solver runs wind "
+                                  f"{ph.speed:.4g} cells/step, ν {ph.nu:.4g} cells²/step.</i>")
         self.physical.setVisible(units.is_si)
+        wind, nu = self.flow_shown
+        if self._flow_key() != self._flow_units and math.isfinite(wind) and math.isfinite(nu):
+            self._show_flow(wind, nu)   # redrawn only when the units change: typing is not interrupted
 
     def show_numbers(self, reynolds: float, mach: float, mach_limit: float):
         self.reynolds.setText(f"Re = {reynolds:.0f}")

@@ -59,6 +59,10 @@ class DisplayUnits:
     def speed(self, v):
         return self.physical.velocity(v) if self.physical else v
 
+    def lattice_speed(self, v):
+        """A speed shown in these units back to the solver's (cells/step)."""
+        return self.physical.lattice_velocity(v) if self.physical else v
+
     def time(self, steps):
         return self.physical.time(steps) if self.physical else steps
 
@@ -77,7 +81,7 @@ class DisplayUnits:
 
 def for_model(choice: UnitsChoice, model) -> DisplayUnits:
     """The units for `model` (a TunnelModel) now: lattice when chosen, or when the flow has no
-    wind or no body to scale by (then nothing physical can be read)."""
+    body to scale by (then nothing physical can be read)."""
     if not choice.physical or model is None:
         return DisplayUnits()
     p = model.params
@@ -86,6 +90,18 @@ def for_model(choice: UnitsChoice, model) -> DisplayUnits:
         return DisplayUnits(PhysicalUnits(FLUIDS[choice.fluid], choice.size_m, choice.span_m, length, p.wind, p.nu))
     except ValueError:
         return DisplayUnits()
+
+
+def choice_to_dict(choice: UnitsChoice) -> dict:
+    """The choice as a session file records it (app/sessions/format.py, manifest "units")."""
+    return {"fluid": choice.fluid, "size_m": float(choice.size_m), "span_m": float(choice.span_m)}
+
+
+def choice_from_dict(d) -> UnitsChoice | None:
+    """A session's recorded choice (already checked by app/sessions/format.py); None if absent."""
+    if not isinstance(d, dict):
+        return None
+    return UnitsChoice(d["fluid"], float(d["size_m"]), float(d["span_m"]))
 
 
 def _column_unit(name: str, units: DisplayUnits):

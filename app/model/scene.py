@@ -162,6 +162,26 @@ def _show(value) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
+#: the tunnel's boundary keys: a scene that names none of them gets the window's quiet tunnel
+BOUNDARY_KEYS = ("sponge_cells", "sponge_strength", "sponge_absorb", "inlet_nonreflecting")
+
+
+def quiet_defaults(nx: int, ramp: int) -> dict:
+    """The window's quiet tunnel (app/model/simulation.py default_base_config) for a scene that
+    names no boundary key: the outlet sponge (32 cells, at most a quarter of the tunnel) with its
+    absorbing layer, and the quiet inlet where the inflow ramp allows it (none, or at least
+    `shortest_ramp(nx)` steps; docs/science/quiet-tunnel.md). Naming any boundary key (e.g.
+    `sponge_cells = 0`) gives the bare tunnel instead."""
+    from feelflow.app.model.simulation import QUIET_INLET_RATE, default_base_config
+    from feelflow.solver.quiet_inlet import shortest_ramp
+
+    base = default_base_config((nx, 8))
+    out = {"sponge_cells": min(base.sponge_cells, nx // 4), "sponge_absorb": base.sponge_absorb}
+    if ramp == 0 or ramp >= shortest_ramp(nx):
+        out["inlet_nonreflecting"] = QUIET_INLET_RATE
+    return out
+
+
 def load_scene(path) -> Scene:
     """Read and validate a scene file; UserError (one line) on any problem."""
     from feelflow.app.inputs import load_toml
@@ -205,10 +225,12 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
     inflow_speed = flow.number("inflow_speed", 0.05 if x_boundary == "tunnel" else 0.0, nonnegative=True)
     inflow_profile = flow.choice("inflow_profile", PROFILES, "uniform")
     ramp = flow.integer("inflow_ramp_steps", 1000, lo=0, hi=MAX_STEPS)
-    sponge_cells = flow.integer("sponge_cells", 0, lo=0)
+    quiet = quiet_defaults(nx, ramp) if (x_boundary == "tunnel" and not any(flow.has(k) for k in BOUNDARY_KEYS)) \
+        else {}
+    sponge_cells = flow.integer("sponge_cells", quiet.get("sponge_cells", 0), lo=0)
     sponge_strength = flow.number("sponge_strength", 10.0, positive=True)
-    sponge_absorb = flow.number("sponge_absorb", 0.0, nonnegative=True)
-    inlet_nonreflecting = flow.number("inlet_nonreflecting", 0.0, nonnegative=True)
+    sponge_absorb = flow.number("sponge_absorb", quiet.get("sponge_absorb", 0.0), nonnegative=True)
+    inlet_nonreflecting = flow.number("inlet_nonreflecting", quiet.get("inlet_nonreflecting", 0.0), nonnegative=True)
     mach_limit = flow.number("mach_limit", 0.17, positive=True)
     initial_velocity = flow.pair("initial_velocity", (0.0, 0.0))
     body_force = flow.pair("body_force", (0.0, 0.0))
@@ -258,7 +280,7 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
     run = top.table("run")
     default_steps = script.total_steps if script.total_steps > 0 else None
     steps = run.integer("steps", default_steps if default_steps else MISSING, lo=1, hi=MAX_STEPS)
-    backend = run.choice("backend", sorted(BACKENDS), "numpy")
+    backend = run.choice("backend", sorted(BACKENDS) + ["auto"], "auto")
     run.done()
     top.done()
 

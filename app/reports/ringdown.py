@@ -131,6 +131,52 @@ def run_seed(key: str, backend: str, before: bool, scenes_dir: Path, phase_steps
             "phase_steps": int(b - a)}
 
 
+def last_stop(script) -> int | None:
+    """The step at which the script's last moving phase ends (None: it never moves)."""
+    end, stop = 0, None
+    for phase in script.phases:
+        end += phase.steps
+        if phase.velocity != (0.0, 0.0) or phase.oscillates:
+            stop = end
+    return stop
+
+
+def load_moving_scene(path):
+    """(scene, step of its last stop); UserError (one line) for a bad file or a body that never moves."""
+    from feelflow.app.errors import UserError
+    from feelflow.app.model.scene import load_scene
+
+    scene = load_scene(path)
+    stop = last_stop(scene.motion)
+    if stop is None:
+        raise UserError(f"{path}: the body never moves: nothing rings down after a stop")
+    return scene, stop
+
+
+def run_scene(path, backend: str, window=AFTER_WINDOW) -> dict:
+    """A scene file as it stands (its own boundaries, body and motion): the drag swing between
+    `window` steps after its last moving phase ends (10-step means, over their mean), as for
+    the window case; the run goes on past the scene's own steps where it must."""
+    from feelflow.app.headless import make_solver
+
+    scene, stop = load_moving_scene(path)
+    steps = stop + window[1]
+    cfg = scene.config
+    solver = make_solver(backend, cfg)
+    start = time.perf_counter()
+    try:
+        drag = _drag_series(solver, scene.body, scene.motion, steps, BLOCK)
+    finally:
+        solver.close()
+    t = (np.arange(len(drag)) + 1) * BLOCK
+    after = (t > stop + window[0]) & (t <= stop + window[1])
+    settled = float(drag[after].mean())
+    return {"case": f"scene {Path(path).name}", "backend": backend, "boundaries": "scene",
+            "grid": f"{cfg.nx}x{cfg.ny}", "quiet_inlet": cfg.inlet_nonreflecting, "absorb": cfg.sponge_absorb,
+            "wall_s": round(time.perf_counter() - start, 1), "settled_drag": settled,
+            "swing_after_stop": float(drag[after].std() / abs(settled)), "swing_before_move": None}
+
+
 def format_table(runs: list[dict]) -> str:
     """Markdown: one row per run, before and after side by side in run order."""
     lines = ["| case | backend | boundaries | grid | quiet inlet rate | absorb | settled drag "

@@ -25,7 +25,7 @@ REYNOLDS = 40.0
 SPEED = 0.04
 WINDOW = (3000, 5000)
 #: --quick: steps window of a smoke test (not physics)
-QUICK_WINDOW = (60, 160)
+QUICK_WINDOW = (20, 70)
 BLOCKS = (1, 5, 25)
 MODELS = ("momentum_exchange", "pressure")
 

@@ -45,6 +45,11 @@ STATE = "state.npz"  # only when the recording started on a running flow (manife
 PROBES = "probes.npz"
 PROBES_MAX_BYTES = 16 << 20
 PROBE_NAMES = ("positions", "probe0", "probe1", "probe2", "probe3")
+#: optional manifest key: the units the window showed while it recorded (View > Units;
+#: app/model/display_units.py): {"fluid": "lattice" or a solver/units.py FLUIDS key, "size_m",
+#: "span_m"}. Only what is shown depends on it, never the replay, and a reader that does not know
+#: it ignores it, so it needs no new format version.
+UNITS = "units"
 MEMBERS = (MANIFEST, PARAMETERS, INPUTS, FORCES)
 #: largest uncompressed member we read (a zip bomb is refused before it is inflated); the
 #: array members are bounded tighter, by the rows and grid the manifest declares
@@ -166,6 +171,7 @@ class Session:
     state: np.ndarray | None = None  # then its populations f (9, ny, nx), from state.npz
     inlet_reference: np.ndarray | None = None  # and the quiet inlet's reference (ny,), if it has one
     probes: dict | None = None       # the window's probes, from the optional probes.npz (PROBES)
+    units: dict | None = None        # the window's units choice, from the optional manifest key UNITS
     source: str = field(default="session", compare=False)
 
     @property
@@ -506,7 +512,27 @@ def _validate(manifest, parameters, inputs, forces, src, state=None, inlet_refer
     return Session(manifest=manifest, config=config, body=body, backend=manifest["backend"],
                    force_models=tuple(initial_models), inputs=inputs, parameters=params,
                    forces=forces, models=tuple(models), start=start, state=state,
-                   inlet_reference=_validate_inlet_reference(inlet_reference, config), source=src)
+                   inlet_reference=_validate_inlet_reference(inlet_reference, config), source=src,
+                   units=_validate_units(manifest.get(UNITS)))
+
+
+def _validate_units(units) -> dict | None:
+    """The optional manifest key UNITS: None, or {"fluid", "size_m", "span_m"} with a known
+    fluid and positive finite lengths in metres."""
+    if units is None:
+        return None
+    from feelflow.solver.units import FLUIDS
+
+    fluids = ("lattice",) + tuple(FLUIDS)
+    if not isinstance(units, dict) or set(units) != {"fluid", "size_m", "span_m"}:
+        raise SessionError(f"{MANIFEST}: {UNITS} must hold exactly fluid, size_m and span_m")
+    if units["fluid"] not in fluids:
+        raise SessionError(f"{MANIFEST}: {UNITS}.fluid must be one of {', '.join(fluids)}, got {units['fluid']!r}")
+    for key in ("size_m", "span_m"):
+        v = units[key]
+        if not (is_number(v) and 0 < v < 1e6):
+            raise SessionError(f"{MANIFEST}: {UNITS}.{key} must be a positive length in metres, got {v!r}")
+    return {"fluid": units["fluid"], "size_m": float(units["size_m"]), "span_m": float(units["span_m"])}
 
 
 def _validate_inlet_reference(reference, config: FlowConfig):

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from feelflow.app.sessions.format import (FORMAT, PARAMETER_NAMES, VERSION, Session, config_to_dict,
+from feelflow.app.sessions.format import (FORMAT, PARAMETER_NAMES, UNITS, VERSION, Session, config_to_dict,
                                           feelflow_version, force_columns, save_session)
 from feelflow.solver.config import FlowConfig
 
@@ -34,6 +34,8 @@ class SessionRecorder:
         self.force_models = tuple(force_models)
         self.backend = backend
         self.probes: dict | None = None   # the window's probes (app/model/probes.py to_arrays), saved with it
+        #: the window's units choice (app/model/display_units.py choice_to_dict), saved in the manifest
+        self.units: dict | None = None
         self.renderer = renderer or ("none (numpy on the CPU)" if backend == "numpy" else "unknown")
         self.scene_toml = scene_toml
         self.scene_source = scene_source
@@ -129,7 +131,7 @@ class SessionRecorder:
                     "body": np.array([r[3] for r in self._forces], dtype=np.float64).reshape(nf, 4),
                     "values": values},
             models=tuple(self._models), start=self.start, state=self.state, inlet_reference=self.inlet_reference,
-            probes=self.probes,
+            probes=self.probes, units=self.units,
         )
 
     def _manifest(self) -> dict:
@@ -139,7 +141,7 @@ class SessionRecorder:
                  "force_models": list(self.force_models)}
         if self.scene_dict is not None:
             scene["dict"] = json.loads(json.dumps(self.scene_dict, default=str))
-        return {
+        manifest = {
             "format": FORMAT, "version": VERSION, "feelflow_version": feelflow_version(),
             "created": self.created, "backend": self.backend, "renderer": self.renderer,
             "scene": scene, "start": self.start,
@@ -147,6 +149,9 @@ class SessionRecorder:
             "counts": {"inputs": len(self._inputs), "parameters": len(self._parameters),
                        "forces": len(self._forces), "steps": self.step},
         }
+        if self.units is not None:   # optional: older readers ignore it (format.py UNITS)
+            manifest[UNITS] = dict(self.units)
+        return manifest
 
     def save(self, path) -> Path:
         """Write the session file atomically; SessionError (one line) if it cannot."""

@@ -131,6 +131,9 @@ def main(args) -> int:
 
         if lesson is not None and lesson not in PRESETS:
             raise UserError(f"--lesson: one of {', '.join(PRESETS)}, got {lesson!r}")
+        views = ("time", "speed", "polar", "drag_polar", "cp")
+        if getattr(args, "plot_view", None) not in (None, *views):
+            raise UserError(f"--plot-view: one of {', '.join(views)}, got {args.plot_view!r}")
         test = SelfTest(window, seconds=args.seconds, screenshot=args.screenshot, replay=session is not None,
                         frame_profile=getattr(args, "frame_profile", False), lesson=lesson,
                         plot_view=getattr(args, "plot_view", None))

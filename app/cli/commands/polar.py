@@ -32,7 +32,7 @@ def add_arguments(parser):
                         help="angles of attack in degrees (nose up is positive): a list '-4,0,4,8' or a range "
                              "'START:STOP:STEP' ('-4:16:2' includes 16)")
     parser.add_argument("--backend", default=None, metavar="numpy|cpu|gl|auto",
-                        help="solver backend (default: the scene's run.backend, else numpy)")
+                        help="solver backend (default: the scene's run.backend, else auto: the fastest here)")
     parser.add_argument("--scale", default="1", metavar="N",
                         help="resolution factor 1 - 4 (default 1): grid, body and viscosity scaled, Re kept")
     parser.add_argument("--tolerance", default=0.01, type=float, metavar="DC",
@@ -130,6 +130,9 @@ def main(args) -> int:
     check_work(config.nx, config.ny, 0, f"{args.scene} at --scale {factor}", "grid")
     check_memory(config.nx, config.ny, f"{args.scene} at --scale {factor}", "grid")
 
+    from feelflow.app.cli.commands.run import warn_outside_stable_region
+
+    warn_outside_stable_region(scene, args.scene)
     speed = config.inflow_speed
     chord = chord_of(shape)
     sweep = PolarSweep(angles, speed, chord, sample_steps=max(10, 25 * factor), tolerance=args.tolerance)

@@ -53,6 +53,9 @@ def add_arguments(parser):
     parser.add_argument("--json", default=None, metavar="PATH", help="lessons, scenes: also write the runs as JSON")
     parser.add_argument("--force", action="store_true", help="replace --json if it exists")
     parser.add_argument("--scenes", default="scenes", metavar="DIR", help="folder holding the scenes (default: scenes)")
+    parser.add_argument("--scene", default=None, metavar="FILE",
+                        help="ringdown: run this scene file as it stands instead (its own boundaries and motion; "
+                             "the swing 1000-3000 steps after its last moving phase ends)")
     parser.add_argument("--out", default="docs/science", metavar="DIR",
                         help="folder for seed-report.md and seed-report/ (default: docs/science)")
     parser.add_argument("--replot", action="store_true",
@@ -140,13 +143,20 @@ def scene_calm(args) -> int:
 
 def ringdown(args) -> int:
     from feelflow.app.headless import gl_context
-    from feelflow.app.reports.ringdown import (QUICK_PHASE_STEPS, SEED_DIAMETERS, format_table, run_seed,
-                                                run_window)
+    from feelflow.app.reports.ringdown import (AFTER_WINDOW, QUICK_PHASE_STEPS, SEED_DIAMETERS, format_table,
+                                                run_seed, run_window)
 
     if args.backend == "gl":
         gl_context()   # one line on stderr, exit 2, when there is no EGL context
     elif args.backend != "numpy":
         raise UserError(f"--backend: must be numpy or gl, got {args.backend!r}")
+    if args.scene is not None:
+        from feelflow.app.reports.ringdown import load_moving_scene, run_scene
+
+        load_moving_scene(args.scene)   # one line, exit 2, before any run
+        print(f"feelflow report ringdown: {args.scene} on {args.backend}", file=sys.stderr, flush=True)
+        runs = [run_scene(args.scene, args.backend, (100, 300) if args.quick else AFTER_WINDOW)]
+        return _print_runs(runs, format_table(runs), args.json)
     phase_steps = phase_steps_option(args.phase_steps, 1000)
     folder = Path(args.scenes)
     cases = _chosen(args.only, ["window", *SEED_DIAMETERS], "case")

@@ -20,7 +20,7 @@ from feelflow.app.errors import UserError
 def add_arguments(parser):
     parser.add_argument("scene", metavar="SCENE.toml", help="the scene file (keys: docs/reference/scenes.md)")
     parser.add_argument("--backend", default=None, metavar="numpy|cpu|gl|auto",
-                        help="solver backend (default: the scene's run.backend, else numpy); auto: the "
+                        help="solver backend (default: the scene's run.backend, else auto); auto: the "
                              "fastest here, timed briefly on the scene's grid and remembered")
     parser.add_argument("--steps", default=None, metavar="N", help="number of steps (default: the scene's)")
     parser.add_argument("--out", default="forces.csv", metavar="PATH", help="CSV file to write (default: forces.csv)")
@@ -99,6 +99,10 @@ def main(args) -> int:
 
         toml_text = read_bytes(args.scene, "scene file").decode("utf-8")
         solver, recorder = record_headless(solver, scene, scene_toml=toml_text)
+        if si is not None:   # the units chosen, for a replay in the window (session-format.md, "units")
+            from feelflow.app.model.display_units import choice_to_dict
+
+            recorder.units = choice_to_dict(choice)
     try:
         # a blow-up is detected and reported in one line, not as floating-point warnings
         with warnings.catch_warnings(), np.errstate(all="ignore"):

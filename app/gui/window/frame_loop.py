@@ -297,8 +297,9 @@ class FrameLoop:
             return
         p, panel = model.params, w.panel
         live = model is w.sim
-        if live and (abs(panel.wind.value() - p.wind) > 5e-4   # a sweep, a lesson or the guard
-                     or abs(panel.viscosity.value() - p.nu) > 5e-5):
+        wind, nu = panel.flow_shown     # lattice units, whatever units the boxes show
+        if live and (abs(wind - p.wind) > 5e-4   # a sweep, a lesson or the guard
+                     or abs(nu - p.nu) > 5e-5):
             panel.show_params(p, self.display_mode)
         elif live and not panel.angle.hasFocus():   # the wheel or the handle turned the body
             panel.show_angle(p.angle_deg)

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from PySide6.QtWidgets import QFileDialog, QLabel, QMessageBox
 
 from feelflow.app.gui.window.dialogs import attempt
+from feelflow.app.model.display_units import choice_to_dict
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
@@ -48,6 +49,7 @@ class ReplayController:
         path, _ = QFileDialog.getSaveFileName(w, "Save session", "lesson.ffsession", "Sessions (*.ffsession)")
         if path:
             recorder.probes = w.probes.session_arrays()   # the probes placed while it recorded, if any
+            recorder.units = choice_to_dict(w.units.choice)   # the units shown (View > Units)
             attempt(w, lambda: recorder.save(path), "Could not save the session")
 
     # --- replaying ----------------------------------------------------------------------------

@@ -1,9 +1,11 @@
 """View > Units: lattice units, or SI for a physical fluid (air, water, SAE 30 oil) and body
 size, under which the side panel's forces, the force plot, the probes' plot and the forces CSV
 read in newtons, metres per second, pascals and seconds for a flow with the simulated Reynolds
-number (app/model/display_units.py picks, solver/units.py converts). The choice is remembered
-(QSettings); the device's force scaling does not depend on it (haptics/ scales the lattice force
-itself)."""
+number (app/model/display_units.py picks, solver/units.py converts); the side panel's wind box
+then reads m/s and its viscosity box the fluid's viscosity. The choice is remembered (QSettings)
+and recorded in session files; replaying a session shows it in the units it was recorded in, and
+Stop replay returns to the user's own choice. The device's force scaling does not depend on it
+(haptics/ scales the lattice force itself)."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
@@ -13,7 +15,7 @@ from PySide6.QtWidgets import (QComboBox, QDialog, QDialogButtonBox, QDoubleSpin
                                QVBoxLayout)
 
 from feelflow.app.model.display_units import (DEFAULT_SIZE_M, DEFAULT_SPAN_M, LATTICE, DisplayUnits, UnitsChoice,
-                                              for_model)
+                                              choice_from_dict, for_model)
 from feelflow.solver.units import FLUIDS
 
 if TYPE_CHECKING:
@@ -70,7 +72,9 @@ class UnitsController:
     def __init__(self, window: "MainWindow"):
         self.w = window
         self.choice = self._remembered()
+        self.own_choice: UnitsChoice | None = None   # the user's choice while a replay shows the recorded one
         self.units = DisplayUnits()
+        window.events.shownChanged.connect(self.model_changed)
         self.timer = QTimer(window)     # the physical reading follows the flow (wind, viscosity, body)
         self.timer.setInterval(REFRESH_MS)
         self.timer.timeout.connect(self.refresh)
@@ -89,19 +93,34 @@ class UnitsController:
         if d.exec() == QDialog.Accepted:
             self.set_choice(d.choice())
 
-    def set_choice(self, choice: UnitsChoice):
-        """Show every number in `choice`'s units from now on, and remember it."""
+    def set_choice(self, choice: UnitsChoice, remember: bool = True):
+        """Show every number in `choice`'s units from now on, and remember it (QSettings) unless
+        it is a replayed session's."""
         self.choice = choice
-        s = self.w.settings
-        s.setValue("units/fluid", choice.fluid)
-        s.setValue("units/size_m", choice.size_m)
-        s.setValue("units/span_m", choice.span_m)
+        if remember:
+            self.own_choice = None
+            s = self.w.settings
+            s.setValue("units/fluid", choice.fluid)
+            s.setValue("units/size_m", choice.size_m)
+            s.setValue("units/span_m", choice.span_m)
         self.refresh()
         if choice.physical:
             self.timer.start()
         else:
             self.timer.stop()
         self.w.statusBar().showMessage(f"Units: {self.units.describe()}", 8000)
+
+    def model_changed(self, model):
+        """A replay started (its session's recorded units, if it has them) or stopped (back to
+        the user's choice)."""
+        session = getattr(getattr(model, "player", None), "session", None)
+        recorded = choice_from_dict(getattr(session, "units", None))
+        if recorded is not None:
+            if self.own_choice is None:
+                self.own_choice = self.choice
+            self.set_choice(recorded, remember=False)
+        elif model is self.w.sim and self.own_choice is not None:
+            self.set_choice(self.own_choice)
 
     def default_size(self, fluid: str) -> float:
         return DEFAULT_SIZE_M.get(fluid, 0.01)
