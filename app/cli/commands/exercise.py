@@ -38,6 +38,9 @@ def add_arguments(parser):
                    help="score at N times the exercise's resolution (1..8; default 1; 2 to confirm a close "
                         "ranking); refused before scoring when the grid, the steps or the memory it "
                         "needs are beyond the bounds")
+    p.add_argument("--backend", choices=("numpy", "cpu"), default="numpy",
+                   help="float64 solver for the runs: numpy (default, the reference) or the compiled cpu "
+                        "backend (the same digits in about a third of the time: docs/science/cpu-backend.md)")
     p = sub.add_parser("check", help="validate an exercise file and score its reference solutions")
     p.add_argument("exercise", metavar="EXERCISE.toml")
     p.add_argument("--convergence", action="store_true",
@@ -191,8 +194,9 @@ def _score(exercise, args) -> int:
     s = exercise.scene.scaled(scale)
     print(_machine_line())
     print(f"{exercise.title}: scoring {len(files)} shape files on {min(workers, len(files))} processes "
-          f"(numpy float64, {s.nx} x {s.ny}, {s.steps} steps each)", flush=True)
-    rows, wall = grading.grade(exercise, files, workers, scales=(scale,), progress=ProgressBar("shapes"))
+          f"({getattr(args, 'backend', 'numpy')} float64, {s.nx} x {s.ny}, {s.steps} steps each)", flush=True)
+    rows, wall = grading.grade(exercise, files, workers, scales=(scale,), progress=ProgressBar("shapes"),
+                               backend=getattr(args, "backend", "numpy"))
     rows = grading.ranked(exercise, rows)
     save_csv(out, grading.CSV_HEADER, grading.csv_rows(rows, exercise), "--out")
     o = exercise.objective
