@@ -107,3 +107,25 @@ def test_cli_run_record_within_the_bound_exits_0(tmp_path):
                         "--record", rec], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert r.returncode == 0 and r.stderr == "", r.stderr
     assert load_session(rec).steps == 30
+
+
+def test_recorder_stops_before_its_parameter_changes_outgrow_their_member(monkeypatch, tmp_path):
+    """parameters.json is bounded by bytes (bounds.MAX_JSON_BYTES), not only by rows: the recorder
+    counts the bytes it will write, exactly, and stops before the member would pass them."""
+    import json
+    import zipfile
+
+    cfg = small_config()
+    rec = SessionRecorder(cfg, start_body(), MODELS)
+    manifest = len(json.dumps(rec.session().manifest, indent=2)) + 1
+    monkeypatch.setattr(bounds, "MAX_JSON_BYTES", manifest + 600)   # the manifest fits; a few changes do
+    ss = SessionSolver(create_solver("numpy", cfg), rec)
+    for _ in range(40):
+        ss.pause()
+        ss.resume()
+    assert rec.full is not None and "bytes of parameter changes" in rec.full
+    path = rec.save(tmp_path / "params.ffsession")
+    with zipfile.ZipFile(path) as zf:
+        size = zf.getinfo("parameters.json").file_size
+    assert size == rec.parameters_bytes <= bounds.MAX_JSON_BYTES
+    assert len(load_session(path).parameters) == len(rec.session().parameters) > 3

@@ -46,17 +46,19 @@ def rows_problem(counts: dict) -> str | None:
     return None
 
 
-def session_problem(counts: dict, nx: int, ny: int) -> str | None:
+def session_problem(counts: dict, nx: int, ny: int, parameters_bytes: int = 0) -> str | None:
     """Why a session with these counts (inputs, parameters, forces, steps) on its scene's nx x ny
-    grid is more than a session may hold, or None: the loader's own bounds (`member_limits`), which
-    the recorder (recorder.py) checks before each row so that it never writes a file this loader
-    refuses."""
+    grid, and a parameters member of `parameters_bytes`, is more than a session may hold, or None:
+    the loader's own bounds (`member_limits`, MAX_JSON_BYTES), which the recorder (recorder.py)
+    checks before each row so that it never writes a file this loader refuses."""
     from feelflow.app.errors import UserError
     from feelflow.app.inputs import check_work
 
     problem = rows_problem(counts)
     if problem is not None:
         return problem
+    if parameters_bytes > MAX_JSON_BYTES:
+        return f"parameters.json would be {parameters_bytes} bytes, more than a session may hold ({MAX_JSON_BYTES})"
     try:
         check_work(max(nx, 1), max(ny, 1), counts["steps"], "the session", "counts.steps")
     except UserError as exc:

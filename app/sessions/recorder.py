@@ -53,6 +53,8 @@ class SessionRecorder:
         self.step = 0
         #: None while recording; one line once the recording stopped at the session bound
         self.full: str | None = None
+        #: the bytes parameters.json will have (format.py writes "[\n", the changes, "\n]\n")
+        self.parameters_bytes = 3
         self._seq = 0
         self._inputs: list[tuple] = []   # (seq, step, x, y, angle, vx, vy, omega)
         self._parameters: list[dict] = []
@@ -71,7 +73,7 @@ class SessionRecorder:
         return cls(scene.config, scene.body, scene.force_models, backend=backend or scene.backend,
                    renderer=renderer, scene_toml=scene_toml, scene_source=getattr(scene, "source", None))
 
-    def _room(self, key: str, steps: int = 0) -> bool:
+    def _room(self, key: str, steps: int = 0, json_bytes: int = 0) -> bool:
         """True if one more `key` row (and `steps` more steps) stays within the session bound;
         else the recording stops here (`full`)."""
         if self.full is not None:
@@ -79,11 +81,14 @@ class SessionRecorder:
         counts = {"inputs": len(self._inputs), "parameters": len(self._parameters),
                   "forces": len(self._forces), "steps": self.step + steps}
         counts[key] += 1
-        problem = bounds.session_problem(counts, self.config.nx, self.config.ny)
+        problem = bounds.session_problem(counts, self.config.nx, self.config.ny, self.parameters_bytes + json_bytes)
         if problem is None:
+            self.parameters_bytes += json_bytes
             return True
         if bounds.rows_problem(counts) is not None:
             problem = f"a session file holds at most {bounds.MAX_ROWS} {_ROW_NAMES[key]}"
+        elif problem.startswith("parameters.json"):
+            problem = f"a session file holds at most {bounds.MAX_JSON_BYTES} bytes of parameter changes"
         else:
             problem = "a session file may not hold " + problem.removeprefix("the session: counts.steps: ")
         self.full = f"the recording stopped at step {self.step}: {problem}; what was recorded up to there is kept"
@@ -117,11 +122,13 @@ class SessionRecorder:
             value = value.to_dict()
         if name == "force_models":
             value = list(value)
-        json.dumps(value, allow_nan=False)  # must be plain JSON
-        if not self._room("parameters"):
+        change = {"seq": self._seq, "step": self.step, "name": name, "value": value}
+        # must be plain JSON; its bytes in parameters.json (indent=1: " change" and ",\n")
+        size = len(json.dumps([change], indent=1, allow_nan=False)) - 2
+        if not self._room("parameters", json_bytes=size):
             return False
-        seq, t = self._stamp(step)
-        self._parameters.append({"seq": seq, "step": t, "name": name, "value": value})
+        self._stamp(step)   # the seq and step of `change`
+        self._parameters.append(change)
         return True
 
     def record_forces(self, n: int, forces: dict, body=(math.nan,) * 4, *, step=None) -> bool:
