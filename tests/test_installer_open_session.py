@@ -23,9 +23,8 @@ def test_a_missing_session_file_is_one_line_and_exit_2(tmp_path):
 
 @pytest.mark.gui
 @pytest.mark.skipif(not os.environ.get("DISPLAY"), reason="needs an X display (run under xvfb-run -a)")
-def test_gui_with_a_session_file_opens_the_window_replaying_it(qapp, tmp_path):
+def test_gui_with_a_session_file_opens_the_window_replaying_it(qapp, tmp_path, monkeypatch):
     from PySide6.QtCore import QTimer
-    from PySide6.QtWidgets import QApplication
 
     from feelflow.app.cli.main import main
     from feelflow.app.gui.main_window import MainWindow
@@ -39,11 +38,22 @@ def test_gui_with_a_session_file_opens_the_window_replaying_it(qapp, tmp_path):
     path = rec.save(tmp_path / "lesson.ffsession")
 
     seen = {}
+    # Only the window this command opens is looked at: a window an earlier test of the same
+    # process left for Qt to delete may still be listed among the top-level widgets, and
+    # touching it can crash the process.
+    opened = []
+    init = MainWindow.__init__
+
+    def remember(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        opened.append(self)
+
+    monkeypatch.setattr(MainWindow, "__init__", remember)
 
     def watch():
         """Once the window replays, note what it shows and close it (app.exec() then returns)."""
-        for w in QApplication.topLevelWidgets():
-            if isinstance(w, MainWindow) and w.isVisible():
+        for w in opened:
+            if w.isVisible():
                 if w.replays.replay is not None:
                     seen.update(label=w.replays.label.text(), shown=w.viewport.sim is w.replays.replay,
                                 live=w.sim is not None)
@@ -53,9 +63,8 @@ def test_gui_with_a_session_file_opens_the_window_replaying_it(qapp, tmp_path):
 
     def give_up():
         seen.setdefault("timeout", True)
-        for w in QApplication.topLevelWidgets():
-            if isinstance(w, MainWindow):
-                w.close()
+        for w in opened:
+            w.close()
 
     poll = QTimer()
     poll.timeout.connect(watch)

@@ -28,7 +28,7 @@ SESSION = ROOT / "tests" / "data" / "sessions" / "v2-midflow.ffsession"
 #: an option names a file when its metavar says so
 FILE_METAVAR = re.compile(r"PATH|FILE|DIR|\.\w+$")
 #: options that name a file the command READS; every other file option is an output
-INPUT_OPTIONS = {"gui --exercise", "report --scenes"}
+INPUT_OPTIONS = {"gui --exercise", "report --scenes", "report --scene"}
 #: values for options a command requires
 REQUIRED_VALUES = {"--angles": "0"}
 

@@ -43,7 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--seconds", type=float, default=8.0, help="with --selftest: how long to run")
     parser.add_argument("--lesson", default=None, metavar="KEY",
                         help="with --selftest: run this lesson (app/model/presets.py) for --seconds instead of the "
-                             "default script, then save the screenshot (e.g. polar)")
+                             "default script (e.g. polar); --screenshot names the picture")
     parser.add_argument("--plot-view", default=None, metavar="VIEW",
                         help="with --selftest --lesson: the force plot's view for the screenshot (time, speed, polar, "
                              "drag_polar, cp)")
