@@ -271,3 +271,33 @@ def test_selftest_measures_a_cli_recorded_replay_rows_whole_and_in_parts(tmp_pat
     assert len(lines) == 2, r.stdout
     per_frame = {k: float(v.split("(")[1].split(" steps/frame")[0]) for k, v in lines.items()}
     assert per_frame["long rows in parts"] <= per_frame["rows whole"]
+
+
+def test_a_recording_stops_at_the_session_bound_says_so_and_saves_a_file_that_opens(
+        window, qtbot, tmp_path, monkeypatch):
+    """The bound made small (app/sessions/bounds.py MAX_ROWS): the recording stops, the status
+    bar and the Record action say so, the tunnel runs on, and choosing Record saves what was
+    recorded, which the loader (same bound) opens."""
+    from PySide6.QtWidgets import QFileDialog
+
+    from feelflow.app.gui.selftest import send_mouse
+    from feelflow.app.sessions import bounds, load_session
+
+    monkeypatch.setattr(bounds, "MAX_ROWS", 30)
+    path = tmp_path / "full.ffsession"
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(path), ""))
+    vp, sim = window.viewport, window.sim
+    window.actions.record.trigger()
+    rec = sim.solver.recorder
+    send_mouse(vp, "press", vp.to_widget(*sim.pos))
+    send_mouse(vp, "move", vp.to_widget(sim.pos[0] + 15, sim.pos[1] + 4))   # a row of each kind a step
+    qtbot.waitUntil(lambda: rec.full is not None and "full" in window.actions.record.text(), timeout=20000)
+    assert "stopped" in window.statusBar().currentMessage() and "Record session" in window.statusBar().currentMessage()
+    assert window.actions.record.isChecked()
+    t = sim.solver.time
+    qtbot.waitUntil(lambda: sim.solver.time > t + 20, timeout=20000)   # the tunnel runs on
+    send_mouse(vp, "release", vp.to_widget(*sim.pos))
+    window.actions.record.trigger()
+    assert window.actions.record.text() == "Record session" and not window.actions.record.isChecked()
+    s = load_session(path)
+    assert max(s.manifest["counts"][k] for k in ("inputs", "parameters", "forces")) == 30

@@ -1,5 +1,5 @@
 """`feelflow bench operators [--quick] [--rounds N] [--json PATH]`: what each collision operator
-costs per step, on the numpy and the gl backend, in the window's tunnel.
+costs per step, on the numpy, the compiled cpu and the gl backend, in the window's tunnel.
 
 The tunnel scene of `feelflow bench solver` (app/bench/solver_speed.py: inlet, pressure outlet with
 its sponge, a cylinder moved every 10 steps, the reference force every step) at the window's
@@ -48,7 +48,7 @@ def main(args) -> int:
 
     quick = bool(getattr(args, "quick", False))
     rounds = getattr(args, "rounds", None) or (1 if quick else 3)
-    steps = {"numpy": 60 if quick else 300, "gl": 200 if quick else 1000}
+    steps = {"numpy": 60 if quick else 300, "cpu": 300 if quick else 1500, "gl": 200 if quick else 1000}
     from feelflow.solver.backend import NUMPY_ONLY_COLLISIONS
 
     def runs_on(backend, op):

@@ -37,6 +37,35 @@ def _count(d, key: str, fail, where: str) -> int:
     return v
 
 
+def rows_problem(counts: dict) -> str | None:
+    """Why these counts of inputs, parameter changes and force rows are more than a session may
+    hold (MAX_ROWS each), or None."""
+    for key in ("inputs", "parameters", "forces"):
+        if counts[key] > MAX_ROWS:
+            return f"counts.{key} is {counts[key]}, more than a session may hold ({MAX_ROWS})"
+    return None
+
+
+def session_problem(counts: dict, nx: int, ny: int, parameters_bytes: int = 0) -> str | None:
+    """Why a session with these counts (inputs, parameters, forces, steps) on its scene's nx x ny
+    grid, and a parameters member of `parameters_bytes`, is more than a session may hold, or None:
+    the loader's own bounds (`member_limits`, MAX_JSON_BYTES), which the recorder (recorder.py)
+    checks before each row so that it never writes a file this loader refuses."""
+    from feelflow.app.errors import UserError
+    from feelflow.app.inputs import check_work
+
+    problem = rows_problem(counts)
+    if problem is not None:
+        return problem
+    if parameters_bytes > MAX_JSON_BYTES:
+        return f"parameters.json would be {parameters_bytes} bytes, more than a session may hold ({MAX_JSON_BYTES})"
+    try:
+        check_work(max(nx, 1), max(ny, 1), counts["steps"], "the session", "counts.steps")
+    except UserError as exc:
+        return str(exc)
+    return None
+
+
 def member_limits(manifest, fail, manifest_name: str, members) -> dict:
     """Bytes each array member (inputs, forces, state) may inflate to, from the counts and grid
     the manifest declares, after bounding those (MAX_ROWS; app/inputs.py's grid and steps)."""
@@ -49,9 +78,9 @@ def member_limits(manifest, fail, manifest_name: str, members) -> dict:
         fail(f"{where}'counts' is missing or not a dict")
     counts = manifest["counts"]
     n = {k: _count(counts, k, fail, where + "counts.") for k in ("inputs", "parameters", "forces", "steps")}
-    for key in ("inputs", "parameters", "forces"):
-        if n[key] > MAX_ROWS:
-            fail(f"{where}counts.{key} is {n[key]}, more than a session may hold ({MAX_ROWS})")
+    problem = rows_problem(n)
+    if problem is not None:
+        fail(where + problem)
     if n["forces"] > n["steps"]:
         fail(f"{where}counts.forces is {n['forces']} but a force row covers at least one of the "
              f"{n['steps']} steps")

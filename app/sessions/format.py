@@ -25,7 +25,8 @@ import numpy as np
 
 from feelflow.app.errors import shown
 from feelflow.app.sessions import versions
-from feelflow.app.sessions.bounds import MAX_FILE_BYTES, MAX_JSON_BYTES, check_npz, member_limits
+from feelflow.app.sessions import bounds
+from feelflow.app.sessions.bounds import MAX_FILE_BYTES, check_npz, member_limits
 from feelflow.solver.config import ConfigError, FlowConfig
 
 FORMAT = "feelflow-session"
@@ -304,8 +305,8 @@ def load_session(path) -> Session:
                 fail(f"{member} inflates to more than {limit} bytes")
             data[member] = raw
 
-        read(MANIFEST, MAX_JSON_BYTES)
-        read(PARAMETERS, MAX_JSON_BYTES)
+        read(MANIFEST, bounds.MAX_JSON_BYTES)   # the recorder's bound too (bounds.session_problem)
+        read(PARAMETERS, bounds.MAX_JSON_BYTES)
         manifest = _json_member(data[MANIFEST], MANIFEST, fail)
         limits = member_limits(manifest, fail, MANIFEST, (INPUTS, FORCES, STATE))
         for member in (INPUTS, FORCES) + ((STATE,) if STATE in names else ()):

@@ -10,9 +10,13 @@ from pathlib import Path
 
 import numpy as np
 
+from feelflow.app.sessions import bounds
 from feelflow.app.sessions.format import (FORMAT, PARAMETER_NAMES, UNITS, VERSION, Session, config_to_dict,
                                           feelflow_version, force_columns, save_session)
 from feelflow.solver.config import FlowConfig
+
+
+_ROW_NAMES = {"inputs": "input samples", "parameters": "parameter changes", "forces": "force rows"}
 
 
 # --- recording --------------------------------------------------------------------------------
@@ -24,6 +28,11 @@ class SessionRecorder:
     advances it. The optional `step=` arguments are checks: they must equal the clock (inputs,
     parameters) or the clock + n (forces). Normally `SessionSolver` feeds a recorder; a caller
     that drives its own solver may call the record_* methods in the order it drives it.
+
+    A recording never grows past what the session loader accepts (bounds.py `session_problem`:
+    rows of each kind, steps on the scene's grid): the row that would pass it is not recorded,
+    nor anything after it; `full` then says why in one line, the record_* methods return False,
+    and what was recorded up to there stays a valid session to save.
     """
 
     def __init__(self, config: FlowConfig, body=None, force_models=(), *, backend: str = "numpy",
@@ -42,6 +51,10 @@ class SessionRecorder:
         self.scene_dict = scene_dict
         self.created = datetime.now(timezone.utc).isoformat(timespec="seconds")
         self.step = 0
+        #: None while recording; one line once the recording stopped at the session bound
+        self.full: str | None = None
+        #: the bytes parameters.json will have (format.py writes "[\n", the changes, "\n]\n")
+        self.parameters_bytes = 3
         self._seq = 0
         self._inputs: list[tuple] = []   # (seq, step, x, y, angle, vx, vy, omega)
         self._parameters: list[dict] = []
@@ -60,6 +73,27 @@ class SessionRecorder:
         return cls(scene.config, scene.body, scene.force_models, backend=backend or scene.backend,
                    renderer=renderer, scene_toml=scene_toml, scene_source=getattr(scene, "source", None))
 
+    def _room(self, key: str, steps: int = 0, json_bytes: int = 0) -> bool:
+        """True if one more `key` row (and `steps` more steps) stays within the session bound;
+        else the recording stops here (`full`)."""
+        if self.full is not None:
+            return False
+        counts = {"inputs": len(self._inputs), "parameters": len(self._parameters),
+                  "forces": len(self._forces), "steps": self.step + steps}
+        counts[key] += 1
+        problem = bounds.session_problem(counts, self.config.nx, self.config.ny, self.parameters_bytes + json_bytes)
+        if problem is None:
+            self.parameters_bytes += json_bytes
+            return True
+        if bounds.rows_problem(counts) is not None:
+            problem = f"a session file holds at most {bounds.MAX_ROWS} {_ROW_NAMES[key]}"
+        elif problem.startswith("parameters.json"):
+            problem = f"a session file holds at most {bounds.MAX_JSON_BYTES} bytes of parameter changes"
+        else:
+            problem = "a session file may not hold " + problem.removeprefix("the session: counts.steps: ")
+        self.full = f"the recording stopped at step {self.step}: {problem}; what was recorded up to there is kept"
+        return False
+
     def _stamp(self, step) -> tuple[int, int]:
         if step is not None and int(step) != self.step:
             raise ValueError(f"event at step {step}, but the recorder is at step {self.step}")
@@ -67,33 +101,48 @@ class SessionRecorder:
         self._seq += 1
         return seq, self.step
 
-    def record_input(self, x, y, angle=0.0, vx=0.0, vy=0.0, omega=0.0, *, step=None) -> None:
-        """A body pose (x, y, angle) and commanded motion (vx, vy, omega), lattice units."""
+    def record_input(self, x, y, angle=0.0, vx=0.0, vy=0.0, omega=0.0, *, step=None) -> bool:
+        """A body pose (x, y, angle) and commanded motion (vx, vy, omega), lattice units.
+        False (nothing recorded) once the recording is `full`."""
         values = tuple(float(v) for v in (x, y, angle, vx, vy, omega))
         if not all(math.isfinite(v) for v in values):
             raise ValueError(f"input sample {values} is not finite")
+        if not self._room("inputs"):
+            return False
         seq, t = self._stamp(step)
         self._inputs.append((seq, t) + values)
+        return True
 
-    def record_parameter(self, name: str, value=None, *, step=None) -> None:
-        """A parameter change (PARAMETER_NAMES; docs/reference/session-format.md says what each value is)."""
+    def record_parameter(self, name: str, value=None, *, step=None) -> bool:
+        """A parameter change (PARAMETER_NAMES; docs/reference/session-format.md says what each value is).
+        False (nothing recorded) once the recording is `full`."""
         if name not in PARAMETER_NAMES:
             raise ValueError(f"unknown parameter {name!r}; one of {', '.join(PARAMETER_NAMES)}")
         if name == "body" and value is not None and not isinstance(value, dict):
             value = value.to_dict()
         if name == "force_models":
             value = list(value)
-        json.dumps(value, allow_nan=False)  # must be plain JSON
-        seq, t = self._stamp(step)
-        self._parameters.append({"seq": seq, "step": t, "name": name, "value": value})
+        change = {"seq": self._seq, "step": self.step, "name": name, "value": value}
+        # must be plain JSON; its bytes in parameters.json (indent=1: " change" and ",\n")
+        size = len(json.dumps([change], indent=1, allow_nan=False)) - 2
+        if not self._room("parameters", json_bytes=size):
+            return False
+        self._stamp(step)   # the seq and step of `change`
+        self._parameters.append(change)
+        return True
 
-    def record_forces(self, n: int, forces: dict, body=(math.nan,) * 4, *, step=None) -> None:
-        """`forces` {model: (fx, fy)} averaged over the last n steps; body (x, y, vx, vy) then."""
+    def record_forces(self, n: int, forces: dict, body=(math.nan,) * 4, *, step=None) -> bool:
+        """`forces` {model: (fx, fy)} averaged over the last n steps; body (x, y, vx, vy) then.
+        False (nothing recorded, the clock stays) once the recording is `full`."""
         n = int(n)
         if n < 1:
             raise ValueError(f"a force row covers at least one step, got n = {n}")
+        if self.full is not None:
+            return False
         if step is not None and int(step) != self.step + n:
             raise ValueError(f"force row at step {step}, but the recorder is at {self.step} + {n}")
+        if not self._room("forces", n):
+            return False
         seq = self._seq
         self._seq += 1
         self.step += n
@@ -102,6 +151,7 @@ class SessionRecorder:
                 self._models.append(name)
         self._forces.append((seq, self.step, n, tuple(float(v) for v in body),
                              {k: (float(v[0]), float(v[1])) for k, v in forces.items()}))
+        return True
 
     def rows(self, start: int = 0) -> list[tuple]:
         """Force rows recorded so far, from the `start`-th: (step, n, body, {model: (fx, fy)})."""

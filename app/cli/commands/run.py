@@ -141,6 +141,11 @@ def main(args) -> int:
           f"Re {scene.reynolds:.4g} with L = {scene.reference_length:g} cells, U = {scene.reference_speed:g}, "
           f"Ma {scene.mach:.3f}); {wall:.1f} s, {mlups:.1f} MLUPS"
           + (f"; SI columns for {si.describe()}" if si is not None else ""))
+    if recorder is not None and recorder.full is not None:
+        # the run went on to its end (every row is in --out); the session holds its first part
+        print(f"feelflow: --record: {recorder.full} in {args.record}; the run went on to step {steps} "
+              f"and all its forces are in {out}", file=sys.stderr)
+        return 1
     return 0
 
 

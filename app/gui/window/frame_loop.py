@@ -195,6 +195,7 @@ class FrameLoop:
             w.panel.show_params(sim.params, self.display_mode)
             w.flow.after_rebuild()
         w.inputs.after_frame(forces)
+        w.replays.watch_recording()
         self._frame_done(now, t0, t1, n, forces, rgba)
 
     def _tick_replay(self, now):

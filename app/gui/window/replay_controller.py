@@ -29,6 +29,7 @@ class ReplayController:
         self.label = QLabel()   # "Replaying <name>: step N / M" (hidden by passing messages)
         window.statusBar().addWidget(self.label, 1)
         self.label.hide()
+        self._full_said = False   # the recording's stop at the session bound has been shown
 
     # --- recording ----------------------------------------------------------------------------
     def toggle_recording(self, _=None):
@@ -41,16 +42,29 @@ class ReplayController:
             return
         if solver.recorder is None:
             solver.start_recording(renderer=w.viewport.renderer())
+            self._full_said = False
             w.actions.record.setChecked(True)
             w.statusBar().showMessage("Recording a session: inputs, parameter changes and forces.", 5000)
             return
         w.actions.record.setChecked(False)
+        w.actions.record.setText("Record session")
         recorder = solver.stop_recording()
         path, _ = QFileDialog.getSaveFileName(w, "Save session", "lesson.ffsession", "Sessions (*.ffsession)")
         if path:
             recorder.probes = w.probes.session_arrays()   # the probes placed while it recorded, if any
             recorder.units = choice_to_dict(w.units.choice)   # the units shown (View > Units)
             attempt(w, lambda: recorder.save(path), "Could not save the session")
+
+    def watch_recording(self):
+        """After each live frame: once the recording stopped at the most a session file may hold
+        (SessionRecorder.full), say so in the status bar and on the Record action until it is
+        saved; the tunnel runs on."""
+        rec = self.w.sim.solver.recorder if self.w.sim is not None else None
+        if rec is None or rec.full is None or self._full_said:
+            return
+        self._full_said = True
+        self.w.actions.record.setText("Record session (full: choose to stop and save)")
+        self.w.statusBar().showMessage(f"Session: {rec.full}. Choose File > Record session to save it.")
 
     # --- replaying ----------------------------------------------------------------------------
     def open_dialog(self, _=None):
