@@ -22,6 +22,10 @@ class StepWeightedMean:
             acc[1] += steps * fy
         self.steps += steps
 
+    def totals(self) -> dict[str, tuple[float, float]]:
+        """{model: (sum k Fx, sum k Fy)}: each force summed over the steps (an impulse per unit span)."""
+        return {name: (sx, sy) for name, (sx, sy) in self._sums.items()}
+
     def mean(self, steps: int | None = None) -> dict[str, tuple[float, float]]:
         """{model: (Fx, Fy)} averaged over `steps` (default: the steps added)."""
         n = self.steps if steps is None else steps

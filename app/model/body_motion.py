@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import math
 
+from feelflow.solver.force_average import StepWeightedMean
+
 #: a body slower than this (cells per step) and nearer its target than REST_DISTANCE (cells) is
 #: at rest: a critically damped spring creeps towards its target for ever, and a creep of 1e-5
 #: cells per step is a hundredth of a cell in a thousand steps
@@ -39,13 +41,11 @@ def advance_with_motion(solver, n: int, move, moving) -> dict[str, tuple[float, 
     the n steps in one run. Returns each force model's force summed over the steps (weight:
     steps); SolverDiverged propagates from the solver."""
     done = 0
-    acc: dict[str, tuple[float, float]] = {}
+    total = StepWeightedMean()
     while done < n:
         k = 1 if moving() else n - done
         move(k)
         solver.step(k)
-        for name, (fx, fy) in solver.forces().items():
-            ax, ay = acc.get(name, (0.0, 0.0))
-            acc[name] = (ax + fx * k, ay + fy * k)
+        total.add(solver.forces(), k)
         done += k
-    return acc
+    return total.totals()
