@@ -29,7 +29,8 @@ def test_switch_units_and_convert_the_drag_by_hand(window, qtbot):  # noqa: F811
     assert w.lessons.apply("vortex_street")      # a lesson: the cylinder at Re 100 (Presets menu)
     w.probes.add(6.0, w.sim.pos[1])
     qtbot.waitUntil(lambda: len(w.sim.history.time) > 20 and len(w.probes.probes.items[0].time) > 5, timeout=30000)
-    assert "lattice units" in w.panel.drag.text()
+    # the readouts refresh on their own slower timer: on a fast machine 20 rows come before it
+    qtbot.waitUntil(lambda: "lattice units" in w.panel.drag.text(), timeout=10000)
     assert w.plot.plot.getAxis("left").labelText == "force (lattice units)"
     lattice_header = next(csv.reader(io.StringIO(w.plot.csv_text())))
     assert "time_s" not in lattice_header
