@@ -27,37 +27,15 @@ from __future__ import annotations
 import numpy as np
 
 from feelflow.solver.lattice import C, RHO0, W
-from feelflow.solver.regularised import smagorinsky_factor
+from feelflow.solver.regularised import RegularisedCollider
 
-BLOCK_NODES = 16384
 #: <Delta h | Delta h> below which gamma is taken as 2 (BGK): no higher-order deviation to steer
 TINY = 1e-30
 
 
-class KBCCollider:
-    """In-place KBC collision of a (9, ny, nx) array of shifted populations, with the interface
-    of solver.regularised.RegularisedCollider."""
-
-    def __init__(self, ny: int, nx: int, dtype, omega, force=(0.0, 0.0), keep=None,
-                 incompressible: bool = False, smagorinsky: float = 0.0, block_nodes: int = BLOCK_NODES):
-        self.nx, self.ny = nx, ny
-        self.rows = max(1, min(ny, block_nodes // nx))
-        self.omega = omega if np.isscalar(omega) else np.asarray(omega, dtype=np.float64)
-        self.tau0 = 1.0 / self.omega
-        self.force = (float(force[0]), float(force[1]))
-        self.has_force = self.force != (0.0, 0.0)
-        self.keep = None if keep is None else np.asarray(keep, dtype=np.float64)
-        self.incompressible = bool(incompressible)
-        self.smag = smagorinsky_factor(smagorinsky)
-
-    def __call__(self, f: np.ndarray, target=None) -> float:
-        total = 0.0
-        if self.keep is not None:
-            target = np.asarray(target, dtype=np.float64)[:, None]
-        for y0 in range(0, self.ny, self.rows):
-            y1 = min(self.ny, y0 + self.rows)
-            total += self._block(f[:, y0:y1, :], None if target is None else target[y0:y1])
-        return total
+class KBCCollider(RegularisedCollider):
+    """In-place KBC collision of a (9, ny, nx) array of shifted populations: the set-up and the
+    blocking of solver.regularised.RegularisedCollider, with the KBC step in `_block`."""
 
     def _block(self, f, target) -> float:
         """Moments from sums of populations (as solver/regularised.py), then two passes over the
