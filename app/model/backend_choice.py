@@ -15,7 +15,7 @@ from __future__ import annotations
 import os
 import re
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 #: what `--backend auto` and the window compare, in order of preference on a tie
@@ -107,6 +107,10 @@ def choice_key(renderer: str, nx: int, ny: int) -> str:
     return f"backend/{name}/{nx}x{ny}"
 
 
+#: the least viscosity a timing trial runs at (U/nu <= 2 for any wind the window allows)
+TIMING_NU = 0.05
+
+
 def _default_setup(solver) -> None:
     """The window's default kind of scene: a cylinder of ny/8 at nx/4, momentum exchange."""
     from feelflow.shapes import Cylinder
@@ -118,7 +122,11 @@ def _default_setup(solver) -> None:
 
 def time_backend(name: str, config, make_solver, seconds: float = SECONDS, setup=_default_setup) -> Timing:
     """Steps per second of backend `name` on `config` (see the module docstring). make_solver(name,
-    config) builds it; any exception it raises is this backend's `error` (one line)."""
+    config) builds it; any exception it raises is this backend's `error` (one line).
+    The trial runs `config`'s grid, operator, precision and boundaries at a viscosity of at least
+    TIMING_NU: a step costs the same at any viscosity, and a scene the user runs outside the
+    stable region must not diverge in the trial (it would then fail before its own first step)."""
+    config = replace(config, nu=max(config.nu, TIMING_NU))
     try:
         solver = make_solver(name, config)
     except Exception as exc:  # noqa: BLE001 - a backend that cannot start is reported, not fatal
