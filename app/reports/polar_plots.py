@@ -7,46 +7,16 @@ curve per angle, drawn with -C_p upwards as aerodynamicists do.
 """
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
 
 from feelflow.app.model.polar import thin_airfoil_cl
+from feelflow.app.reports.plot_images import export_png, offscreen_pyqtgraph
 
 #: colours of successive curves (angles) in the C_p image
 PALETTE = [(0, 90, 200), (200, 60, 0), (0, 150, 60), (150, 0, 150), (180, 140, 0), (0, 150, 170),
            (120, 60, 20), (90, 90, 90)]
-
-
-def _pyqtgraph():
-    if "QT_QPA_PLATFORM" not in os.environ and not os.environ.get("DISPLAY"):
-        os.environ["QT_QPA_PLATFORM"] = "offscreen"
-    import pyqtgraph as pg
-
-    pg.mkQApp()
-    pg.setConfigOptions(background="w", foreground="k", antialias=True)
-    return pg
-
-
-def _export(widget, path: Path, width: int):
-    """Render the widget's scene to PNG atomically, then dispose of the widget."""
-    from pyqtgraph.exporters import ImageExporter
-    from pyqtgraph.Qt import QtWidgets
-
-    from feelflow.app.files import atomic_path
-
-    widget.show()
-    QtWidgets.QApplication.processEvents()
-    try:
-        with atomic_path(path, suffix=".png") as tmp:
-            exporter = ImageExporter(widget.scene())
-            exporter.parameters()["width"] = width
-            exporter.export(str(tmp))
-    finally:
-        widget.close()
-        widget.deleteLater()
-        QtWidgets.QApplication.processEvents()
 
 
 def _plain_axes(plot_item):
@@ -57,7 +27,7 @@ def _plain_axes(plot_item):
 
 def polar_image(points, path: Path, title: str, zero_lift_alpha: float = 0.0) -> None:
     """Write the three-panel polar (module docstring) of `points` (app/model/polar.PolarPoint)."""
-    pg = _pyqtgraph()
+    pg = offscreen_pyqtgraph()
     win = pg.GraphicsLayoutWidget()
     win.resize(1500, 520)
     win.addLabel(title, row=0, col=0, colspan=3, size="11pt")
@@ -100,12 +70,12 @@ def polar_image(points, path: Path, title: str, zero_lift_alpha: float = 0.0) ->
             label = pg.TextItem(f"{a_:g} deg", color=grey, anchor=(0, 1))
             label.setPos(float(x_), float(y_))
             p3.addItem(label)
-    _export(win, Path(path), 1500)
+    export_png(win, win.scene(), Path(path), 1500)
 
 
 def cp_image(curves, path: Path, title: str) -> None:
     """Write C_p along the surface: `curves` is a list of (label, SurfacePressure)."""
-    pg = _pyqtgraph()
+    pg = offscreen_pyqtgraph()
     w = pg.PlotWidget()
     w.resize(900, 560)
     w.setTitle(title, size="11pt")
@@ -121,4 +91,4 @@ def cp_image(curves, path: Path, title: str) -> None:
         for side, style in (("upper", pg.QtCore.Qt.PenStyle.SolidLine), ("lower", pg.QtCore.Qt.PenStyle.DashLine)):
             x, y = getattr(cp, side)
             w.plot(x, y, pen=pg.mkPen(colour, width=2, style=style), name=label if side == "upper" else None)
-    _export(w, Path(path), 900)
+    export_png(w, w.scene(), Path(path), 900)

@@ -2,47 +2,16 @@
 from __future__ import annotations
 
 import math
-import os
 from pathlib import Path
 
 import numpy as np
 
+from feelflow.app.reports.plot_images import export_png, offscreen_pyqtgraph
 from feelflow.app.reports.seed_analysis import PLOT_SMOOTH_STEPS, fmt, force_series, running_mean
 from feelflow.app.reports.seed_runs import MODELS, REFERENCE
 
 COLOURS = {"momentum_exchange": (0, 90, 200), "momentum_exchange_classic": (200, 60, 0),
            "macroscopic": (0, 150, 60), "pressure": (150, 0, 150)}
-
-
-def _qt():
-    if "QT_QPA_PLATFORM" not in os.environ and not os.environ.get("DISPLAY"):
-        os.environ["QT_QPA_PLATFORM"] = "offscreen"
-    import pyqtgraph as pg
-
-    pg.mkQApp()
-    pg.setConfigOptions(background="w", foreground="k", antialias=True)
-    return pg
-
-
-def _export(plot_widget, path: Path, width=900):
-    """Write the plot as PNG atomically, then dispose of the widget (Qt objects left for the
-    interpreter's shutdown can crash PySide6 there)."""
-    from pyqtgraph.exporters import ImageExporter
-    from pyqtgraph.Qt import QtWidgets
-
-    from feelflow.app.files import atomic_path
-
-    plot_widget.show()  # lay the plot out (title, axes) before rendering it
-    QtWidgets.QApplication.processEvents()
-    try:
-        with atomic_path(path, suffix=".png") as tmp:
-            exporter = ImageExporter(plot_widget.getPlotItem())
-            exporter.parameters()["width"] = width
-            exporter.export(str(tmp))
-    finally:
-        plot_widget.close()
-        plot_widget.deleteLater()
-        QtWidgets.QApplication.processEvents()
 
 
 def _plot(pg, title, xlabel, ylabel, size=(900, 520)):
@@ -57,7 +26,7 @@ def _plot(pg, title, xlabel, ylabel, size=(900, 520)):
 
 
 def make_plots(parts: dict, res: dict, folder: Path) -> list[str]:
-    pg = _qt()
+    pg = offscreen_pyqtgraph()
     folder.mkdir(parents=True, exist_ok=True)
     names = []
     dash = {"d16": pg.QtCore.Qt.PenStyle.SolidLine, "d24": pg.QtCore.Qt.PenStyle.DashLine,
@@ -84,7 +53,7 @@ def make_plots(parts: dict, res: dict, folder: Path) -> list[str]:
                 w.addItem(pg.InfiniteLine(pos=float(b), angle=90,
                                           pen=pg.mkPen((120, 120, 120), style=pg.QtCore.Qt.PenStyle.DashLine)))
             name = f"protocol_{m}.png"
-            _export(w, folder / name)
+            export_png(w, w.getPlotItem(), folder / name)
             names.append(name)
     if "sweep" in res:
         w = _plot(pg, "Plate drag against speed (log-log), fitted F ~ U^n", "inflow speed U (lattice units)",
@@ -99,7 +68,7 @@ def make_plots(parts: dict, res: dict, folder: Path) -> list[str]:
             if math.isfinite(s["exponent"]):
                 xx = np.linspace(x.min(), x.max(), 20)
                 w.plot(xx, s["prefactor"] * xx ** s["exponent"], pen=pg.mkPen(COLOURS[m], width=1))
-        _export(w, folder / "drag_vs_speed.png")
+        export_png(w, w.getPlotItem(), folder / "drag_vs_speed.png")
         names.append("drag_vs_speed.png")
     if "shapes" in res:
         w = _plot(pg, "Drag coefficient per shape (same frontal width 24, Re 200)", "shape",
@@ -111,13 +80,13 @@ def make_plots(parts: dict, res: dict, folder: Path) -> list[str]:
             w.addItem(bars)
             w.plotItem.legend.addItem(bars, m)
         w.getAxis("bottom").setTicks([[(i, k) for i, k in enumerate(keys)]])
-        _export(w, folder / "drag_per_shape.png")
+        export_png(w, w.getPlotItem(), folder / "drag_per_shape.png")
         names.append("drag_per_shape.png")
     if "lift" in parts:
         w = _plot(pg, "Half airfoil, flat side down: lift F_y against time", "step", "F_y (lattice units per step)")
         run = parts["lift"]["runs"]["half_airfoil"]
         for m in MODELS:
             w.plot(run["step"], force_series(run, m)[:, 1], pen=pg.mkPen(COLOURS[m], width=2), name=m)
-        _export(w, folder / "lift.png")
+        export_png(w, w.getPlotItem(), folder / "lift.png")
         names.append("lift.png")
     return names
