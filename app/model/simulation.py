@@ -104,6 +104,7 @@ class Simulation:
         self.make_shape = shape_factory or make_shape
         self.polygon = None          # vertices of the custom polygon (body frame), or None
         self.history = History()
+        self.last_torques: dict[str, float] = {}  # each model's mean torque over the last advance
         self.hold_still = False
         self._asked = (None, None)   # (degrees, radians) of the last turn_to: see target_degrees
         self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
@@ -379,9 +380,11 @@ class Simulation:
                 self.set_flow(wind=wind)
         done = 0
         acc = {}
+        torques = {}   # each model's torque summed over the steps
         self.capped = False
         if self.runner is not None:
             acc = {k: (fx * n, fy * n) for k, (fx, fy) in self.runner.advance(n).items()}
+            torques = {k: t * n for k, t in self.runner.last_torques.items()}
             r = self.runner
             self.pos, self.shape = r.position, r.shape
             self.vel = r.script.velocity_at(r.t - 1)
@@ -390,14 +393,17 @@ class Simulation:
                 self.vel = (0.0, 0.0)
             done = n
         if done < n:   # the pose advances every step while the body moves (app/model/body_motion.py)
-            acc = advance_with_motion(self.solver, n, self._move_body, self._body_moves)
+            acc = advance_with_motion(self.solver, n, self._move_body, self._body_moves, torques)
             self.capped |= self.solver.speed_capped
         forces = {k: (v[0] / n, v[1] / n) for k, v in acc.items()}
+        torques = {k: t / n for k, t in torques.items()}
         for probe in self._probes():   # a probe's force is the pressure model's: not a model of its own
             forces.pop(probe.name, None)
+            torques.pop(probe.name, None)
+        self.last_torques = torques
         if self.polar is not None:
             self.polar.after_advance(self, forces, n)
-        self.history.add(self.solver.time, self.vel, self.relative_wind(), forces)
+        self.history.add(self.solver.time, self.vel, self.relative_wind(), forces, torques)
         self.apply_local_guard()
         return forces
 
