@@ -102,6 +102,9 @@ class SessionSolver:
     def forces(self) -> dict[str, tuple[float, float]]:
         return self._solver.forces()
 
+    def torques(self) -> dict[str, float]:
+        return self._solver.torques()
+
     def macroscopic(self):
         return self._solver.macroscopic()
 
