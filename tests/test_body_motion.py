@@ -181,7 +181,7 @@ def test_a_turning_body_feels_the_torque_that_resists_the_turn():
     rates = []
     for _ in range(30):
         sim.advance(5)
-        rates.append(sim.rate)
+        rates.append(sim.body.rate)
     _, torque = sim.history.torque(sim.params.force_model)
     assert np.isfinite(torque).all() and sim.last_torques[sim.params.force_model] == torque[-1]
     assert (torque[:15] < 0).all()                       # speeding up, then turning at the capped rate
