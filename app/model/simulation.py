@@ -131,6 +131,7 @@ class Simulation:
         self.make_shape = shape_factory or make_shape
         self.polygon = None          # vertices of the custom polygon (body frame), or None
         self.history = History()
+        self.last_torques: dict[str, float] = {}  # each model's mean torque over the last advance
         self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
         self.sweep: WindSweep | None = None       # a wind-speed sweep (a lesson), or None
         self.sweep_slew_steps = self.SWEEP_SLEW_STEPS   # for the next sweep (0: changes at once)
@@ -370,9 +371,11 @@ class Simulation:
                 self.set_flow(wind=wind)
         done = 0
         acc = {}
+        torques = {}   # each model's torque summed over the steps
         self.capped = False
         if self.runner is not None:
             acc = {k: (fx * n, fy * n) for k, (fx, fy) in self.runner.advance(n).items()}
+            torques = {k: t * n for k, t in self.runner.last_torques.items()}
             r = self.runner
             self.pos, self.shape = r.position, r.shape
             self.vel = r.script.velocity_at(r.t - 1)
@@ -381,11 +384,13 @@ class Simulation:
                 self.vel = (0.0, 0.0)
             done = n
         if done < n:   # the pose advances every step while the body moves (app/model/body_motion.py)
-            acc = advance_with_motion(self.solver, n, self._move_body, self.body.moving)
+            acc = advance_with_motion(self.solver, n, self._move_body, self.body.moving, torques)
             self.capped |= self.solver.speed_capped
         forces = {k: (v[0] / n, v[1] / n) for k, v in acc.items()}
         self.pressure.after_advance(self, forces, n)
-        self.history.add(self.solver.time, self.vel, self.relative_wind(), forces)
+        torques = {k: t / n for k, t in torques.items() if k in forces}   # not the probes' (a model of none)
+        self.last_torques = torques
+        self.history.add(self.solver.time, self.vel, self.relative_wind(), forces, torques)
         self.apply_local_guard()
         return forces
 
