@@ -91,7 +91,7 @@ class FrameLoop:
         vp = self.viewport
         vp.sim = w.plot.sim = model
         vp.locked = model is not self.sim
-        vp.tracers = vp.arrow_forces = None
+        vp.tracers = vp.arrow_forces = vp.torque_arc = None
         self.forget_last_frame()
         self.upload_field()
         w.plot.refresh(force=True)
@@ -288,7 +288,9 @@ class FrameLoop:
         """The viewport's drag and lift arrows for this frame's force (app/model/readouts.py)."""
         model = self.w.shown
         self.viewport.arrow_forces = readouts.arrows(forces.get(model.params.force_model), model.relative_wind(),
-                                                       model.reference_length())
+                                                     model.reference_length())
+        self.viewport.torque_arc = readouts.torque_arc(model.last_torques.get(model.params.force_model),
+                                                       model.params.size, model.config.max_speed)
 
     def _advance_tracers(self, rgba, n):
         """Move the viewport's tracers n steps through the field (app/model/tracers.py)."""
