@@ -28,7 +28,8 @@ from feelflow.solver.regularised import smagorinsky_factor
 _EMPTY_I = np.zeros(0, np.int64)
 _EMPTY_F = np.zeros(0, np.float64)
 #: the momentum-exchange models the boundary pass sums: model class -> slice of its (4,) sums
-_LINK_SUMS = {GalileanMomentumExchange: slice(0, 2), ClassicMomentumExchange: slice(2, 4)}
+#: each momentum exchange's entries of the compiled step's link sums (cpu_kernels._links): fx, fy, moment
+_LINK_SUMS = {GalileanMomentumExchange: (0, 1, 4), ClassicMomentumExchange: (2, 3, 5)}
 
 
 def _bits(dirs) -> int:
@@ -83,7 +84,7 @@ class CpuSolver(NumpySolver):
         self._no_profile = np.zeros((3, ny))
         self._target_zero = np.zeros(ny)
         self._empty_solid = np.zeros((9, 0), dt)
-        self._link_force = np.zeros(4)
+        self._link_force = np.zeros(6)
         self._edge_grid, self._edge_nodes = self._boundary_nodes()
         self._mask_links = None
         self._redo = None
@@ -121,7 +122,7 @@ class CpuSolver(NumpySolver):
 
             self._redo, self._link_arrays = redo_nodes(self._edge_nodes, self._edge_grid, links, b.window)
         else:
-            self._redo, self._link_arrays = self._edge_nodes, (_EMPTY_I,) * 5 + (_EMPTY_F,) * 6
+            self._redo, self._link_arrays = self._edge_nodes, (_EMPTY_I,) * 5 + (_EMPTY_F,) * 8
         self._mask_links = links
         return self._redo, self._link_arrays
 
@@ -155,7 +156,7 @@ class CpuSolver(NumpySolver):
         n = int(n)
         link_models = {name: _LINK_SUMS[type(m)] for name, m in self._models.items() if type(m) in _LINK_SUMS}
         others = {name: m for name, m in self._models.items() if name not in link_models}
-        sums = {name: [0.0, 0.0] for name in self._models}
+        sums = {name: [0.0, 0.0, 0.0] for name in self._models}
         impulse = self._impulse
         self._impulse = (0.0, 0.0)
         done = 0
@@ -164,24 +165,28 @@ class CpuSolver(NumpySolver):
                 win = self.body_window()
                 if win is not None:
                     for name, model in others.items():
-                        fx, fy = model.compute(win)
+                        fx, fy, torque = model.evaluate(win)
                         sums[name][0] += fx
                         sums[name][1] += fy
+                        sums[name][2] += torque
             k = 1 if others else n
             self._advance_steps(k)
             done += k
             if link_models and self.body is not None:
-                for name, part in link_models.items():
-                    fx, fy = self._link_force[part]
+                cx, cy = float(self.body.shape.x), float(self.body.shape.y)
+                for name, (ix, iy, im) in link_models.items():
+                    fx, fy = self._link_force[ix], self._link_force[iy]
                     sums[name][0] += fx
                     sums[name][1] += fy
+                    sums[name][2] += self._link_force[im] - (cx * fy - cy * fx)  # about the centre
         if n > 0:
             if self.body is not None:  # the Galilean form books the cover/uncover impulse
-                for name, part in link_models.items():
-                    if part.start == 0:
+                for name, (ix, _, _) in link_models.items():
+                    if ix == 0:
                         sums[name][0] += impulse[0]
                         sums[name][1] += impulse[1]
             self._forces = {name: (s[0] / n, s[1] / n) for name, s in sums.items()}
+            self._torques = {name: s[2] / n for name, s in sums.items()}
 
     def _step_once(self) -> None:
         self._advance_steps(1)

@@ -323,11 +323,11 @@ def move_body(old, new, config, g, impulse: str) -> tuple[float, float]:
 
 
 @numba.njit(**_JIT)
-def _redo_nodes(ey, ex, ebits, edge_grid, li, liy, lix, lfy, lfx, x0, y0, h, w):
+def _redo_nodes(ey, ex, ebits, edge_grid, li, liy, lix, lfy, lfx, lq, x0, y0, h, w):
     """The boundary pass's node list (solver/cpu_backend.py `_redo_nodes`): the domain-edge nodes
     (ey, ex, ebits), then each node that owns a body link, row by row, with a bit per link
-    direction and its edge bits, as (3, m) (iy, ix, bits); and the links' (iy, ix, fy, fx) in
-    grid coordinates (4, n)."""
+    direction and its edge bits, as (3, m) (iy, ix, bits); the links' (iy, ix, fy, fx) in grid
+    coordinates (4, n); and their wall crossings x - q c_i (px, py) (2, n), for the torque."""
     win = np.zeros((h, w), np.int64)
     for k in range(len(li)):
         win[liy[k], lix[k]] |= 1 << li[k]
@@ -347,9 +347,12 @@ def _redo_nodes(ey, ex, ebits, edge_grid, li, liy, lix, lfy, lfx, x0, y0, h, w):
                 nodes[2, k] = win[y, x] | edge_grid[y + y0, x + x0]
                 k += 1
     grid = np.empty((4, len(li)), np.int64)
+    cross = np.empty((2, len(li)))
     for k in range(len(li)):
         grid[0, k], grid[1, k], grid[2, k], grid[3, k] = liy[k] + y0, lix[k] + x0, lfy[k] + y0, lfx[k] + x0
-    return nodes, grid
+        cross[0, k] = float(lix[k] + x0) - lq[k] * float(_CXI[li[k]])
+        cross[1, k] = float(liy[k] + y0) - lq[k] * float(_CYI[li[k]])
+    return nodes, grid, cross
 
 
 def redo_nodes(edge_nodes, edge_grid, links, window):
@@ -358,8 +361,8 @@ def redo_nodes(edge_nodes, edge_grid, links, window):
     x0, y0, x1, y1 = window
     ey, ex, ebits = edge_nodes
     c = np.ascontiguousarray
-    nodes, grid = _redo_nodes(ey, ex, ebits, edge_grid, c(links.i), c(links.iy), c(links.ix), c(links.fy), c(links.fx),
-                              x0, y0, y1 - y0, x1 - x0)
+    nodes, grid, cross = _redo_nodes(ey, ex, ebits, edge_grid, c(links.i), c(links.iy), c(links.ix), c(links.fy),
+                                     c(links.fx), c(links.q), x0, y0, y1 - y0, x1 - x0)
     uw = links.uw
     return (nodes[0], nodes[1], nodes[2]), (c(links.i), grid[0], grid[1], grid[2], grid[3], c(links.a), c(links.b),
-                                            c(links.c), c(links.d), c(uw[:, 0]), c(uw[:, 1]))
+                                            c(links.c), c(links.d), c(uw[:, 0]), c(uw[:, 1]), cross[0], cross[1])

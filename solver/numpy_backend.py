@@ -123,19 +123,21 @@ class NumpySolver(Solver):
 
     # --- stepping -------------------------------------------------------------
     def step(self, n: int = 1) -> None:
-        sums = {name: [0.0, 0.0] for name in self._models}
+        sums = {name: [0.0, 0.0, 0.0] for name in self._models}
         for _ in range(int(n)):
             if self._models:
                 win = self.body_window()
                 if win is not None:
                     for name, model in self._models.items():
-                        fx, fy = model.compute(win)
+                        fx, fy, torque = model.evaluate(win)
                         sums[name][0] += fx
                         sums[name][1] += fy
+                        sums[name][2] += torque
             self._impulse = (0.0, 0.0)
             self._step_once()
         if n > 0:
             self._forces = {name: (s[0] / n, s[1] / n) for name, s in sums.items()}
+            self._torques = {name: s[2] / n for name, s in sums.items()}
 
     def _step_once(self) -> None:
         g, gin = self.g, self._gin

@@ -135,6 +135,8 @@ def test_compiled_node_list_holds_the_link_nodes_and_their_bits():
     assert np.array_equal(gy, L.iy + y0) and np.array_equal(gx, L.ix + x0)
     assert np.array_equal(gfy, L.fy + y0) and np.array_equal(gfx, L.fx + x0)
     assert np.array_equal(arrays[9], L.uw[:, 0]) and np.array_equal(arrays[10], L.uw[:, 1])
+    assert np.array_equal(arrays[11], L.ix + x0 - L.q * C[L.i, 0])   # the wall crossings (torque)
+    assert np.array_equal(arrays[12], L.iy + y0 - L.q * C[L.i, 1])
 
 
 def test_cpu_equals_numpy_for_a_body_jumping_cells_beside_a_wall():

@@ -175,7 +175,7 @@ class ReplaySimulation:
         mean = StepWeightedMean()
         for row in rows:
             vx, vy = (0.0, 0.0) if math.isnan(row.body[2]) else row.body[2:4]
-            self.history.add(row.step, (vx, vy), (row.inflow_speed - vx, -vy), row.forces)
+            self.history.add(row.step, (vx, vy), (row.inflow_speed - vx, -vy), row.forces, row.torques)
             mean.add(row.forces, row.n)
         if rows:
             self._last_forces = mean.mean()
