@@ -83,7 +83,7 @@ class FrameLoop:
         vp = w.viewport
         vp.sim = w.plot.sim = model
         vp.locked = model is not w.sim
-        vp.tracers = vp.arrow_forces = None
+        vp.tracers = vp.arrow_forces = vp.torque_arc = None
         self.forget_last_frame()
         self.upload_field()
         w.plot.refresh(force=True)
@@ -281,6 +281,8 @@ class FrameLoop:
         model = self.w.shown
         self.w.viewport.arrow_forces = readouts.arrows(forces.get(model.params.force_model), model.relative_wind(),
                                                        model.reference_length())
+        self.w.viewport.torque_arc = readouts.torque_arc(model.last_torques.get(model.params.force_model),
+                                                         model.params.size, model.config.max_speed)
 
     def _advance_tracers(self, rgba, n):
         """Move the viewport's tracers n steps through the field (app/model/tracers.py)."""

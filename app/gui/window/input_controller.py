@@ -47,7 +47,8 @@ class InputController:
 
     def after_frame(self, forces):
         """After a live frame: the device's position becomes the body's target, and the selected
-        force model's force goes to the device (lattice units; the device scales it)."""
+        force model's force and torque go to the device (lattice units; the loop scales them; a
+        torque not computed goes as 0, so that it never zeroes the force as a NaN would)."""
         dev, sim = self.device, self.w.sim
         if dev is None:
             return
@@ -56,7 +57,8 @@ class InputController:
             sim.drive(BodyInput.pull(*target, source="device"))
         f = forces.get(sim.params.force_model)
         if f is not None:
-            dev.submit(f, sim.solver.time)
+            torque = sim.last_torques.get(sim.params.force_model, 0.0)
+            dev.submit(f, sim.solver.time, torque if math.isfinite(torque) else 0.0)
 
     # --- the input selector ---------------------------------------------------------------------
     def refresh_devices(self):
@@ -100,7 +102,8 @@ class InputController:
             w.panel.input_note.setText("")
             return
         try:
-            self.device = DeviceInput(url, (w.sim.config.nx, w.sim.config.ny), DeviceInput.expected_peak(w.sim), w)
+            self.device = DeviceInput(url, (w.sim.config.nx, w.sim.config.ny), DeviceInput.expected_peak(w.sim), w,
+                                      expected_peak_torque=DeviceInput.expected_peak_torque(w.sim))
         except (DeviceError, BadDeviceURL, OSError, ValueError) as exc:
             QMessageBox.warning(w, "The device cannot be used", f"{exc}\nBack to the mouse.")
             self._back_to_mouse("")
