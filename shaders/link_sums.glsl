@@ -14,6 +14,9 @@
 // The backend sums the texels in float64 and adds the links' constant K = -2 RHO0 sum w_i c_i
 // and the cover/uncover impulse J: Galilean-invariant F = S1 + S2 + K + J, classic F = S1 + K,
 // the numbers solver/forces/momentum_exchange.py computes from the window (f = g + w RHO0).
+// The same terms' moments about the body's centre, r = x + q c_ib - X (the link's wall
+// crossing), go to the second target: M1 = sum r x S1-term, M2 = sum r x S2-term; the backend
+// adds K's moment: Galilean-invariant torque M1 + M2 + M_K, classic M1 + M_K.
 // @LATTICE
 // @INCLUDE paired_layout.glsl
 // @INCLUDE body_links.glsl
@@ -26,13 +29,18 @@ uniform ivec4 window;          // the force window (x0, y0, x1, y1) in nodes
 uniform sampler2D LINK_TEXELS;  // (k, y, 1, 0): the state texels with links; (0, 0, 0, 0) past the list
 uniform ivec2 slot_origin;     // the slot's lower-left texel in the target
 
-layout(location = 0) out vec4 sums;  // (S1.x, S1.y, S2.x, S2.y) of this texel's two nodes
+layout(location = 0) out vec4 sums;     // (S1.x, S1.y, S2.x, S2.y) of this texel's two nodes
+layout(location = 1) out vec4 moments;  // (M1, M2, 0, 0) of the same links about body_centre
 
 ivec2 wrap(ivec2 p) {
     return ivec2((p.x + N.x) % N.x, (p.y + N.y) % N.y);
 }
 
-void add_node(ivec2 x, inout vec2 s1, inout vec2 s2) {
+float cross2(vec2 a, vec2 b) {
+    return a.x * b.y - a.y * b.x;
+}
+
+void add_node(ivec2 x, inout vec2 s1, inout vec2 s2, inout vec2 mom) {
     if (x.x < window.x || x.x >= window.z) return;
     uint m = texelFetch(MASK, x, 0).r;
     if ((m & 1u) != 0u || (m & 0x1FEu) == 0u) return;  // solid, or no cut link
@@ -46,13 +54,18 @@ void add_node(ivec2 x, inout vec2 s1, inout vec2 s2) {
         int ib = OPP[i];
         ivec2 ci = C[i];
         float q = qs[ib];
-        vec2 uw = wall_velocity(vec2(x) + q * vec2(C[ib]));
+        vec2 xw = vec2(x) + q * vec2(C[ib]);  // the wall crossing
+        vec2 uw = wall_velocity(xw);
         bool two_node = (m & (1u << uint(8 + i))) != 0u;
         float second = two_node ? pop(ib, wrap(x + ci)) : 0.0;
         float gin = bouzidi_incoming(i, q, two_node, own[ib], own[i], second, uw);
         float gout = own[ib];
-        s1 -= vec2(ci) * (gout + gin);
-        s2 -= uw * (gout - gin);
+        vec2 t1 = -vec2(ci) * (gout + gin);
+        vec2 t2 = -uw * (gout - gin);
+        s1 += t1;
+        s2 += t2;
+        vec2 r = xw - body_centre;
+        mom += vec2(cross2(r, t1), cross2(r, t2));
     }
 }
 
@@ -61,9 +74,11 @@ void main() {
     ivec2 k = ivec2(entry.xy);
     vec2 s1 = vec2(0.0);
     vec2 s2 = vec2(0.0);
+    vec2 m = vec2(0.0);
     if (entry.z > 0.5 && k.y >= window.y && k.y < window.w) {
-        add_node(ivec2(2 * k.x, k.y), s1, s2);
-        add_node(ivec2(2 * k.x + 1, k.y), s1, s2);
+        add_node(ivec2(2 * k.x, k.y), s1, s2, m);
+        add_node(ivec2(2 * k.x + 1, k.y), s1, s2, m);
     }
     sums = vec4(s1, s2);
+    moments = vec4(m, 0.0, 0.0);
 }

@@ -81,6 +81,11 @@ class FlowSolver(Protocol):
         """Mean force per enabled model over the last `step(n)` call."""
         ...
 
+    def torques(self) -> dict[str, float]:
+        """Mean torque on the body about its centre per enabled model over the last `step(n)`
+        call (counter-clockwise positive)."""
+        ...
+
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
         """Place the body (a `shapes` shape at its pose, or None) moving at `velocity`."""
         ...
@@ -154,6 +159,7 @@ class Solver(ABC):
         self.body = None      # solver.body.BodyState of the body, or None
         self._models = {}     # enabled force models by name
         self._forces: dict[str, tuple[float, float]] = {}  # their means over the last step(n)
+        self._torques: dict[str, float] = {}  # and their torques' means
         from feelflow.solver.body import DEFAULT_IMPULSE, DEFAULT_REFILL
 
         self.body_refill, self.body_impulse = DEFAULT_REFILL, DEFAULT_IMPULSE   # set_body_schemes
@@ -216,6 +222,7 @@ class Solver(ABC):
 
         self._models = {name: create_model(name) for name in names}
         self._forces = {}
+        self._torques = {}
         self._rebuild_body_window()
 
     def add_force_model(self, model) -> None:
@@ -235,6 +242,11 @@ class Solver(ABC):
     def forces(self) -> dict[str, tuple[float, float]]:
         """Mean force per model over the last `step(n)` call, lattice units."""
         return dict(self._forces)
+
+    def torques(self) -> dict[str, float]:
+        """Mean torque per model about the body's centre over the last `step(n)` call,
+        counter-clockwise positive, lattice units (ForceModel.torque)."""
+        return dict(self._torques)
 
     @property
     def force_models(self) -> dict:

@@ -28,7 +28,8 @@ from feelflow.solver.regularised import smagorinsky_factor
 _EMPTY_I = np.zeros(0, np.int64)
 _EMPTY_F = np.zeros(0, np.float64)
 #: the momentum-exchange models the boundary pass sums: model class -> slice of its (4,) sums
-_LINK_SUMS = {GalileanMomentumExchange: slice(0, 2), ClassicMomentumExchange: slice(2, 4)}
+#: each momentum exchange's entries of the compiled step's link sums (cpu_kernels._links): fx, fy, moment
+_LINK_SUMS = {GalileanMomentumExchange: (0, 1, 4), ClassicMomentumExchange: (2, 3, 5)}
 
 
 def _bits(dirs) -> int:
@@ -83,7 +84,7 @@ class CpuSolver(NumpySolver):
         self._no_profile = np.zeros((3, ny))
         self._target_zero = np.zeros(ny)
         self._empty_solid = np.zeros((9, 0), dt)
-        self._link_force = np.zeros(4)
+        self._link_force = np.zeros(6)
         self._edge_grid, self._edge_nodes = self._boundary_nodes()
         self._mask_links = None
         self._redo = None
@@ -109,35 +110,42 @@ class CpuSolver(NumpySolver):
     def _redo_nodes(self):
         """(iy, ix, bits) of every node a boundary rule or a body link writes a population of,
         and the links as flat arrays in grid coordinates; rebuilt when the body's links change,
-        from the links and the body window alone. A link node on the domain's edge comes twice,
-        the second time (the links' part, later in the list) with every bit, so it wins."""
+        from the links and the body window alone (compiled: solver/cpu_body.py). A link node on
+        the domain's edge comes twice, the second time (the links' part, later in the list) with
+        every bit, so it wins."""
         b = self.body
         links = None if b is None else b.links
         if self._redo is not None and links is self._mask_links:
             return self._redo, self._link_arrays
-        ey, ex, ebits = self._edge_nodes
         if links is not None and len(links):
-            x0, y0 = b.window[0], b.window[1]
-            h, w = b.window[3] - y0, b.window[2] - x0
-            win = np.zeros((h, w), np.int64)
-            for i in range(1, 9):  # a node has at most one link per direction
-                sel = links.i == i
-                win[links.iy[sel], links.ix[sel]] |= 1 << i
-            wy, wx = np.nonzero(win)
-            ly, lx = wy + y0, wx + x0
-            nodes = (np.concatenate([ey, ly]), np.concatenate([ex, lx]),
-                     np.concatenate([ebits, win[wy, wx] | self._edge_grid[ly, lx]]))
-            i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
-            f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
-            self._link_arrays = (i64(links.i), i64(links.iy + y0), i64(links.ix + x0), i64(links.fy + y0),
-                                 i64(links.fx + x0), f64(links.a), f64(links.b), f64(links.c),
-                                 f64(links.d), f64(links.uw[:, 0]), f64(links.uw[:, 1]))
+            from feelflow.solver.cpu_body import redo_nodes
+
+            self._redo, self._link_arrays = redo_nodes(self._edge_nodes, self._edge_grid, links, b.window)
         else:
-            nodes = (ey, ex, ebits)
-            self._link_arrays = (_EMPTY_I,) * 5 + (_EMPTY_F,) * 6
-        self._redo = tuple(np.ascontiguousarray(a, dtype=np.int64) for a in nodes)
+            self._redo, self._link_arrays = self._edge_nodes, (_EMPTY_I,) * 5 + (_EMPTY_F,) * 8
         self._mask_links = links
         return self._redo, self._link_arrays
+
+    def _body_state(self, shape, velocity, omega, raster=None):
+        """As Solver._body_state, with the compiled raster of a cylinder and the compiled links
+        (solver/cpu_body.py: the same numbers, a fraction of the time per move)."""
+        if shape is None:
+            return None
+        from feelflow.shapes.cylinder import Cylinder
+        from feelflow.solver import cpu_body
+        from feelflow.solver.body import make_body_state, window_margin
+
+        return make_body_state(shape, velocity, omega, self.config, window_margin(self._models.values()), raster,
+                               links=cpu_body.build_links,
+                               rasteriser=cpu_body.cylinder_raster if type(shape) is Cylinder else None)
+
+    def _move_body(self, old, new) -> tuple[float, float]:
+        """NumpySolver._move_body, compiled for the equilibrium refill (solver/cpu_body.py)."""
+        if self.body_refill != "equilibrium":
+            return super()._move_body(old, new)
+        from feelflow.solver import cpu_body
+
+        return cpu_body.move_body(old, new, self.config, self.g, self.body_impulse)
 
     # --- stepping -------------------------------------------------------------
     def step(self, n: int = 1) -> None:
@@ -148,7 +156,7 @@ class CpuSolver(NumpySolver):
         n = int(n)
         link_models = {name: _LINK_SUMS[type(m)] for name, m in self._models.items() if type(m) in _LINK_SUMS}
         others = {name: m for name, m in self._models.items() if name not in link_models}
-        sums = {name: [0.0, 0.0] for name in self._models}
+        sums = {name: [0.0, 0.0, 0.0] for name in self._models}
         impulse = self._impulse
         self._impulse = (0.0, 0.0)
         done = 0
@@ -157,24 +165,28 @@ class CpuSolver(NumpySolver):
                 win = self.body_window()
                 if win is not None:
                     for name, model in others.items():
-                        fx, fy = model.compute(win)
+                        fx, fy, torque = model.evaluate(win)
                         sums[name][0] += fx
                         sums[name][1] += fy
+                        sums[name][2] += torque
             k = 1 if others else n
             self._advance_steps(k)
             done += k
             if link_models and self.body is not None:
-                for name, part in link_models.items():
-                    fx, fy = self._link_force[part]
+                cx, cy = float(self.body.shape.x), float(self.body.shape.y)
+                for name, (ix, iy, im) in link_models.items():
+                    fx, fy = self._link_force[ix], self._link_force[iy]
                     sums[name][0] += fx
                     sums[name][1] += fy
+                    sums[name][2] += self._link_force[im] - (cx * fy - cy * fx)  # about the centre
         if n > 0:
             if self.body is not None:  # the Galilean form books the cover/uncover impulse
-                for name, part in link_models.items():
-                    if part.start == 0:
+                for name, (ix, _, _) in link_models.items():
+                    if ix == 0:
                         sums[name][0] += impulse[0]
                         sums[name][1] += impulse[1]
             self._forces = {name: (s[0] / n, s[1] / n) for name, s in sums.items()}
+            self._torques = {name: s[2] / n for name, s in sums.items()}
 
     def _step_once(self) -> None:
         self._advance_steps(1)

@@ -396,10 +396,12 @@ def _walls(g, pre, walls, periodic_x):
 
 
 @numba.njit(**_JIT)
-def _links(g, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, sums):
+def _links(g, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, lpx, lpy, sums):
     """Rule a (solver/bouzidi.py incoming, float64) on every body link, and the momentum
     exchange on them (solver/forces/momentum_exchange.py, full f = g + w RHO0):
-    sums += (Galilean fx, fy, classic fx, fy) without the cover/uncover impulse."""
+    sums += (Galilean fx, fy, classic fx, fy, Galilean p x F, classic p x F) without the
+    cover/uncover impulse, p = (lpx, lpy) the link's wall crossing x - q c_i in grid
+    coordinates (the caller takes the centre's moment c x F off: the torque about c)."""
     for k in range(len(li)):
         i = li[k]
         ib = _OPP[i]
@@ -411,10 +413,16 @@ def _links(g, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, sums):
         f_out = g_out + wr
         f_in = v + wr
         cx, cy = _CX[i], _CY[i]
-        sums[0] += (-cx - luwx[k]) * f_out - (cx - luwx[k]) * f_in
-        sums[1] += (-cy - luwy[k]) * f_out - (cy - luwy[k]) * f_in
-        sums[2] -= cx * (f_out + f_in)
-        sums[3] -= cy * (f_out + f_in)
+        gx = (-cx - luwx[k]) * f_out - (cx - luwx[k]) * f_in
+        gy = (-cy - luwy[k]) * f_out - (cy - luwy[k]) * f_in
+        sx = -cx * (f_out + f_in)
+        sy = -cy * (f_out + f_in)
+        sums[0] += gx
+        sums[1] += gy
+        sums[2] += sx
+        sums[3] += sy
+        sums[4] += lpx[k] * gy - lpy[k] * gx
+        sums[5] += lpx[k] * sy - lpy[k] * sx
 
 
 @numba.njit(inline="always", **_JIT)
@@ -445,7 +453,7 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
     @numba.njit(parallel=True, **_JIT)
     def advance(n, t0, ramp_steps, g, out, pre, op, om, keep, target, xs, Fx, Fy, smag, scratch, sums,
                 tunnel, walls, periodic_x, profile, wall_profile, quiet_rate, quiet_coefficient, drho_ref,
-                li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, force,
+                li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, lpx, lpy, force,
                 ry, rx, rbits, sy, sx, solid_g):
         """n steps from time t0, the state in g (post-collision), ping-ponging with out; returns
         (steps done, finite): it stops after the first step whose density is not finite (that
@@ -455,7 +463,8 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
            r wall_profile, the quiet inlet's correction once the ramp is over: quiet_rate > 0),
            b (walls: 0 periodic, 1 no-slip, 2 free-slip) and a (the body links li..luwy, in grid
            coordinates) into pre, from the post-collision state; the momentum exchange summed
-           into force (4,) over the n steps (Galilean fx, fy, classic fx, fy, no impulse);
+           into force (6,) over the n steps (Galilean fx, fy, classic fx, fy, no impulse, and
+           their moments about the grid origin from the wall crossings lpx, lpy: _links);
         2. pull-stream + collide of columns 1 .. nx-2, blocks of rows in parallel (scratch (B,
            2, 9, CHUNK): each block's gather and result buffers, nothing allocated in the
            parallel loop; sums (B,) each block's sum drho): columns 1 .. xs-1 share the rates
@@ -485,7 +494,7 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                 _inlet(a, pre, r, wall_profile, quiet, quiet_rate, quiet_coefficient, drho_ref)
             if walls != 0:
                 _walls(a, pre, walls, periodic_x)
-            _links(a, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, force)
+            _links(a, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, lpx, lpy, force)
             for blk in prange(nb):
                 bb = scratch[blk, 0]
                 o = scratch[blk, 1]

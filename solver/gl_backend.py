@@ -143,6 +143,9 @@ class GLSolver(Solver):
         self._band_sums = None  # LinkSums: the link-sum pass (LINK_SUM_MODELS), made on first use
         self._block_sums = False  # the block being drawn sums links instead of copying windows
         self._link_sums = 0  # lbm_step.glsl LINK_SUMS of the body variant: 0, 1 Galilean, 2 classic
+        #: the momentum exchange's torque is summed (the link-sum pass); False: a lone momentum
+        #: exchange's force is summed in the step's own pass, its torque NaN
+        self.sum_torque = True
         self._sums_keep = None  # the body programs' sums_keep uniform as last set
 
         self._impulse = (0.0, 0.0)
@@ -212,9 +215,10 @@ class GLSolver(Solver):
     # --- forces summed on the GPU (solver/gl_link_sums.py) ----------------------
     def _link_sum_mode(self) -> int:
         """lbm_step.glsl's LINK_SUMS for the enabled models: 1 (2) where the Galilean-invariant
-        (classic) momentum exchange is the body's only force model; 0 else (both exchanges: the
-        link-sum pass; other models: the window)."""
-        if self.body is None:
+        (classic) momentum exchange is the body's only force model and no torque is wanted
+        (`sum_torque` False); 0 else (the link-sum pass, which sums the torque too; other
+        models: the window)."""
+        if self.body is None or self.sum_torque:
             return 0
         return LINK_SUMS_OF_MODEL.get(tuple(self._models), 0)
 
@@ -319,7 +323,7 @@ class GLSolver(Solver):
         non-finite final state replays the block from its start state (kept in the third
         side) with a check after every step, so SolverDiverged names the exact step."""
         n = int(n)
-        sums = {name: [0.0, 0.0] for name in self._models}
+        sums = {name: [0.0, 0.0, 0.0] for name in self._models}
         done = 0
         self._use_link_sum_mode(self._link_sum_mode())
         while done < n:
@@ -357,13 +361,15 @@ class GLSolver(Solver):
                 raise
             for win in windows:  # a BodyWindow, or (block_sums, in_pass) forces already
                 forces = (win if self._block_sums or in_pass else
-                          {name: model.compute(win) for name, model in self._models.items()})
-                for name, (fx, fy) in forces.items():
+                          {name: model.evaluate(win) for name, model in self._models.items()})
+                for name, (fx, fy, torque) in forces.items():
                     sums[name][0] += fx
                     sums[name][1] += fy
+                    sums[name][2] += torque
             done += k
         if n > 0:
             self._forces = {name: (s[0] / n, s[1] / n) for name, s in sums.items()}
+            self._torques = {name: s[2] / n for name, s in sums.items()}
 
     def _resolve_checks(self, t0: int, bands: int, impulses, band_sides=None):
         """Read back a block of `bands` steps from time t0 and check it: the tile sums of the

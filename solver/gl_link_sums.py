@@ -14,11 +14,14 @@ Two ways to sum, chosen by the enabled force models (LINK_SUM_MODELS):
   the block's running total in texture G4's spare channels over the body window (lbm_step.glsl
   LINK_SUMS 1 Galilean-invariant, 2 classic; `read_pass_sums`): no extra pass, and a block
   reads those texels of one attachment;
-- both exchanges (four sums a texel): a link-sum pass in the step's scene (LinkSums,
-  shaders/link_sums.glsl) writes one RGBA32F texel of partial sums per state texel with a cut
-  link into the band area (solver/gl_band.py); a block reads those texels of one attachment.
+- both exchanges, or the torque wanted (four sums and two moments a texel): a link-sum pass in
+  the step's scene (LinkSums, shaders/link_sums.glsl) writes two RGBA32F texels of partial sums
+  (attachments 0 and 1) per state texel with a cut link into the band area (solver/gl_band.py);
+  a block reads those texels of two attachments.
 """
 from __future__ import annotations
+
+import math
 
 import moderngl
 import numpy as np
@@ -40,6 +43,19 @@ def links_constant(links) -> tuple[float, float]:
     """K = -2 RHO0 sum w_i c_i over the body's links, per step."""
     i = links.i
     return tuple(-2.0 * RHO0 * (W[i, None] * C[i]).sum(axis=0)) if len(i) else (0.0, 0.0)
+
+
+def links_constant_moment(body) -> float:
+    """M_K: the moment of K's terms -2 RHO0 w_i c_i about the body's centre, each at its link's
+    wall crossing x - q c_i, per step."""
+    links = body.links
+    i = links.i
+    if not len(i):
+        return 0.0
+    k = -2.0 * RHO0 * W[i, None] * C[i]
+    rx = body.window[0] + links.ix - links.q * C[i, 0] - body.shape.x
+    ry = body.window[1] + links.iy - links.q * C[i, 1] - body.shape.y
+    return float(np.sum(rx * k[:, 1] - ry * k[:, 0]))
 
 
 class LinkSums:
@@ -105,25 +121,29 @@ class LinkSums:
             self.vao.render(moderngl.TRIANGLES, vertices=6, first=6 * slot)
 
     def forces(self, fbos, sides, bands: int, models, impulses, t0: int):
-        """Each step's forces {model: (fx, fy)} from its slot of link sums in the band areas
-        (step b: slot b // 2 of side sides[b % 2]; attachment 0 of `fbos[side]` only, summed in
-        float64), plus K and, Galilean-invariant, the step's impulse. Returns (forces per step,
-        the first step whose sums are not finite or None)."""
+        """Each step's forces and torques {model: (fx, fy, torque)} from its slot of link sums in
+        the band areas (step b: slot b // 2 of side sides[b % 2]; attachments 0 (sums) and 1
+        (moments) of `fbos[side]`, summed in float64), plus K (and its moment) and,
+        Galilean-invariant, the step's impulse. Returns (forces per step, the first step whose
+        sums are not finite or None)."""
         cols, ww, wh = self.layout
         rows, cols_ = np.divmod(np.arange(len(self.texels)), ww)  # list entry j in its slot
         k_x, k_y = links_constant(self.body.links)
-        sums = np.empty((bands, 4))
+        m_k = links_constant_moment(self.body)
+        sums = np.empty((bands, 6))
         for first in (0, 1):  # the steps whose slots side sides[first] holds: first, first + 2, ...
             band = np.arange(first, bands, 2)
             if not len(band):
                 continue
             slot = band // 2
             h = -(-(int(slot[-1]) + 1) // cols) * wh  # the rows of the band area those slots use
-            data = fbos[sides[first]].read(viewport=(self.kx, 0, cols * ww, h), components=4,
-                                           attachment=0, dtype="f4")
-            area = np.frombuffer(data, dtype="f4").reshape(h, cols * ww, 4)
-            texels = area[(slot // cols * wh)[:, None] + rows, (slot % cols * ww)[:, None] + cols_]
-            sums[band] = texels.sum(axis=1, dtype=np.float64)  # (steps, 4), each step's in float64
+            at = ((slot // cols * wh)[:, None] + rows, (slot % cols * ww)[:, None] + cols_)
+            for attachment, channels in ((0, slice(0, 4)), (1, slice(4, 6))):
+                data = fbos[sides[first]].read(viewport=(self.kx, 0, cols * ww, h), components=4,
+                                               attachment=attachment, dtype="f4")
+                area = np.frombuffer(data, dtype="f4").reshape(h, cols * ww, 4)
+                texels = area[at][..., :channels.stop - channels.start]
+                sums[band, channels] = texels.sum(axis=1, dtype=np.float64)  # each step's in float64
         finite = np.isfinite(sums).all(axis=1)
         good = bands if finite.all() else int(np.argmin(finite))
         out = []
@@ -132,9 +152,11 @@ class LinkSums:
             forces = {}
             if "momentum_exchange" in models:
                 forces["momentum_exchange"] = (float(s[0] + s[2] + k_x + impulses[b][0]),
-                                               float(s[1] + s[3] + k_y + impulses[b][1]))
+                                               float(s[1] + s[3] + k_y + impulses[b][1]),
+                                               float(s[4] + s[5] + m_k))
             if "momentum_exchange_classic" in models:
-                forces["momentum_exchange_classic"] = (float(s[0] + k_x), float(s[1] + k_y))
+                forces["momentum_exchange_classic"] = (float(s[0] + k_x), float(s[1] + k_y),
+                                                       float(s[4] + m_k))
             out.append(forces)
         return out, (None if good == bands else t0 + good)
 
@@ -162,12 +184,13 @@ def read_pass_sums(fbo, rects) -> np.ndarray:
 def pass_sums_forces(total, mode: int, links, bands: int, impulses, step: int) -> dict:
     """The force summed over a block's `bands` steps from the step pass's running total (mode
     1: Galilean-invariant S1 + S2 per step, 2: classic S1), plus K each step and,
-    Galilean-invariant, each step's impulse. Non-finite sums raise SolverDiverged at `step`, the
+    Galilean-invariant, each step's impulse; {model: (fx, fy, torque)}, the torque NaN (the
+    pass has no channel left for it: the backend takes the link-sum pass where a torque is wanted). Non-finite sums raise SolverDiverged at `step`, the
     block's end, which the caller replays to find the step."""
     if not np.all(np.isfinite(total)):
         raise SolverDiverged(step, "non-finite populations around the body")
     k_x, k_y = links_constant(links)
     fx, fy = float(total[0] + bands * k_x), float(total[1] + bands * k_y)
     if mode == 2:
-        return {"momentum_exchange_classic": (fx, fy)}
-    return {"momentum_exchange": (fx + sum(j[0] for j in impulses), fy + sum(j[1] for j in impulses))}
+        return {"momentum_exchange_classic": (fx, fy, math.nan)}
+    return {"momentum_exchange": (fx + sum(j[0] for j in impulses), fy + sum(j[1] for j in impulses), math.nan)}

@@ -141,6 +141,7 @@ class MotionRunner:
         self.shape0 = shape
         self.t = 0
         self._placed = None  # (t, velocity) of the last set_body
+        self.last_torques: dict[str, float] = {}  # mean torque per model of the last advance
         self._place(self.script.velocity_at(0))
 
     @property
@@ -159,7 +160,8 @@ class MotionRunner:
         self._placed = (self.t, velocity)
 
     def advance(self, n: int) -> dict[str, tuple[float, float]]:
-        """Run n steps along the script; the force per model averaged over them. Raises
+        """Run n steps along the script; the force per model averaged over them (the torques'
+        means in `last_torques`). Raises
         `SolverDiverged` when the flow has left the physical range (`Solver.check_physical`)."""
         total = StepWeightedMean()
 
@@ -177,8 +179,9 @@ class MotionRunner:
                 left = self.script.steps_left_in_phase(self.t)
                 k = remaining if left is None else min(remaining, left)
             self.solver.step(k)
-            total.add(self.solver.forces(), k)
+            total.add(self.solver.forces(), k, self.solver.torques())
             self.t += k
             remaining -= k
         self.solver.check_physical()   # SolverDiverged when the flow left the physical range
+        self.last_torques = total.torque_mean()
         return total.mean()

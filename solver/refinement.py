@@ -25,7 +25,8 @@ part with tau-).
   (1 - 1/tau). A tau+- of 1 exactly (BGK at tau 1) leaves no post-collision non-equilibrium
   to rescale and is refused.
 - Forces: the fine lattice's force models, averaged over its two steps, divided by 2
-  (F = f rho dx^3 / dt^2 per unit span: halving dx and dt halves it in lattice units).
+  (F = f rho dx^3 / dt^2 per unit span: halving dx and dt halves it in lattice units); torques
+  divided by 4 (T = t rho dx^4 / dt^2 per unit span).
 """
 from __future__ import annotations
 
@@ -221,10 +222,12 @@ class RefinedSolver(Solver):
                 if ring is not None:
                     self._set_fine_ring(ring)
                 self.fine.step(1)
+                torques = self.fine.torques()
                 for name, (fx, fy) in self.fine.forces().items():
-                    s = sums.setdefault(name, [0.0, 0.0])
+                    s = sums.setdefault(name, [0.0, 0.0, 0.0])
                     s[0] += fx
                     s[1] += fy
+                    s[2] += torques.get(name, 0.0)
             self._restrict()
             self._set_fine_ring(ring_t1)  # the fine lattice whole at t + 1 (its ring was streamed over)
             self._ring_now = ring_t1
@@ -232,6 +235,8 @@ class RefinedSolver(Solver):
         if n > 0:
             # mean over the 2 n fine steps, and F_coarse = F_fine / 2 (module docstring)
             self._forces = {name: (s[0] / (4 * n), s[1] / (4 * n)) for name, s in sums.items()}
+            # and T_coarse = T_fine / 4 (a moment arm of half the cells)
+            self._torques = {name: s[2] / (8 * n) for name, s in sums.items()}
 
     def shifted_distributions(self) -> np.ndarray:
         return self.coarse.shifted_distributions()

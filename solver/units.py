@@ -8,7 +8,7 @@ numbers need a reference length L and a reference velocity U, which the caller s
 - Pressure p = c_s^2 rho (ideal LBM equation of state); a pressure difference is made
   dimensionless as dp / (rho U^2).
 - Strouhal number St = f L / U.
-- Newtons: a lattice force per unit span times `ForceScale.newtons_per_lattice_force`.
+- Newtons: a lattice force per unit span times `NewtonScale.newtons_per_lattice_force`.
 
 Nothing else in FeelFlow hard-codes a scale.
 """
@@ -80,17 +80,17 @@ def strouhal(frequency: float, length: float, speed: float) -> float:
 
 
 @dataclass(frozen=True)
-class ForceScale:
+class NewtonScale:
     """Lattice force (per unit span, one lattice cell deep) to newtons.
 
-    One factor, `newtons_per_lattice_force`, set either from a physical fluid (`physical`) or
-    as a gain chosen for a haptic device (`for_peak`).
+    One factor, `newtons_per_lattice_force`, set from a physical fluid (`physical`). (The gain
+    from a lattice force to a haptic device's newtons is `haptics.shaping.ForceScale`.)
     """
 
     newtons_per_lattice_force: float
 
     @classmethod
-    def physical(cls, dx_m: float, dt_s: float, rho_kg_m3: float, depth_m: float) -> "ForceScale":
+    def physical(cls, dx_m: float, dt_s: float, rho_kg_m3: float, depth_m: float) -> "NewtonScale":
         """The scale of a physical fluid: cell size dx, step dt, density rho, body span depth.
 
         A lattice cell holds the mass rho dx^2 depth and a lattice acceleration is dx / dt^2,
@@ -99,13 +99,6 @@ class ForceScale:
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"{name}: must be a positive number, got {value!r}")
         return cls(rho_kg_m3 * dx_m * dx_m * depth_m * dx_m / (dt_s * dt_s))
-
-    @classmethod
-    def for_peak(cls, lattice_force: float, newtons: float) -> "ForceScale":
-        """A gain that maps a lattice force magnitude to a given force in newtons (haptics)."""
-        if not (lattice_force > 0 and newtons >= 0):
-            raise ValueError("lattice_force must be > 0 and newtons >= 0")
-        return cls(newtons / lattice_force)
 
     def newtons(self, lattice_force):
         """The force in newtons (scalar, tuple or array)."""
@@ -143,7 +136,7 @@ class PhysicalUnits:
     dt = U dx / U_f (the same as nu dx^2 / nu_f). Then a lattice velocity times dx / dt is in
     m/s, a step is dt seconds, a lattice pressure (rho_0 = 1) times rho_f (dx / dt)^2 is in
     pascals, and a lattice force per unit span times rho_f dx^3 / dt^2 is in newtons per metre of
-    span (`ForceScale.physical`), times `span` (metres) in newtons. Only the Reynolds number is
+    span (`NewtonScale.physical`), times `span` (metres) in newtons. Only the Reynolds number is
     simulated: the lattice Mach number is not the physical one (water at 2 cm/s is far slower
     than sound; the lattice flow runs at Ma ~ 0.1 to be fast)."""
 
@@ -202,8 +195,8 @@ class PhysicalUnits:
         """Lattice kinematic viscosity (cells^2/step) -> m^2/s."""
         return nu * self.dx ** 2 / self.dt
 
-    def force_scale(self) -> ForceScale:
-        return ForceScale.physical(self.dx, self.dt, self.fluid.density, self.span_m)
+    def force_scale(self) -> NewtonScale:
+        return NewtonScale.physical(self.dx, self.dt, self.fluid.density, self.span_m)
 
     def force(self, f):
         """Lattice force (per unit span) -> newtons on a body `span_m` deep."""

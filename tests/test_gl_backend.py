@@ -166,7 +166,8 @@ def test_link_sums_on_the_gpu_give_the_momentum_exchanges_of_the_window(gl_conte
     code (the reference: the same models with a window model enabled too). Both forms, on a body moved, turned and spun between
     blocks (Bouzidi links of both kinds, moving wall, cover/uncover impulses), agree with the
     models on the window to float32 round-off of the sums (1e-5 of the largest force; measured
-    2.8e-7), and the state is the same bit for bit."""
+    2.8e-7), their torques about the body's centre likewise (1e-5 of the largest torque), and
+    the state is the same bit for bit."""
     from feelflow.shapes import FlatPlate
 
     cfg = FlowConfig(nx=96, ny=48, inflow_speed=0.05, inflow_ramp_steps=10)
@@ -181,21 +182,27 @@ def test_link_sums_on_the_gpu_give_the_momentum_exchanges_of_the_window(gl_conte
                      FlatPlate(length=12.0, thickness=2.5, x=31.1, y=23.9, angle=0.35 + 0.05 * k))
             s.set_body(shape, velocity=(0.02, -0.01), omega=0.01 * (k >= 6))
             s.step(7)
-            out.append([s.forces()[n] for n in names])
+            out.append([(*s.forces()[n], s.torques()[n]) for n in names])
         assert s._block_sums == (forces == "gpu")
         runs.append((np.array(out), s.distributions()))
     (f_gpu, g_gpu), (f_win, g_win) = runs
     assert np.array_equal(g_gpu, g_win)
+    t_gpu, t_win = f_gpu[..., 2], f_win[..., 2]
+    f_gpu, f_win = f_gpu[..., :2], f_win[..., :2]
     scale = np.abs(f_win).max()
     assert scale > 0.01
     print(f"\n  link sums against the window: {np.abs(f_gpu - f_win).max() / scale:.1e} of the largest force", end="")
     assert np.abs(f_gpu - f_win).max() <= 1e-5 * scale
     assert not np.allclose(f_win[:, 0], f_win[:, 1])  # the two forms differ on a moving body
+    t_scale = np.abs(t_win).max()
+    assert t_scale > 0.01
+    print(f", torque {np.abs(t_gpu - t_win).max() / t_scale:.1e} of the largest", end="")
+    assert np.abs(t_gpu - t_win).max() <= 1e-5 * t_scale
 
 
 @pytest.mark.parametrize("model", ["momentum_exchange", "momentum_exchange_classic"])
 def test_the_step_pass_sums_the_links_of_a_single_momentum_exchange(gl_context, model):
-    """With one momentum exchange as the only model (the window's and the bench's case), the
+    """With one momentum exchange as the only model and no torque wanted (`sum_torque` False), the
     step's own pass sums its links while it streams them (lbm_step.glsl LINK_SUMS) and keeps the
     running total of a block's steps in texture G4's spare channels; no link-sum pass, no band
     area. On a body moved, turned and spun between calls of 7 and 40 steps (blocks of 32 + 8),
@@ -208,6 +215,7 @@ def test_the_step_pass_sums_the_links_of_a_single_momentum_exchange(gl_context, 
     runs = []
     for forces in ("gpu", "window"):
         s = create_solver("gl", cfg, ctx=gl_context)
+        s.sum_torque = False  # the force alone: the step's own pass
         s.enable_force_models([model] + ([WINDOW_MODEL] if forces == "window" else []))
         out = []
         for k in range(8):
@@ -240,6 +248,7 @@ def test_a_non_finite_body_window_raises_with_its_step_on_every_force_path(gl_co
              "window": ["momentum_exchange", WINDOW_MODEL]}[forces]
     cfg = FlowConfig(nx=64, ny=32, inflow_speed=0.04)
     s = create_solver("gl", cfg, ctx=gl_context)
+    s.sum_torque = forces != "pass"
     s.enable_force_models(names)
     s.set_body(Cylinder(8.0, x=20.0, y=16.0))
     s.step(5)

@@ -100,3 +100,21 @@ def test_the_window_fits_a_1024_pixel_wide_screen(window, qtbot):
     qtbot.wait(100)
     assert plot.readout_label.width() >= plot.readout_label.sizeHint().width()
     assert plot.reference_label.width() >= plot.reference_label.sizeHint().width()
+
+
+def test_the_torque_view_shows_the_torque_that_resists_a_turn(window, qtbot):
+    """The torque view plots the force history's torque of the model shown; the body turned
+    counter-clockwise by the window's turn feels it clockwise (negative) while it turns."""
+    plot, sim = window.plot, window.sim
+    qtbot.waitUntil(lambda: len(sim.history) > 5, timeout=20000)
+    plot.view.setCurrentIndex(plot.view.findData("torque"))
+    assert plot.axis_labels()[1].startswith("torque")
+    n0 = len(sim.history)
+    sim.turn_to(sim.params.angle_deg + 60.0)
+    qtbot.waitUntil(lambda: len(sim.history) > n0 + 10, timeout=20000)
+    plot.refresh(force=True)
+    t, torque = sim.history.torque(sim.params.force_model)
+    shown_t, shown = plot.curves[(sim.params.force_model, "torque")].getData()
+    assert np.allclose(shown[-5:], torque[-5:], equal_nan=True)
+    turning = torque[n0:n0 + 10]
+    assert np.isfinite(turning).all() and np.median(turning) < 0

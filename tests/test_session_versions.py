@@ -6,6 +6,7 @@ explicit schema, not the solver's dataclass."""
 from __future__ import annotations
 
 import dataclasses
+import io
 import json
 import pathlib
 import zipfile
@@ -27,6 +28,7 @@ HISTORY = {
     "v1-1543f8d-midflow.ffsession": "inlet_sponge_cells, a quiet inlet without its stored reference",
     "v1-d9a539c-midflow.ffsession": "the quiet inlet's reference in state.npz",
     "v2-midflow.ffsession": "the explicit schema",
+    "v3-midflow.ffsession": "each model's torque (forces.npz torques)",
 }
 
 
@@ -91,3 +93,34 @@ def test_the_schema_is_every_flow_setting():
     """A setting added to FlowConfig changes what a session must store: add it to a new format
     version (app/sessions/versions.py: VERSION, CONFIG_KEYS and a loader for the old version)."""
     assert set(versions.CONFIG_KEYS) == {f.name for f in dataclasses.fields(FlowConfig)}
+
+
+def test_torques_are_recorded_from_version_3_and_read_as_missing_before():
+    """A version-3 file holds each row's torque as the solver gave it, and its replay gives the
+    same; files of versions 1 and 2 recorded none: NaN, and nothing of theirs reads as a torque."""
+    v3 = load_session(DATA / "v3-midflow.ffsession")
+    torques = v3.forces["torques"]
+    assert torques.shape == (len(v3.forces["seq"]), len(v3.models)) and np.isfinite(torques).all()
+    assert np.abs(torques).max() > 0
+    assert v3.torques(0) == {"momentum_exchange": float(torques[0, 0])}
+    replayed = replay(v3, "numpy").session.forces["torques"]
+    assert np.allclose(replayed, torques, rtol=1e-9, atol=1e-15)
+    for name in ("v2-midflow.ffsession", "v1-2f57f13-start.ffsession"):
+        old = load_session(DATA / name)
+        assert np.isnan(old.forces["torques"]).all() and old.torques(0) == {}
+
+
+def test_a_version_3_file_without_torques_is_one_line(tmp_path):
+    src, dst = DATA / "v3-midflow.ffsession", tmp_path / "no-torques.ffsession"
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w") as zout:
+        for item in zin.infolist():
+            data = zin.read(item)
+            if item.filename == "forces.npz":
+                with np.load(io.BytesIO(data)) as npz:
+                    arrays = {k: npz[k] for k in npz.files if k != "torques"}
+                buf = io.BytesIO()
+                np.savez(buf, **arrays)
+                data = buf.getvalue()
+            zout.writestr(item, data)
+    with pytest.raises(SessionError, match="forces.npz has no array 'torques'"):
+        load_session(dst)

@@ -75,6 +75,21 @@ def test_the_shaken_scenes_moves_count_in_the_stopwatch(request):
     assert watch.seconds >= 0.002 * watch.steps
 
 
+def test_the_scans_local_guard_keeps_a_runaway_flow_stable(request):
+    """The scan with the window's local guard (solver/local_guard.py): TRT on the shaken cylinder
+    at U / nu = 50 runs away within a few hundred steps; with the guard it raises the viscosity
+    from the flow's fastest node, keeps the flow, and the run ends stable and bounded."""
+    make = factory("numpy", request)
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        bare = stability.run_point(make, "cylinder_shaken", "trt", 0.05, 0.001, convective_times=1.0)
+        kept = stability.run_point(make, "cylinder_shaken", "trt", 0.05, 0.001, convective_times=1.0, guard=True)
+    assert not bare.stable, bare
+    assert kept.state == "stable" and kept.max_u < stability.U_BOUND, kept
+    assert kept.guard_raises and kept.nu_final > 0.001, kept
+    assert kept.nu_final == kept.guard_raises[-1][2]
+
+
 def test_the_scan_runs_the_windows_tunnel():
     """The scan's tunnel is the window's: its sponge and the sponge's absorbing layer."""
     from feelflow.app.model.simulation import default_base_config

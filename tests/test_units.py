@@ -37,12 +37,10 @@ def test_strouhal():
     assert units.strouhal(1 / 2000, 20, 0.05) == pytest.approx(0.2)
 
 
-def test_force_scale_physical_and_gain():
-    s = units.ForceScale.physical(dx_m=0.001, dt_s=0.01, rho_kg_m3=1000.0, depth_m=0.1)
+def test_newton_scale_of_a_physical_fluid():
+    s = units.NewtonScale.physical(dx_m=0.001, dt_s=0.01, rho_kg_m3=1000.0, depth_m=0.1)
     # one cell of water 1 mm x 1 mm x 0.1 m (1e-4 kg) accelerated by 1 mm / (0.01 s)^2 = 10 m/s^2
     assert s.newtons(1.0) == pytest.approx(1e-3)
     assert s.newtons((2.0, -1.0)) == pytest.approx((2e-3, -1e-3))
-    g = units.ForceScale.for_peak(0.5, 3.3)
-    assert g.newtons(0.25) == pytest.approx(1.65)
     with pytest.raises(ValueError, match="dx_m"):
-        units.ForceScale.physical(dx_m=-1, dt_s=1, rho_kg_m3=1, depth_m=1)
+        units.NewtonScale.physical(dx_m=-1, dt_s=1, rho_kg_m3=1, depth_m=1)

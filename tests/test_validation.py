@@ -91,6 +91,19 @@ def test_cylinder_at_re200_sheds_at_the_published_strouhal_at_10_cells(request):
     assert 0.0 < q["cd_mean"] / 1.34 - 1.0 < 0.10, q
 
 
+def test_cylinder_re200_targets_are_the_published_values_within_their_tolerances():
+    """The Re 200 case's checks: St within 3 % and C_D within 5 % of the published 2D values
+    (held without running the case, which takes minutes; the case itself is `slow`)."""
+    from feelflow.solver.validation import cylinder_high_re as high_re
+
+    ref = high_re.REFERENCES[200]
+    checks = {c.quantity: c for c in high_re.checks(200.0)}
+    for key, rel in (("strouhal", high_re.ST_REL), ("cd_mean", high_re.CD_REL)):
+        assert checks[key].holds(ref[key] * (1 + 0.99 * rel)) and checks[key].holds(ref[key] * (1 - 0.99 * rel))
+        assert not checks[key].holds(ref[key] * (1 + 1.01 * rel)) and not checks[key].holds(ref[key] * (1 - 1.01 * rel))
+    assert [c.quantity for c in high_re.checks(1000.0)] == ["converged"]
+
+
 @pytest.mark.slow
 def test_schaefer_turek_2d1_at_40_cells(request):
     r = case_module("schaefer-turek-2d1").run(factory("numpy", request), resolution=40)

@@ -39,6 +39,7 @@ class ForcePlot(QWidget):
         self._frozen = None
         self.view = QComboBox()
         self.view.addItem("Drag and lift against time", "time")
+        self.view.addItem("Torque about the body's centre against time", "torque")
         self.view.addItem("Drag against relative speed (log-log)", "speed")
         for key, (label, _, _) in LIFT_VIEWS.items():
             self.view.addItem(label, key)
@@ -154,6 +155,8 @@ class ForcePlot(QWidget):
         if view in LIFT_VIEWS:   # C_p and the polar: dimensionless (app/gui/polar_views.py)
             _, xlabel, ylabel = LIFT_VIEWS[view]
             return xlabel, ylabel
+        if view == "torque":
+            return f"time ({u.time_unit})", f"torque ({u.torque_unit}), counter-clockwise +"
         return f"time ({u.time_unit})", f"force ({u.force_unit})"
 
     def set_units(self, units):
@@ -191,6 +194,8 @@ class ForcePlot(QWidget):
             self.lift_views.draw_drag_polar(self.sim)
         elif view == "cp":
             self.lift_views.draw_cp(self.surface_pressure())
+        elif view == "torque":
+            self._draw_torque_view()
         else:
             self._draw_time_view()
 
@@ -260,6 +265,30 @@ class ForcePlot(QWidget):
             self._curve((model, "lift"), pg.mkPen(cl, width=2.5, style=Qt.DashLine if len(shown) > 1 else Qt.SolidLine),
                         self._name((model, "lift"))).setData(t, lift, connect="finite")
             values.append(np.r_[drag[settled], lift[settled]])
+        self._set_force_range(np.concatenate(values) if values else np.array([]))
+
+    def _draw_torque_view(self):
+        """Each shown model's torque about the body's centre against time (History.torque); the
+        macroscopic model's is zero by construction (solver/forces/macroscopic.py)."""
+        sim = self.sim
+        shown = self.models_shown()
+        if getattr(self, "_shown", None) != (tuple(shown), sim.params.compare_all):
+            self._shown = (tuple(shown), sim.params.compare_all)
+            self.plot.clear()
+            self.curves.clear()
+            self._reset_legend(3 if len(shown) > 1 else 1)
+        values = []
+        u = self.units
+        for model in shown:
+            t, torque = sim.history.torque(model)
+            first = int(np.argmax(np.isfinite(torque))) if np.isfinite(torque).any() else len(t)
+            t, torque = t[first:], torque[first:]
+            settled = t >= start_pulse_steps(sim.params.size)
+            t, torque = u.time(t), u.torque(torque)
+            cd, _ = MODEL_COLOURS.get(model, ((0, 0, 0), (90, 90, 90)))
+            self._curve((model, "torque"), pg.mkPen(cd, width=2.5), self._name((model, "torque"))).setData(
+                t, torque, connect="finite")
+            values.append(torque[settled])
         self._set_force_range(np.concatenate(values) if values else np.array([]))
 
     def _set_force_range(self, values):

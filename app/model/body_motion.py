@@ -35,17 +35,20 @@ def is_moving(vel, rate: float, pos=None, target=None, angle: float = 0.0, angle
     return target is not None and pos is not None and math.hypot(target[0] - pos[0], target[1] - pos[1]) > REST_DISTANCE
 
 
-def advance_with_motion(solver, n: int, move, moving) -> dict[str, tuple[float, float]]:
+def advance_with_motion(solver, n: int, move, moving, torques: dict | None = None) -> dict[str, tuple[float, float]]:
     """Run n steps of `solver`, calling `move(k)` before each run of k steps to advance the pose
     by k steps and place the body: k = 1 while `moving()` says the body moves, else the rest of
     the n steps in one run. Returns each force model's force summed over the steps (weight:
-    steps); SolverDiverged propagates from the solver."""
+    steps), and fills `torques` (where given) with each model's torque summed the same way;
+    SolverDiverged propagates from the solver."""
     done = 0
     total = StepWeightedMean()
     while done < n:
         k = 1 if moving() else n - done
         move(k)
         solver.step(k)
-        total.add(solver.forces(), k)
+        total.add(solver.forces(), k, solver.torques() if torques is not None else None)
         done += k
+    if torques is not None:
+        torques.update(total.torque_totals())
     return total.totals()

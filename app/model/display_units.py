@@ -55,6 +55,7 @@ class DisplayUnits:
     force_unit = property(lambda self: "N" if self.physical else "lattice units")
     pressure_unit = property(lambda self: "Pa" if self.physical else "lattice units")
     viscosity_unit = property(lambda self: "m\u00b2/s" if self.physical else "cells\u00b2/step")
+    torque_unit = property(lambda self: "N\u00b7m" if self.physical else "lattice units")
 
     def speed(self, v):
         return self.physical.velocity(v) if self.physical else v
@@ -68,6 +69,10 @@ class DisplayUnits:
 
     def force(self, f):
         return self.physical.force(f) if self.physical else f
+
+    def torque(self, t):
+        """A torque about the body's centre: a force times a lever arm in cells (dx metres each)."""
+        return self.physical.force(t) * self.physical.dx if self.physical else t
 
     def pressure(self, p):
         return self.physical.pressure(p) if self.physical else p

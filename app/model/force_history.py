@@ -1,5 +1,5 @@
 """The force history: one sample per frame of the running tunnel (its reporter, as lettuce's
-reporters are): step, body velocity, relative wind, the force of each model in use, and whether
+reporters are): step, body velocity, relative wind, the force and torque of each model in use, and whether
 the sample is settled. The plot, the readouts (app/model/readouts.py) and the lessons report read
 it. Qt-free; lattice units."""
 from __future__ import annotations
@@ -28,6 +28,7 @@ class History:
     body_velocity: list = field(default_factory=list)
     wind: list = field(default_factory=list)
     forces: dict = field(default_factory=dict)  # model -> list of (Fx, Fy)
+    torques: dict = field(default_factory=dict)  # model -> list of torques about the body's centre
     settled: list = field(default_factory=list)
     _wind_ref: tuple = (math.nan, math.nan)      # relative wind when it last changed, and when
     _since: float = 0.0
@@ -36,7 +37,7 @@ class History:
     SETTLE_STEPS = 1000
     WIND_TOLERANCE = 0.02
 
-    def add(self, time, body_velocity, wind, forces):
+    def add(self, time, body_velocity, wind, forces, torques=None):
         self.time.append(time)
         self.body_velocity.append(body_velocity)
         self.wind.append(wind)
@@ -45,10 +46,14 @@ class History:
             series = self.forces.setdefault(name, [])
             series.extend([(math.nan, math.nan)] * (len(self.time) - 1 - len(series)))
             series.append(f)
+        for name, t in (torques or {}).items():
+            series = self.torques.setdefault(name, [])
+            series.extend([math.nan] * (len(self.time) - 1 - len(series)))
+            series.append(t)
         if len(self.time) > self.MAX:
             cut = len(self.time) - self.MAX
             del self.time[:cut], self.body_velocity[:cut], self.wind[:cut], self.settled[:cut]
-            for series in self.forces.values():
+            for series in (*self.forces.values(), *self.torques.values()):
                 del series[:max(0, len(series) - self.MAX)]
 
     def _settled(self, time, wind) -> bool:
@@ -59,7 +64,7 @@ class History:
         return time - self._since >= self.SETTLE_STEPS
 
     def clear(self):
-        self.time.clear(), self.body_velocity.clear(), self.wind.clear(), self.forces.clear()
+        self.time.clear(), self.body_velocity.clear(), self.wind.clear(), self.forces.clear(), self.torques.clear()
         self.settled.clear()
         self._wind_ref, self._since = (math.nan, math.nan), 0.0
 
@@ -76,3 +81,13 @@ class History:
             f[n - len(series):] = np.asarray(series[-n:], float)
         drag, lift = readouts.drag_lift(f, np.asarray(self.wind, float).reshape(n, 2))
         return np.asarray(self.time, float), drag, lift
+
+    def torque(self, model: str):
+        """(t, torque) arrays: the model's torque about the body's centre, counter-clockwise
+        positive (NaN where absent)."""
+        n = len(self.time)
+        series = self.torques.get(model, [])
+        out = np.full(n, np.nan)
+        if series:
+            out[n - len(series):] = np.asarray(series[-n:], float)
+        return np.asarray(self.time, float), out

@@ -1,6 +1,8 @@
-"""The running wind tunnel behind the window (Qt-free, so it is testable on its own):
-the solver, the body and its pose, the mouse coupling, the force models in use, and the
-force history the plot and readouts show. Lattice units (docs/science/algorithm.md).
+"""The running wind tunnel behind the window (Qt-free, so it is testable on its own): the
+composition of its parts, each in its own module (the panel's parameters and the flow they
+make, the solver, the body's kinematics, the force history, the local stability guard, the
+surface-pressure watches, a wind sweep or motion script), and `advance(n)`, one frame.
+Lattice units (docs/science/algorithm.md).
 """
 from __future__ import annotations
 
@@ -11,11 +13,13 @@ import numpy as np
 
 from feelflow.app.model import readouts
 from feelflow.app.model.body_input import BodyInput
-from feelflow.app.model.body_motion import advance_with_motion, is_moving
+from feelflow.app.model.body_kinematics import BodyKinematics
+from feelflow.app.model.body_motion import advance_with_motion
 from feelflow.app.model.flow_choice import QUIET_INLET_RATE, FlowChoice, default_base_config, stable_params  # noqa: F401 (re-exported)
 from feelflow.app.model.force_history import History
+from feelflow.app.model.local_stability import LocalStabilityGuard
+from feelflow.app.model.pressure_watches import PressureWatches
 from feelflow.app.model.wind_sweep import SLEW_STEPS, WindSweep
-from feelflow.app.model.coupling import AngleSpring, SpringDamper
 from feelflow.solver import units
 from feelflow.app.sessions import SessionSolver
 from feelflow.solver.backend import create_solver
@@ -43,9 +47,6 @@ FORCE_MODELS = {
 #: y-boundaries offered as "wall type": config value -> label
 WALLS = {"no_slip": "Solid walls (no slip)", "free_slip": "Slippery walls (free slip)",
          "periodic": "No walls (periodic)"}
-
-#: distance (cells) the body's bounding box keeps from the domain edges
-EDGE_MARGIN = 8.0
 
 
 @dataclass
@@ -78,21 +79,47 @@ def phase_name(velocity, wind: float) -> str:
     return f"moving at ({vx:.3f}, {vy:.3f})"
 
 
+class OfBody:
+    """A member of the body's kinematics (`Simulation.body`) that the `TunnelModel` interface
+    (app/model/tunnel.py) names on the model itself: read and set through the Simulation."""
+
+    def __init__(self, name: str):
+        self.name = name
+
+    def __get__(self, sim, owner=None):
+        return self if sim is None else getattr(sim.body, self.name)
+
+    def __set__(self, sim, value):
+        setattr(sim.body, self.name, value)
+
+
 class Simulation:
-    """The running tunnel: owns the solver (a `SessionSolver`), the body and its pose, and runs
-    `advance(n)`: n steps and one force sample. Its parts, each set up here:
+    """The running tunnel: the composition of its parts, each set up here, and `advance(n)`: n
+    steps and one force sample.
     - the panel's parameters (`params`) and the flow they make (`flow_choice`,
       app/model/flow_choice.py: the base configuration, the collision operator, the stability
       guard; `guard_note` says what the last change had to adjust, None when nothing);
-    - the body's pose and its input: the mouse's spring-damper (`coupling`) and the angle spring
-      (app/model/coupling.py), through `drive(BodyInput)`;
+    - the flow (`solver`, a `SessionSolver`: app/sessions/driver.py);
+    - the body's kinematics (`body`, app/model/body_kinematics.py): its pose, the input pulling
+      it and the springs that move it; its pose is also read here (`pos`, `angle`, ...);
     - a motion script (`runner`, solver/motion.py) or a wind sweep (`sweep`,
       app/model/wind_sweep.py) when one runs;
-    - the force history (`history`, app/model/force_history.py), the reporter the plot reads.
+    - the force history (`history`, app/model/force_history.py), the reporter the plot reads;
+    - the local stability guard (`local_guard`, app/model/local_stability.py);
+    - the surface-pressure watches (`pressure`, app/model/pressure_watches.py): the C_p view's
+      and the live polar's.
     """
 
     #: a sweep's change of wind is spread over this many steps (app/model/wind_sweep.py)
     SWEEP_SLEW_STEPS = SLEW_STEPS
+
+    shape = OfBody("shape")             # the body where the flow feels it
+    pos = OfBody("pos")                 # its reference point (cells)
+    vel = OfBody("vel")                 # its velocity (cells per step)
+    angle = OfBody("angle")             # its angle (radians)
+    angle_target = OfBody("angle_target")   # the angle it is asked to turn to (radians)
+    hold_still = OfBody("hold_still")   # it ignores pulls and turns (the polygon editor, some lessons)
+    capped = OfBody("capped")           # the Mach cap limited its speed in the last frame
 
     def __init__(self, params: Params | None = None, backend: str = "numpy", ctx=None, shape_factory=None,
                  base_config: FlowConfig | None = None):
@@ -104,33 +131,24 @@ class Simulation:
         self.make_shape = shape_factory or make_shape
         self.polygon = None          # vertices of the custom polygon (body frame), or None
         self.history = History()
-        self.hold_still = False
-        self._asked = (None, None)   # (degrees, radians) of the last turn_to: see target_degrees
+        self.last_torques: dict[str, float] = {}  # each model's mean torque over the last advance
         self.runner: MotionRunner | None = None   # a scripted motion (the seed's protocol), or None
         self.sweep: WindSweep | None = None       # a wind-speed sweep (a lesson), or None
         self.sweep_slew_steps = self.SWEEP_SLEW_STEPS   # for the next sweep (0: changes at once)
         #: the base configuration, the collision operator and the stability guard (app/model/flow_choice.py)
         self.flow_choice = FlowChoice(base_config, self.params.grid)
         self.params, self.guard_note = self.flow_choice.stable(self.params)
-        self._guard_read_at = None   # solver step of the last max |u| the local guard read
+        self.local_guard = LocalStabilityGuard()
         self.guard_changed = False   # the local guard changed the flow (the window shows guard_note)
-        self.polar = None            # app/model/live_polar.LivePolar: an angle-of-attack sweep
-        self.surface_watch = None    # app/model/live_polar.SurfacePressureWatch: C_p along the surface
-        self.capped = False          # the Mach cap limited the body's speed in the last frame
+        self.pressure = PressureWatches()
         #: the coefficients' reference length when it is not the body's size (an exercise's)
         self.reference_override: readouts.ReferenceLength | None = None
         self.config = self.flow_config()
         # one SessionSolver for the life of the window (app/sessions/): rebuilt, never replaced
         self.solver = SessionSolver(create_solver(self.backend, self.config, ctx=ctx))
-        self.coupling = SpringDamper(max_speed=self.config.max_speed, stream=self._stream(self.config))
-        # the body's pose: reference point (cells), velocity (cells per step), angle and its rate
-        self.pos, self.vel = self.start_position(self.config), (0.0, 0.0)
-        self.angle, self.rate = math.radians(self.params.angle_deg), 0.0
-        self.angle_target = self.angle
-        self._target = None          # where an input pulls the body (`drive`), or None
-        self._clamped_x = self._clamped_y = False   # the last _clamp_pose pushed the body back in x, y
-        self.shape = self.make_shape(self.params, self.polygon, *self.pos, self.angle).validate(
-            self.config.nx, self.config.ny)
+        pos, angle = self.start_position(self.config), math.radians(self.params.angle_deg)
+        shape = self.make_shape(self.params, self.polygon, *pos, angle).validate(self.config.nx, self.config.ny)
+        self.body = BodyKinematics(shape, pos, angle, self.config)
         self._place_body()
 
     @staticmethod
@@ -155,62 +173,50 @@ class Simulation:
         same_grid = (self.config.nx, self.config.ny) == (config.nx, config.ny)
         self.solver.rebuild(config, keep_flow=keep_flow and same_grid)
         if not (keep_flow and same_grid):
-            self.pos, self.vel = self.start_position(config), (0.0, 0.0)
-            self.angle, self.rate = math.radians(self.params.angle_deg), 0.0
-            self.angle_target = self.angle
-            self._target = None
+            self.body.restart(self.start_position(config), math.radians(self.params.angle_deg))
             self.history.clear()
         if self.runner is not None and not keep_flow:
             self.runner = None
         self.config = config
-        self.coupling = SpringDamper(max_speed=config.max_speed, stream=self._stream(config))
+        self.body.use_config(config)
         if not keep_flow:
-            self.shape = self.make_shape(self.params, self.polygon, *self.pos, self.angle).validate(config.nx, config.ny)
+            self.body.shape = self.make_shape(self.params, self.polygon, *self.pos, self.angle).validate(
+                config.nx, config.ny)
         self._place_body()
 
     def _place_body(self):
         """The body inside the margins, the force models enabled, the body placed in the flow."""
-        self._clamp_pose()
+        self.body.clamp()
         self._enable_models()
         self.solver.set_body(self.shape, self.vel, 0.0)
-
-    @staticmethod
-    def _stream(config: FlowConfig, wind: float | None = None) -> tuple[float, float]:
-        """The wind the body's speed is capped relative to (app/model/coupling.py): the inflow in
-        the tunnel, none in a periodic box."""
-        if config.x_boundary != "tunnel":
-            return (0.0, 0.0)
-        return (float(config.inflow_speed if wind is None else wind), 0.0)
 
     def _enable_models(self):
         names = list(FORCE_MODELS) if self.params.compare_all else [self.params.force_model]
         self.solver.enable_force_models(names)
-        for probe in self._probes():
+        for probe in self.pressure.probes():   # the surface-pressure probes, beside the force models
             self.solver.add_force_model(probe)
 
-    def _probes(self):
-        """The surface-pressure probes switched on (the C_p view, the polar), beside the force models."""
-        watch = self.polar or self.surface_watch   # one probe: the polar's serves the C_p view too
-        return [] if watch is None else [watch.probe]
+    @property
+    def polar(self):
+        """The angle-of-attack sweep running in the tunnel (app/model/live_polar.py), or None."""
+        return self.pressure.polar
+
+    @property
+    def surface_watch(self):
+        """C_p along the surface for the plot's C_p view (app/model/live_polar.py), or None."""
+        return self.pressure.surface_watch
 
     def watch_surface_pressure(self, on: bool = True):
         """Switch the pressure model's wall sampling on for C_p along the surface (the C_p view)."""
-        if on and self.surface_watch is None:
-            from feelflow.app.model.live_polar import SurfacePressureWatch
-
-            self.surface_watch = SurfacePressureWatch()
-        elif not on:
-            self.surface_watch = None
+        self.pressure.watch_surface(on)
         self._enable_models()
 
     def start_polar(self, angles, sample_steps: int = 25, **settling):
         """An angle-of-attack sweep (app/model/live_polar.py): the body held still at each angle
         of `angles` (degrees, nose up positive) until its forces settle, then the next."""
-        from feelflow.app.model.live_polar import LivePolar
-
-        self.polar = LivePolar(self, angles, sample_steps=sample_steps, **settling)
+        polar = self.pressure.start_polar(self, angles, sample_steps=sample_steps, **settling)
         self._enable_models()
-        self.polar.start(self)
+        polar.start(self)
 
     # --- what the panel changes ------------------------------------------------------------
     def set_shape(self, kind=None, size=None, angle_deg=None, polygon=None):
@@ -220,9 +226,8 @@ class Simulation:
         poly = self.polygon if polygon is None else polygon
         angle = math.radians(params.angle_deg) if angle_deg is not None else self.angle
         shape = self.make_shape(params, poly, *self.pos, angle).validate(self.config.nx, self.config.ny)
-        self.params, self.polygon, self.shape = params, poly, shape
-        self.angle = self.angle_target = angle
-        self._clamp_pose()
+        self.params, self.polygon = params, poly
+        self.body.reshape(shape, angle)
         self.solver.set_body(self.shape, self.vel, 0.0)
         guarded, note = self.flow_choice.stable(self.params)
         if note:   # a larger body needs a thicker fluid at this wind
@@ -241,7 +246,7 @@ class Simulation:
         self.params = params
         if only_wind:
             self.solver.set_inflow_speed(params.wind)   # live, no rebuild
-            self.coupling.stream = self._stream(self.config, params.wind)
+            self.body.wind_changed(self.config, params.wind)
         else:
             self._build(keep_flow=True)
 
@@ -257,10 +262,9 @@ class Simulation:
     def reset_flow(self):
         """The flow from its initial state again (time 0), body where it was, at rest; history cleared."""
         self.solver.reset()
-        self.runner = self.sweep = self.polar = None
-        self.vel, self.rate, self._target = (0.0, 0.0), 0.0, None
-        self.angle_target = self.angle
-        self.shape = self.shape.moved(*self.pos, self.angle)
+        self.runner = self.sweep = None
+        self.pressure.stop_polar()
+        self.body.stop()
         self.solver.set_body(self.shape, (0.0, 0.0), 0.0)
         self.history.clear()
 
@@ -309,12 +313,10 @@ class Simulation:
                               wall=cfg.y_boundary, force_model=models[0], compare_all=len(models) > 1)
         self.params, self.guard_note = self.flow_choice.stable(self.params)
         self.polygon = verts
-        self.runner = None
-        self.sweep = self.polar = None
+        self.runner = self.sweep = None
+        self.pressure.stop_polar()
         self._build(keep_flow=False)
-        self.pos = (scene.body.x, scene.body.y)
-        self.shape = self.shape.moved(*self.pos, self.angle)
-        self._clamp_pose()
+        self.body.move_to((scene.body.x, scene.body.y))
         self.solver.set_body(self.shape, (0.0, 0.0), 0.0)
         if scene.motion.phases:
             self.start_script(scene.motion)
@@ -323,19 +325,16 @@ class Simulation:
     @property
     def target(self):
         """Where an input pulls the body, (x, y) cells, or None: set only through `drive`."""
-        return self._target
+        return self.body.target
 
     def drive(self, request: BodyInput) -> bool:
-        """The one way in for body input (mouse, haptic device, script: app/model/body_input.py).
-        A pull moves the target of the spring-damper that moves the body (coupling.py); a turn
-        asks the angle spring for an angle (`turn_to`). While the body holds still or a motion
-        script runs, the pose ignores both until that ends, as it always has. Returns True."""
-        if request.let_go:
-            self._target = None
-        elif request.target is not None:
-            self._target = request.target
+        """The one way in for body input (mouse, haptic device, script: app/model/body_input.py):
+        to the body's kinematics (a pull moves the spring-damper's target, a turn asks the angle
+        spring for an angle, as `turn_to`). While the body holds still or a motion script runs,
+        the pose ignores both until that ends, as it always has. Returns True."""
         if request.angle_deg is not None:
-            self.turn_to(request.angle_deg)
+            self.params = replace(self.params, angle_deg=wrap_degrees(request.angle_deg))
+        self.body.drive(request)
         return True
 
     def hit(self, x: float, y: float, tolerance: float = 2.0) -> bool:
@@ -346,20 +345,13 @@ class Simulation:
         """Ask for the angle `degrees` (any turn count: 190 turns 20 from 170, not 340 back):
         the body swings there through the angle spring (rate capped below the Mach limit), and
         the panel's angle (params.angle_deg, wrapped to [-180, 180)) says where it is going."""
-        self.angle_target = math.radians(degrees)
+        self.body.turn_to(degrees)
         self.params = replace(self.params, angle_deg=wrap_degrees(degrees))
-        self._asked = (degrees, self.angle_target)
 
     def target_degrees(self) -> float:
         """The angle the body is asked to turn to, in degrees (any number of turns), exactly as it
-        was asked (by `turn_to` or the panel) where it was: radians -> degrees -> radians is not
-        exact in floating point, and an undo must give back the very angle it took away."""
-        asked, radians = self._asked
-        if radians == self.angle_target:
-            return asked
-        if math.radians(self.params.angle_deg) == self.angle_target:
-            return self.params.angle_deg
-        return math.degrees(self.angle_target)
+        was asked (app/model/body_kinematics.py `target_degrees`)."""
+        return self.body.target_degrees(self.params.angle_deg)
 
     # --- running --------------------------------------------------------------------------
     def relative_wind(self):
@@ -379,9 +371,11 @@ class Simulation:
                 self.set_flow(wind=wind)
         done = 0
         acc = {}
+        torques = {}   # each model's torque summed over the steps
         self.capped = False
         if self.runner is not None:
             acc = {k: (fx * n, fy * n) for k, (fx, fy) in self.runner.advance(n).items()}
+            torques = {k: t * n for k, t in self.runner.last_torques.items()}
             r = self.runner
             self.pos, self.shape = r.position, r.shape
             self.vel = r.script.velocity_at(r.t - 1)
@@ -390,85 +384,38 @@ class Simulation:
                 self.vel = (0.0, 0.0)
             done = n
         if done < n:   # the pose advances every step while the body moves (app/model/body_motion.py)
-            acc = advance_with_motion(self.solver, n, self._move_body, self._body_moves)
+            acc = advance_with_motion(self.solver, n, self._move_body, self.body.moving, torques)
             self.capped |= self.solver.speed_capped
         forces = {k: (v[0] / n, v[1] / n) for k, v in acc.items()}
-        for probe in self._probes():   # a probe's force is the pressure model's: not a model of its own
-            forces.pop(probe.name, None)
-        if self.polar is not None:
-            self.polar.after_advance(self, forces, n)
-        self.history.add(self.solver.time, self.vel, self.relative_wind(), forces)
+        self.pressure.after_advance(self, forces, n)
+        torques = {k: t / n for k, t in torques.items() if k in forces}   # not the probes' (a model of none)
+        self.last_torques = torques
+        self.history.add(self.solver.time, self.vel, self.relative_wind(), forces, torques)
         self.apply_local_guard()
         return forces
 
-    def apply_local_guard(self) -> bool:
-        """The local stability guard (solver/local_guard.py): when the last physical-range check
-        found the fastest node outside the running operator's stable region, raise the viscosity
-        to the one that brings it back (for the operator that viscosity gets), keeping the flow;
-        `guard_note` and `guard_changed` say so in one line. Returns whether it acted."""
-        from feelflow.solver import local_guard
+    def _move_body(self, steps: int):
+        """The pose `steps` steps on (app/model/body_kinematics.py), the body placed where it moved."""
+        if self.body.move(steps):
+            self.solver.set_body(self.shape, self.vel, self.body.rate)
 
-        at = self.solver.max_speed_at
-        if at is None or at == self._guard_read_at:
+    def apply_local_guard(self) -> bool:
+        """The local stability guard (app/model/local_stability.py): when the last physical-range
+        check found the fastest node outside the running operator's stable region, raise the
+        viscosity to the one that brings it back, keeping the flow; `guard_note` and
+        `guard_changed` say so in one line. Returns whether it acted."""
+        action = self.local_guard.check(self.solver, self.config.collision, self.params.nu,
+                                        lambda nu: self.operator_for(replace(self.params, nu=nu)).collision)
+        if action is None:
             return False
-        self._guard_read_at = at
-        verdict = local_guard.check(self.config.collision, self.params.nu, self.solver.max_speed_seen)
-        if verdict.inside:
-            return False
-        if verdict.nu_needed is None:
-            self.guard_note = verdict.line(self.operator_for().label)
-            self.guard_changed = True
-            return True
-        nu = verdict.nu_needed
-        for _ in range(3):   # the chooser may pick another operator at the new viscosity: its region counts
-            op = self.operator_for(replace(self.params, nu=nu)).collision
-            again = local_guard.check(op, nu, verdict.max_speed).nu_needed
-            if again is None or again <= nu:
-                break
-            nu = again
-        nu = math.ceil(nu * 1e4 - 1e-6) / 1e4
         label = self.operator_for().label
-        self.set_flow(nu=nu)
-        self.guard_note = verdict.line(label, nu_set=self.params.nu)
+        if action.nu is None:
+            self.guard_note = action.verdict.line(label)
+        else:
+            self.set_flow(nu=action.nu)
+            self.guard_note = action.verdict.line(label, nu_set=self.params.nu)
         self.guard_changed = True
         return True
-
-    def _body_moves(self) -> bool:
-        """Whether the next step moves or turns the body (app/model/body_motion.py is_moving)."""
-        if self.hold_still:
-            return bool(self.rate) or self.vel != (0.0, 0.0)
-        return is_moving(self.vel, self.rate, self.pos, self._target, self.angle, self.angle_target)
-
-    def _move_body(self, steps: int):
-        old = (self.pos, self.angle)
-        if self.hold_still:
-            self.vel = (0.0, 0.0)
-        else:
-            self.pos, self.vel, capped = self.coupling.advance(self.pos, self.vel, self._target, steps)
-            self.capped |= capped
-        omega_before = self.rate
-        if not self.hold_still:
-            self.angle, self.rate = AngleSpring().advance(self.angle, self.rate, self.angle_target, steps) \
-                if (self.angle != self.angle_target or self.rate) else (self.angle, 0.0)
-        if self._clamp_pose():
-            self.vel = (0.0 if self._clamped_x else self.vel[0], 0.0 if self._clamped_y else self.vel[1])
-        if (self.pos, self.angle) != old or omega_before:
-            self.shape = self.shape.moved(*self.pos, self.angle)
-            self.solver.set_body(self.shape, self.vel, self.rate)
-
-    def _clamp_pose(self) -> bool:
-        """Keep the body EDGE_MARGIN cells inside the domain; True if it had to be pushed back."""
-        shape = self.shape.moved(*self.pos, self.angle)
-        x0, y0, x1, y1 = shape.bounding_box()
-        nx, ny = self.config.nx, self.config.ny
-        dx = max(0.0, EDGE_MARGIN - x0) - max(0.0, x1 - (nx - 1 - EDGE_MARGIN))
-        dy = max(0.0, EDGE_MARGIN - y0) - max(0.0, y1 - (ny - 1 - EDGE_MARGIN))
-        self._clamped_x, self._clamped_y = dx != 0, dy != 0
-        if dx or dy:
-            self.pos = (self.pos[0] + dx, self.pos[1] + dy)
-            self.shape = shape.moved(*self.pos, self.angle)
-            return True
-        return False
 
     # --- what the window shows -----------------------------------------------------------
     def reference_length(self) -> readouts.ReferenceLength:

@@ -24,7 +24,7 @@ MAX_FILE_BYTES = 1 << 30
 MAX_ROWS = 1_000_000
 #: room for the .npy headers and zip records of one .npz member, bytes
 NPZ_OVERHEAD = 4096
-#: most entries in one .npz member (a session's have 1 to 5 arrays)
+#: most entries in one .npz member (a session's have 1 to 6 arrays)
 MAX_ENTRIES = 16
 #: an entry's uncompressed size over its member's size (deflate reaches about 1000:1)
 MAX_RATIO = 1100
@@ -94,9 +94,9 @@ def member_limits(manifest, fail, manifest_name: str, members) -> dict:
         fail(str(exc))
     declared = manifest.get("forces")
     models = declared.get("models") if isinstance(declared, dict) else None
-    columns = 2 * len(models) if isinstance(models, list) and len(models) <= 16 else 32
+    columns = 3 * len(models) if isinstance(models, list) and len(models) <= 16 else 48
     return {inputs: NPZ_OVERHEAD + n["inputs"] * 8 * 8,             # seq, step, pose (3), velocity (3)
-            forces: NPZ_OVERHEAD + n["forces"] * 8 * (7 + columns),  # seq, step, n, body (4), values
+            forces: NPZ_OVERHEAD + n["forces"] * 8 * (7 + columns),  # seq, step, n, body (4), values, torques
             state: NPZ_OVERHEAD + 9 * nx * ny * 8}                     # f (9, ny, nx) float64
 
 

@@ -102,6 +102,9 @@ class SessionSolver:
     def forces(self) -> dict[str, tuple[float, float]]:
         return self._solver.forces()
 
+    def torques(self) -> dict[str, float]:
+        return self._solver.torques()
+
     def macroscopic(self):
         return self._solver.macroscopic()
 
@@ -191,7 +194,7 @@ class SessionSolver:
             done = max(1, min(n, exc.step - start))
             self._record_row(done, {m: (math.nan, math.nan) for m in self.models}, body)
             raise
-        self._record_row(n, self._solver.forces(), body)
+        self._record_row(n, self._solver.forces(), body, self._solver.torques())
 
     def step_part(self, k: int, row_steps: int) -> bool:
         """Run k steps of a force row of `row_steps` steps that is run in parts (a replay that
@@ -212,7 +215,7 @@ class SessionSolver:
             done = part["done"] + max(1, min(k, exc.step - part["start"] - part["done"]))
             self._record_row(done, {m: (math.nan, math.nan) for m in self.models}, part["body"])
             raise
-        part["mean"].add(self._solver.forces(), k)
+        part["mean"].add(self._solver.forces(), k, self._solver.torques())
         part["done"] += k
         if part["done"] < row_steps:
             return False
@@ -223,7 +226,7 @@ class SessionSolver:
             self._record_row(row_steps, {m: (math.nan, math.nan) for m in self.models}, part["body"])
             raise
         self._part = None
-        self._record_row(row_steps, part["mean"].mean(), part["body"])
+        self._record_row(row_steps, part["mean"].mean(), part["body"], part["mean"].torque_mean())
         return True
 
     def check_physical(self) -> None:
@@ -245,10 +248,10 @@ class SessionSolver:
             return (math.nan,) * 4
         return (self.shape.x, self.shape.y, self.velocity[0], self.velocity[1])
 
-    def _record_row(self, n, forces, body) -> None:
+    def _record_row(self, n, forces, body, torques=None) -> None:
         self.clock += n
         if self.recorder is not None:
-            self.recorder.record_forces(n, forces, body)
+            self.recorder.record_forces(n, forces, body, torques=torques)
 
     # --- session commands -----------------------------------------------------
     def set_viscosity(self, nu: float) -> None:

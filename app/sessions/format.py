@@ -63,6 +63,8 @@ INPUT_ARRAYS = {"seq": ("int64", ()), "step": ("int64", ()), "pose": ("float64",
                 "velocity": ("float64", (3,))}
 FORCE_ARRAYS = {"seq": ("int64", ()), "step": ("int64", ()), "n": ("int64", ()),
                 "body": ("float64", (4,)), "values": ("float64", None)}
+#: forces.npz's arrays that only some versions hold (versions.py says which must be there)
+FORCE_ARRAYS_SINCE = {"torques": ("float64", None)}
 STATE_ARRAYS = {"f": ("float64", None)}
 #: state.npz's optional array: the quiet inlet's reference (ny,) float64 (solver/quiet_inlet.py),
 #: present when the flow had one; without it the replay would drift from the recording
@@ -156,7 +158,8 @@ class Session:
     inputs: seq, step (k,) int64; pose (k, 3) x, y, angle; velocity (k, 3) vx, vy, omega.
     parameters: [{"seq", "step", "name", "value"}].
     forces: seq, step, n (m,) int64; body (m, 4) x, y, vx, vy; values (m, 2 * len(models))
-    fx, fy per model (NaN where a model was not computed).
+    fx, fy per model (NaN where a model was not computed); torques (m, len(models)) each
+    model's torque about the body's centre (NaN where not computed or not recorded).
     """
 
     manifest: dict
@@ -204,6 +207,11 @@ class Session:
             forces = {m: (float(row[2 * j]), float(row[2 * j + 1])) for j, m in enumerate(self.models)
                       if not (math.isnan(row[2 * j]) and math.isnan(row[2 * j + 1]))}
             yield int(f["step"][k]), tuple(float(v) for v in f["body"][k]), forces
+
+    def torques(self, row: int) -> dict[str, float]:
+        """{model: torque} of force row `row`, models without a torque there left out."""
+        t = self.forces["torques"][row]
+        return {m: float(t[j]) for j, m in enumerate(self.models) if not math.isnan(t[j])}
 
     def csv_rows(self, values=None):
         """Rows for `force_columns(self.models)` (shortest round-trip decimals; NaN as 'nan')."""
@@ -322,7 +330,8 @@ def load_session(path) -> Session:
     probes = _probe_arrays(data[PROBES], fail) if PROBES in data else None
     try:
         session = _validate(manifest, parameters, _npz_member(data[INPUTS], INPUTS, INPUT_ARRAYS, fail),
-                            _npz_member(data[FORCES], FORCES, FORCE_ARRAYS, fail), src, state, reference)
+                            _npz_member(data[FORCES], FORCES, FORCE_ARRAYS, fail, FORCE_ARRAYS_SINCE), src,
+                            state, reference)
         session.probes = probes
         return session
     except SessionError as exc:
@@ -364,7 +373,9 @@ def _json_member(raw: bytes, member: str, fail):
         fail(str(exc))
 
 
-def _npz_member(raw: bytes, member: str, spec: dict, fail) -> dict:
+def _npz_member(raw: bytes, member: str, spec: dict, fail, optional: dict | None = None) -> dict:
+    """The arrays of `spec` (name -> (dtype, trailing shape)), each checked, and those of
+    `optional` that the member holds."""
     check_npz(raw, member, fail)
     try:
         with np.load(io.BytesIO(raw), allow_pickle=False) as npz:
@@ -372,6 +383,7 @@ def _npz_member(raw: bytes, member: str, spec: dict, fail) -> dict:
             missing = [k for k in spec if k not in names]
             if missing:
                 fail(f"{member} has no array {missing[0]!r}")
+            spec = {**spec, **{k: v for k, v in (optional or {}).items() if k in names}}
             arrays = {k: npz[k] for k in spec}
     except SessionError:
         raise
@@ -387,13 +399,13 @@ def _npz_member(raw: bytes, member: str, spec: dict, fail) -> dict:
         if a.dtype != np.dtype(dtype):
             fail(f"{member}: array {name!r} must be {dtype}, got {a.dtype}")
         if trailing is None:
-            ok = a.ndim == (3 if spec is STATE_ARRAYS else 2)
+            ok = a.ndim == (3 if member == STATE else 2)
         else:
             ok = a.shape[1:] == trailing and a.ndim == 1 + len(trailing)
         if not ok:
-            want = ("(9, ny, nx)" if spec is STATE_ARRAYS else "(rows, columns)") if trailing is None else str(("rows",) + trailing).replace("'", "")
+            want = ("(9, ny, nx)" if member == STATE else "(rows, columns)") if trailing is None else str(("rows",) + trailing).replace("'", "")
             fail(f"{member}: array {name!r} has shape {a.shape}, expected {want}")
-        if spec is STATE_ARRAYS:
+        if member == STATE:
             continue
         if rows is None:
             rows = a.shape[0]
@@ -418,7 +430,8 @@ def _validate(manifest, parameters, inputs, forces, src, state=None, inlet_refer
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         raise SessionError(f"{MANIFEST}: not a FeelFlow session (expected \"format\": \"{FORMAT}\")")
     try:   # one loader per format version: the file in the current version's form
-        manifest, parameters = versions.loader_for(manifest.get("version")).upgrade(manifest, parameters)
+        loader = versions.loader_for(manifest.get("version"))
+        manifest, parameters = loader.upgrade(manifest, parameters)
     except versions.SessionFormatError as exc:
         raise SessionError(f"{MANIFEST}: {exc}") from None
     for key, kind in (("feelflow_version", str), ("created", str), ("backend", str), ("renderer", str),
@@ -445,6 +458,13 @@ def _validate(manifest, parameters, inputs, forces, src, state=None, inlet_refer
     if forces["values"].shape[1] != 2 * len(models):
         raise SessionError(f"{FORCES}: 'values' has {forces['values'].shape[1]} columns, expected "
                            f"{2 * len(models)} (fx, fy for {len(models)} models)")
+    try:
+        forces = loader.forces(forces, len(models))
+    except versions.SessionFormatError as exc:
+        raise SessionError(str(exc)) from None
+    if forces["torques"].shape != (len(forces["seq"]), len(models)) or np.isinf(forces["torques"]).any():
+        raise SessionError(f"{FORCES}: 'torques' must be {len(forces['seq'])} rows of {len(models)} torques "
+                           f"(one per model, NaN where not computed), got shape {forces['torques'].shape}")
     counts = manifest["counts"]
     actual = {"inputs": len(inputs["seq"]), "parameters": len(parameters) if isinstance(parameters, list) else -1,
               "forces": len(forces["seq"]), "steps": int(forces["step"][-1]) if len(forces["step"]) else 0}

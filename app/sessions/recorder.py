@@ -58,7 +58,7 @@ class SessionRecorder:
         self._seq = 0
         self._inputs: list[tuple] = []   # (seq, step, x, y, angle, vx, vy, omega)
         self._parameters: list[dict] = []
-        self._forces: list[tuple] = []   # (seq, step, n, (x, y, vx, vy), {model: (fx, fy)})
+        self._forces: list[tuple] = []   # (seq, step, n, (x, y, vx, vy), {model: (fx, fy)}, {model: torque})
         self._models: list[str] = list(self.force_models)
         #: set by SessionSolver.start_recording: how the running flow was when recording began
         self.start: dict | None = None
@@ -131,8 +131,9 @@ class SessionRecorder:
         self._parameters.append(change)
         return True
 
-    def record_forces(self, n: int, forces: dict, body=(math.nan,) * 4, *, step=None) -> bool:
-        """`forces` {model: (fx, fy)} averaged over the last n steps; body (x, y, vx, vy) then.
+    def record_forces(self, n: int, forces: dict, body=(math.nan,) * 4, *, step=None, torques=None) -> bool:
+        """`forces` {model: (fx, fy)} averaged over the last n steps, and `torques` {model: T}
+        (a model left out: not computed); body (x, y, vx, vy) then.
         False (nothing recorded, the clock stays) once the recording is `full`."""
         n = int(n)
         if n < 1:
@@ -150,12 +151,14 @@ class SessionRecorder:
             if name not in self._models:
                 self._models.append(name)
         self._forces.append((seq, self.step, n, tuple(float(v) for v in body),
-                             {k: (float(v[0]), float(v[1])) for k, v in forces.items()}))
+                             {k: (float(v[0]), float(v[1])) for k, v in forces.items()},
+                             {k: float(v) for k, v in (torques or {}).items() if k in forces}))
         return True
 
     def rows(self, start: int = 0) -> list[tuple]:
-        """Force rows recorded so far, from the `start`-th: (step, n, body, {model: (fx, fy)})."""
-        return [(step, n, body, dict(forces)) for _, step, n, body, forces in self._forces[start:]]
+        """Force rows recorded so far, from the `start`-th: (step, n, body, {model: (fx, fy)},
+        {model: torque})."""
+        return [(step, n, body, dict(forces), dict(torques)) for _, step, n, body, forces, torques in self._forces[start:]]
 
     # --- output ---------------------------------------------------------------
     def session(self) -> "Session":
@@ -163,10 +166,13 @@ class SessionRecorder:
         ni, nf = len(self._inputs), len(self._forces)
         inp = np.array(self._inputs, dtype=np.float64).reshape(ni, 8)
         values = np.full((nf, 2 * len(self._models)), np.nan)
-        for r, (_, _, _, _, forces) in enumerate(self._forces):
+        torque_values = np.full((nf, len(self._models)), np.nan)
+        for r, (_, _, _, _, forces, torques) in enumerate(self._forces):
             for name, (fx, fy) in forces.items():
                 k = self._models.index(name)
                 values[r, 2 * k:2 * k + 2] = fx, fy
+            for name, torque in torques.items():
+                torque_values[r, self._models.index(name)] = torque
         return Session(
             manifest=self._manifest(),
             config=self.config, body=self.body, backend=self.backend,
@@ -179,7 +185,7 @@ class SessionRecorder:
                     "step": np.array([r[1] for r in self._forces], dtype=np.int64),
                     "n": np.array([r[2] for r in self._forces], dtype=np.int64),
                     "body": np.array([r[3] for r in self._forces], dtype=np.float64).reshape(nf, 4),
-                    "values": values},
+                    "values": values, "torques": torque_values},
             models=tuple(self._models), start=self.start, state=self.state, inlet_reference=self.inlet_reference,
             probes=self.probes, units=self.units,
         )

@@ -29,13 +29,14 @@ from feelflow.solver.backend import BackendError, SolverDiverged, create_solver
 class ReplayedRow(NamedTuple):
     """One replayed `step(n)` call: the session step at its end, the steps it covered, the body
     (x, y, vx, vy) during it (NaN: no body), {model: (fx, fy)} (mean over the call; NaN where the
-    flow diverged) and the inflow speed in use."""
+    flow diverged), the inflow speed in use and {model: torque} (mean over the call)."""
 
     step: int
     n: int
     body: tuple
     forces: dict
     inflow_speed: float
+    torques: dict
 
 
 
@@ -223,8 +224,8 @@ class SessionPlayer:
         except (ValueError, BackendError) as exc:
             raise self._cannot(k, ev, exc) from None
         if complete:
-            step, n, body, forces = self.recorder.rows(len(self.rows))[0]
-            self.rows.append(ReplayedRow(step, n, body, forces, self.inflow_speed))
+            step, n, body, forces, torques = self.recorder.rows(len(self.rows))[0]
+            self.rows.append(ReplayedRow(step, n, body, forces, self.inflow_speed, torques))
         return complete
 
     def _cannot(self, k: int, ev, exc) -> SessionError:

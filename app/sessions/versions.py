@@ -13,6 +13,9 @@ through a new version here (tests/test_session_versions.py fails until it is add
   their value says (each one's "off"); `inlet_sponge_cells` only in files written while FeelFlow
   had an inlet velocity layer (removed since, replaced by the quiet inlet), 0 when it was off.
 - Version 2: `scene.config` and every rebuild's config hold exactly `CONFIG_KEYS`.
+- Version 3: `forces.npz` holds `torques` too (m, M): each model's mean torque on the body about
+  its centre per force row (NaN: not computed). Versions 1 and 2 recorded none: their rows read
+  as NaN torques.
 
 Qt-free. docs/reference/session-format.md, "Versioning".
 """
@@ -20,8 +23,10 @@ from __future__ import annotations
 
 import copy
 
+import numpy as np
+
 #: the current format version, written by this FeelFlow
-VERSION = 2
+VERSION = 3
 
 #: version 2's flow configuration: exactly these keys (FlowConfig fields of the same names)
 CONFIG_KEYS = ("nx", "ny", "nu", "collision", "trt_magic", "smagorinsky", "equilibrium", "dtype",
@@ -94,6 +99,13 @@ class LoaderV1:
         manifest["version"] = VERSION
         return manifest, parameters
 
+    def forces(self, forces: dict, models: int) -> dict:
+        """forces.npz's arrays in the current form, for `models` force models: versions 1 and 2
+        recorded no torque, so `torques` is NaN (a copy; any `torques` array there is not theirs)."""
+        out = {k: v for k, v in forces.items() if k != "torques"}
+        out["torques"] = np.full((len(forces["seq"]), models), np.nan)
+        return out
+
 
 class LoaderV2(LoaderV1):
     """The current version: the configuration holds exactly `CONFIG_KEYS`."""
@@ -112,7 +124,18 @@ class LoaderV2(LoaderV1):
         return dict(d)
 
 
-LOADERS = {1: LoaderV1(), 2: LoaderV2()}
+class LoaderV3(LoaderV2):
+    """The current version: forces.npz holds each model's torque (`torques`)."""
+
+    version = 3
+
+    def forces(self, forces: dict, models: int) -> dict:
+        if "torques" not in forces:
+            raise SessionFormatError("forces.npz has no array 'torques' (a version-3 session holds it)")
+        return dict(forces)
+
+
+LOADERS = {1: LoaderV1(), 2: LoaderV2(), 3: LoaderV3()}
 
 
 def loader_for(version) -> LoaderV1:

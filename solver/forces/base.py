@@ -62,3 +62,9 @@ class ForceModel(ABC):
         """The torque of the fluid on the body about its centre (shape.x, shape.y), counter-
         clockwise positive, lattice units per step; a model without a moment gives 0."""
         return 0.0
+
+    def evaluate(self, window: BodyWindow) -> tuple[float, float, float]:
+        """(F_x, F_y, torque) for this step: what the backends call each step (a model that
+        shares work between its force and its torque overrides it)."""
+        fx, fy = self.compute(window)
+        return fx, fy, self.torque(window)

@@ -120,6 +120,14 @@ class MacroscopicDrag(ForceModel):
         rho, ux, uy = self.sample(window)
         return self.formula(window.shape, rho, ux - window.velocity[0], uy - window.velocity[1])
 
+    def torque(self, window: BodyWindow) -> float:
+        """0: the drag equation is a control-volume law for the force through the body's centre.
+        A moment would need a moment coefficient per shape and a relative angular velocity,
+        and neither the seed nor the drag tables give one (the torque on a turning cylinder is
+        viscous, mu Omega R^2, not a |U|^2 law); the contour's mean velocity, which is all this
+        model reads, carries no moment. Use `momentum_exchange` for the torque."""
+        return 0.0
+
     def formula(self, shape, rho: float, ux: float, uy: float) -> tuple[float, float]:
         """The drag equation for relative velocity U = (ux, uy) and density rho."""
         speed = math.hypot(ux, uy)

@@ -75,10 +75,15 @@ class PressureIntegration(ForceModel):
         rho = moments_at(window, nodes)[0]
         return pts, normals, lengths, stencil.apply(rho)
 
-    def compute(self, window: BodyWindow) -> tuple[float, float]:
-        _, normals, lengths, rho = self.wall_density(window)
+    def wall_pressure(self, window: BodyWindow):
+        """(points, normals, lengths, p): the equation of state's pressure at each surface
+        element (0 where no fluid node is in reach)."""
+        pts, normals, lengths, rho = self.wall_density(window)
         valid = self._geom[3].valid  # a surface point with no fluid node in reach: gauge pressure 0
-        p = np.where(valid, self.beta_prime * (rho * rho - RHO0 * RHO0), 0.0)
+        return pts, normals, lengths, np.where(valid, self.beta_prime * (rho * rho - RHO0 * RHO0), 0.0)
+
+    def compute(self, window: BodyWindow) -> tuple[float, float]:
+        _, normals, lengths, p = self.wall_pressure(window)
         fx = -float(np.sum(p * normals[:, 0] * lengths))
         fy = -float(np.sum(p * normals[:, 1] * lengths))
         return fx, fy
@@ -86,8 +91,11 @@ class PressureIntegration(ForceModel):
     def torque(self, window: BodyWindow) -> float:
         """- sum r x n p dA about the body's centre (zero on a circle: pressure acts through its
         centre; the viscous shear, which turns it, is not in this model)."""
-        pts, normals, lengths, rho = self.wall_density(window)
-        valid = self._geom[3].valid
-        p = np.where(valid, self.beta_prime * (rho * rho - RHO0 * RHO0), 0.0)
+        return self.evaluate(window)[2]
+
+    def evaluate(self, window: BodyWindow) -> tuple[float, float, float]:
+        pts, normals, lengths, p = self.wall_pressure(window)
+        fx = -float(np.sum(p * normals[:, 0] * lengths))
+        fy = -float(np.sum(p * normals[:, 1] * lengths))
         rx, ry = pts[:, 0] - window.shape.x, pts[:, 1] - window.shape.y
-        return -float(np.sum(p * lengths * (rx * normals[:, 1] - ry * normals[:, 0])))
+        return fx, fy, -float(np.sum(p * lengths * (rx * normals[:, 1] - ry * normals[:, 0])))

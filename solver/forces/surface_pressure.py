@@ -41,17 +41,17 @@ class SurfacePressureProbe(PressureIntegration):
         self._count = 0
         self._pose = None
 
-    def compute(self, window):
-        pts, normals, lengths, rho = self.wall_density(window)
+    def wall_density(self, window):
+        """As the pressure model's, and summed into the time mean (every force or torque of a
+        step reads it once)."""
+        pts, normals, lengths, rho = super().wall_density(window)
         pose = (window.shape, window.x0, window.y0)
         if pose != self._pose or self._sum is None or self._sum.shape != rho.shape:
             self._pose, self._sum, self._count = pose, np.zeros_like(rho), 0
         self._sum += rho
         self._count += 1
         self._last = (window.shape, pts, normals, lengths, self._geom[3].valid)
-        valid = self._geom[3].valid
-        p = np.where(valid, self.beta_prime * (rho * rho - RHO0 * RHO0), 0.0)
-        return -float(np.sum(p * normals[:, 0] * lengths)), -float(np.sum(p * normals[:, 1] * lengths))
+        return pts, normals, lengths, rho
 
     @property
     def steps(self) -> int:

@@ -95,6 +95,12 @@ class Point:
     state: str = ""            # stable | diverged | unbounded (measured) or inferred-stable/-unstable
     steps: int = 0             # steps run (up to the failure)
     max_u: float = float("nan")
+    #: max |u| over the last third of the steps run (a bounded flow's is not above the earlier ones)
+    max_u_last_third: float = float("nan")
+    #: with the local guard (`run_point(..., guard=True)`): the viscosity the run ended at and
+    #: each (step, max |u|, new viscosity) at which the guard raised it
+    nu_final: float = float("nan")
+    guard_raises: tuple = ()
 
     @property
     def re_cell(self) -> float:
@@ -105,18 +111,26 @@ class Point:
         return self.state in ("stable", "inferred-stable")
 
     def to_dict(self) -> dict:
-        return {"scene": self.scene, "collision": self.collision, "u": self.speed, "nu": self.nu,
-                "size": self.size, "re_cell": round(self.re_cell, 4), "state": self.state, "steps": self.steps,
-                "max_u": None if not math.isfinite(self.max_u) else round(self.max_u, 5)}
+        out = {"scene": self.scene, "collision": self.collision, "u": self.speed, "nu": self.nu,
+               "size": self.size, "re_cell": round(self.re_cell, 4), "state": self.state, "steps": self.steps,
+               "max_u": None if not math.isfinite(self.max_u) else round(self.max_u, 5),
+               "max_u_last_third": None if not math.isfinite(self.max_u_last_third) else round(self.max_u_last_third, 5)}
+        if self.guard_raises or math.isfinite(self.nu_final):
+            out.update(nu_final=self.nu_final, guard_raises=[list(r) for r in self.guard_raises])
+        return out
 
 
-def scene_config(scene: str, collision: str, speed: float, nu: float, grid=GRID, smagorinsky: float = 0.0) -> FlowConfig:
+def scene_config(scene: str, collision: str, speed: float, nu: float, grid=GRID, smagorinsky: float = 0.0,
+                 mach_limit: float | None = None) -> FlowConfig:
+    """The scene's flow; `mach_limit` (default FlowConfig's) sets the Mach cap the shaken
+    cylinder is driven at."""
     nx, ny = grid
     start = (0.0, 0.0) if scene == "cylinder_impulsive" else (speed, 0.0)
+    extra = {} if mach_limit is None else {"mach_limit": mach_limit}
     return FlowConfig(nx=nx, ny=ny, nu=nu, collision=collision, smagorinsky=smagorinsky, dtype="float32", x_boundary="tunnel",
                       y_boundary="no_slip", inflow_speed=speed, inflow_ramp_steps=0, initial_velocity=start,
                       sponge_cells=min(SPONGE_CELLS, nx // 4), sponge_absorb=SPONGE_ABSORB,
-                      inlet_nonreflecting=QUIET_INLET_RATE).validate()
+                      inlet_nonreflecting=QUIET_INLET_RATE, **extra).validate()
 
 
 def scene_body(scene: str, size: float, grid=GRID):
@@ -138,53 +152,95 @@ def _max_speed(solver) -> float:
     return float(np.nanmax(s)) if np.isfinite(s).all() else float("inf")
 
 
+class _Live:
+    """The running solver, replaced when the local guard rebuilds it at a higher viscosity."""
+
+    def __init__(self, solver):
+        self.solver = solver
+
+
 def run_point(make_solver: SolverFactory, scene: str, collision: str, speed: float, nu: float,
               size: int = DEFAULT_RESOLUTION, watch: Stopwatch | None = None,
               convective_times: float = CONVECTIVE_TIMES, grid=GRID, u_bound: float = U_BOUND,
-              smagorinsky: float = 0.0) -> Point:
+              smagorinsky: float = 0.0, mach_limit: float | None = None, guard: bool = False) -> Point:
     """Run one point; its state is stable, diverged (SolverDiverged) or unbounded (max |u| above
-    `u_bound`; pass math.inf to count only the solver's own divergence check)."""
-    config = scene_config(scene, collision, speed, nu, grid, smagorinsky)
+    `u_bound`; pass math.inf to count only the solver's own divergence check). `mach_limit`:
+    the Mach cap the shaken cylinder is driven at (default FlowConfig's). `guard`: the window's
+    local stability guard (solver/local_guard.py) acts every GUARD_EVERY steps, raising the
+    viscosity with the flow kept, as the window does; `point.nu_final` and `point.guard_raises`
+    say what it did."""
+    config = scene_config(scene, collision, speed, nu, grid, smagorinsky, mach_limit)
     body = scene_body(scene, size, grid)
     watch = watch or Stopwatch()
     steps = int(math.ceil(convective_times * size / speed))
     point = Point(scene, collision, speed, nu, size)
-    solver = make_solver(config)
+    live = _Live(make_solver(config))
+    rebuild = (lambda new_nu: _rebuild(live, make_solver, new_nu)) if guard else None
     try:
         if scene == "cylinder_shaken":
-            _shake(solver, body, steps, point, watch, u_bound)
+            _shake(live, body, steps, point, watch, u_bound, rebuild)
         else:
-            solver.set_body(body)
-            _run(solver, steps, point, watch, lambda n: watch.step(solver, n), u_bound)
+            live.solver.set_body(body)
+            _run(live, steps, point, watch, lambda n: watch.step(live.solver, n), u_bound, rebuild)
     finally:
-        solver.close()
+        live.solver.close()
+    if guard:
+        point.nu_final = live.solver.config.nu
     return point
 
 
-def _run(solver, steps, point, watch, advance, u_bound):
+#: steps between the guard's reads of max |u| (the window's physical-range check)
+GUARD_EVERY = 64
+
+
+def _rebuild(live, make_solver, nu):
+    """The solver at viscosity nu with the flow kept (the window's set_flow(nu=...))."""
+    from dataclasses import replace
+
+    f = live.solver.distributions()
+    old = live.solver
+    live.solver = make_solver(replace(old.config, nu=nu).validate())
+    old.close()
+    live.solver.set_distributions(f)
+
+
+def _run(live, steps, point, watch, advance, u_bound, rebuild=None):
+    from feelflow.solver import local_guard
+
     done = 0
-    point.max_u = 0.0
+    point.max_u = point.max_u_last_third = 0.0
+    every = GUARD_EVERY if rebuild else CHECK_EVERY
     try:
         while done < steps:
-            n = min(CHECK_EVERY, steps - done)
+            n = min(every, steps - done)
             advance(n)
             done += n
-            point.max_u = max(point.max_u, _max_speed(solver))
+            now = _max_speed(live.solver)
+            point.max_u = max(point.max_u, now)
+            if 3 * done > 2 * steps:
+                point.max_u_last_third = max(point.max_u_last_third, now)
             if point.max_u > u_bound:
                 point.state, point.steps = "unbounded", done
                 return
+            if rebuild is not None:
+                cfg = live.solver.config
+                verdict = local_guard.check(cfg.collision, cfg.nu, now)
+                if not verdict.inside and verdict.nu_needed is not None:
+                    nu = math.ceil(verdict.nu_needed * 1e4 - 1e-6) / 1e4   # as the window rounds it
+                    rebuild(nu)
+                    point.guard_raises += ((done, round(now, 4), nu),)
     except SolverDiverged as exc:
         point.state, point.steps, point.max_u = "diverged", exc.step + 1, float("inf")
         return
     point.state, point.steps = "stable", done
 
 
-def _shake(solver, body, steps, point, watch, u_bound):
+def _shake(live, body, steps, point, watch, u_bound, rebuild=None):
     """Back and forth along the stream over one diameter (centred on the start), spinning with
     the direction of travel, at the Mach cap: asks for the cap in translation and in rotation;
     `set_body` scales both so that the fastest surface point moves at exactly max_speed
     (docs/science/algorithm.md 'Speed limit'), so each keeps half of it."""
-    cap = solver.config.max_speed
+    cap = live.solver.config.max_speed
     x0, y0, x1, y1 = body.bounding_box()
     radius = math.hypot(0.5 * (x1 - x0), 0.5 * (y1 - y0))   # the cap's R: centre to a box corner
     v = 0.5 * cap                                         # the capped translation speed
@@ -194,17 +250,17 @@ def _shake(solver, body, steps, point, watch, u_bound):
     def move_and_step():
         t = state["t"]
         direction = -1.0 if ((t + sweep // 2) // sweep) % 2 == 0 else 1.0   # first against the stream
-        solver.set_body(body.moved(x=state["x"], y=body.y), velocity=(direction * cap, 0.0),
-                        omega=direction * cap / radius)
-        solver.step(1)
+        live.solver.set_body(body.moved(x=state["x"], y=body.y), velocity=(direction * cap, 0.0),
+                             omega=direction * cap / radius)
+        live.solver.step(1)
         state["x"] += direction * v
         state["t"] = t + 1
 
     def advance(n):  # the moves count in the stopwatch's time, as the steps they belong to
         for _ in range(n):
-            watch.timed(solver.config.nx * solver.config.ny, 1, move_and_step)
+            watch.timed(live.solver.config.nx * live.solver.config.ny, 1, move_and_step)
 
-    _run(solver, steps, point, watch, advance, u_bound)
+    _run(live, steps, point, watch, advance, u_bound, rebuild)
 
 
 # --- the scan ---------------------------------------------------------------------------------
@@ -378,7 +434,13 @@ def main(argv=None) -> int:
     parser.add_argument("--size", type=int, nargs="+", default=[DEFAULT_RESOLUTION], help="body size(s) in cells")
     parser.add_argument("--scene", nargs="+", default=list(SCENES), choices=SCENES)
     parser.add_argument("--convective-times", type=float, default=CONVECTIVE_TIMES)
-    parser.add_argument("--backend", default="numpy", help="numpy or gl (EGL standalone context)")
+    parser.add_argument("--backend", default="numpy", help="numpy, cpu or gl (EGL standalone context)")
+    parser.add_argument("--mach-limit", type=float, default=None,
+                        help="the Mach cap the shaken cylinder is driven at (default: the window's, FlowConfig's)")
+    parser.add_argument("--no-bound", action="store_true",
+                        help=f"count only the solver's NaN check, not max |u| > {U_BOUND}")
+    parser.add_argument("--guard", action="store_true",
+                        help="the window's local stability guard raises the viscosity when the flow leaves its region")
     args = parser.parse_args(argv)
     if (args.nu is None) == (args.k is None):
         parser.error("give --nu or --k")
@@ -398,8 +460,11 @@ def main(argv=None) -> int:
             for scene in args.scene:
                 start = time.perf_counter()
                 p = run_point(make_solver, scene, args.collision, args.u, nu, size,
-                              convective_times=args.convective_times, smagorinsky=args.smagorinsky)
+                              convective_times=args.convective_times, smagorinsky=args.smagorinsky,
+                              u_bound=math.inf if args.no_bound else U_BOUND, mach_limit=args.mach_limit,
+                              guard=args.guard)
                 row = {**p.to_dict(), "smagorinsky": args.smagorinsky, "backend": args.backend,
+                       "mach_limit": args.mach_limit, "bound": None if args.no_bound else U_BOUND,
                        "convective_times": args.convective_times, "seconds": round(time.perf_counter() - start, 1)}
                 print(json.dumps(row), flush=True)
     return 0
