@@ -76,6 +76,7 @@ class Viewport(QWidget):
         self.probing = False     # clicks place (left) and remove (right) probes instead of moving the body
         self.probe_marks = []    # [(x, y, QColor, label)] probes to draw (app/gui/window/probes.py)
         self.arrow_forces = None       # {"drag": (x, y), "lift": (x, y)} cells (app/model/readouts.py arrows)
+        self.torque_arc = None         # degrees of the turn handle's torque arc (readouts.torque_arc)
         self.tracers = None
         self.frames = 0
         self.field_texture = None
