@@ -8,9 +8,7 @@ plot (its refresh and its paint), and the top-level window's update (Qt's compos
 widgets into the window). Each part is timed with `time.perf_counter`, exclusive of the parts
 nested in it; `detach()` restores the objects and `report()` gives per-frame means and shares
 of the wall time. "Rest" is the wall time no part measured: Qt's event loop, the other
-widgets, the self-test's own timer. On the cpu backend the solver's steps run beside the
-viewport's repaint (app/gui/window/frame_loop.py): those parts overlap, their shares can add up
-to more than the wall time, and "rest" is then what is left, at least zero.
+widgets, the self-test's own timer.
 
 On the gl backend the solver's steps include the read-back at the end of each block of steps
 (solver/gl_backend.py), which waits for llvmpipe to run the queued steps: that wait is the
@@ -20,7 +18,6 @@ from __future__ import annotations
 
 import math
 import os
-import threading
 import time
 
 from PySide6.QtCore import QEvent
@@ -48,7 +45,7 @@ class FrameProfile:
     def __init__(self):
         self.totals = dict.fromkeys(PARTS, 0.0)
         self.calls = dict.fromkeys(PARTS, 0)
-        self._local = threading.local()   # .stack: [part, start, time of nested parts] per thread
+        self._stack: list[list] = []   # [part, start, time of nested parts]
         self._undo: list = []
         self._slots: list = []
         self.frames = 0
@@ -59,14 +56,12 @@ class FrameProfile:
 
     # --- timing ---------------------------------------------------------------------------
     def _timed(self, part: str, fn, only=None):
-        """`fn` timed as `part` (when `only(args)` says so, if given); nested parts per thread
-        (the cpu backend's steps run in a worker thread beside the drawing)."""
-        local, totals, calls = self._local, self.totals, self.calls
+        """`fn` timed as `part` (when `only(args)` says so, if given)."""
+        stack, totals, calls = self._stack, self.totals, self.calls
 
         def wrapper(*args, **kwargs):
             if only is not None and not only(*args):
                 return fn(*args, **kwargs)
-            stack = local.__dict__.setdefault("stack", [])
             frame = [part, time.perf_counter(), 0.0]
             stack.append(frame)
             try:

@@ -41,9 +41,6 @@ READOUT_MS = 500
 #: backend a read-back of all populations), about 1.5 ms on a 2-core machine without a GPU;
 #: non-finite populations are still caught at every step by the backends themselves
 PHYSICAL_CHECK_STEPS = 64
-#: on the compiled cpu backend, a frame's solver steps run in a worker thread while the
-#: viewport repaints (FrameLoop._advance_beside_drawing)
-SOLVER_BESIDE_DRAWING = True
 
 
 class FrameLoop:
@@ -60,8 +57,6 @@ class FrameLoop:
         self.other_cost = 5e-3      # seconds per frame outside stepping
         self._last_tick = None
         self._last_step_s = 0.0
-        self._worker = None         # the thread the cpu backend's steps run in beside drawing
-        self._drawn_beside = False  # this frame repainted the viewport beside its steps
         self._rate_window = [time.perf_counter(), 0, 0]   # start, steps, frames
         self.rates = {"steps_per_s": 0.0, "fps": 0.0, "mlups": 0.0}
         self.tracers = Tracers(N_TRACERS)
@@ -89,9 +84,6 @@ class FrameLoop:
     def stop(self):
         self.timer.stop()
         self.slow_timer.stop()
-        if self._worker is not None:   # idle: every frame waits for its steps
-            self._worker.shutdown(wait=True)
-            self._worker = None
 
     def show_model(self, model):
         """Point the viewport and the plot at `model` (the live tunnel or a replay) and draw it."""
@@ -194,7 +186,7 @@ class FrameLoop:
         w.make_current()
         t0 = time.perf_counter()
         try:
-            forces = self._advance_beside_drawing(sim, n)
+            forces = sim.advance(n)
         except SolverDiverged:
             self._on_nan()
             return
@@ -214,35 +206,12 @@ class FrameLoop:
         w.replays.watch_recording()
         self._frame_done(now, t0, t1, n, forces, rgba)
 
-    def _advance_beside_drawing(self, sim, n):
-        """sim.advance(n). On the compiled cpu backend, whose kernel releases Python's lock, the
-        steps run in a worker thread while this thread repaints the viewport with the field of
-        the frame before (its GL draw, its overlay, its copy to the window): the solver gets the
-        time drawing took. This thread waits for the steps before it returns to Qt's event loop,
-        so no controller of the window changes the simulation while they run; the frame's
-        field is drawn at the start of the next frame, one frame later (docs/science/cpu-backend.md)."""
-        self._drawn_beside = False
-        if not SOLVER_BESIDE_DRAWING or sim.backend != "cpu" or self.w.viewport.sim is not sim:
-            return sim.advance(n)
-        if self._worker is None:
-            from concurrent.futures import ThreadPoolExecutor
-
-            self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="feelflow-steps")
-        steps = self._worker.submit(sim.advance, n)
-        try:
-            self.w.viewport.repaint()
-            self._drawn_beside = True
-        finally:
-            forces = steps.result()   # the steps' exception (SolverDiverged), if any, raises here
-        return forces
-
     def _tick_replay(self, now):
         """One frame of the replay, at the live tunnel's steps-per-frame budget."""
         from feelflow.app.sessions import SessionError
 
         w = self.w
         r = w.replays.replay
-        self._drawn_beside = False
         w.inputs.watch_during_replay()
         if r.paused or r.done:
             self.viewport.update()
@@ -272,8 +241,7 @@ class FrameLoop:
             vp.rho_ref = self._free_stream_density(rgba)
         self.update_arrows(forces)
         self.w.probes.sample_frame(rgba if rgba is not None else self._field_array)   # app/gui/window/probes.py
-        if not self._drawn_beside:   # else the next frame draws it beside its steps
-            vp.update()
+        vp.update()
         # adaptive stepping: cost per step and the rest of the frame, smoothed
         self.step_cost = 0.8 * self.step_cost + 0.2 * (t1 - t0) / n
         if self._last_tick is not None:
