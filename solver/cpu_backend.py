@@ -18,7 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from feelflow.shapes.cylinder import Cylinder
+from feelflow.solver import cpu_body
 from feelflow.solver.backend import SolverDiverged
+from feelflow.solver.body import make_body_state, window_margin
 from feelflow.solver.forces.momentum_exchange import ClassicMomentumExchange, GalileanMomentumExchange
 from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS
 from feelflow.solver.numpy_backend import NumpySolver, absorb_keep, relaxation_rates
@@ -118,9 +121,7 @@ class CpuSolver(NumpySolver):
         if self._redo is not None and links is self._mask_links:
             return self._redo, self._link_arrays
         if links is not None and len(links):
-            from feelflow.solver.cpu_body import redo_nodes
-
-            self._redo, self._link_arrays = redo_nodes(self._edge_nodes, self._edge_grid, links, b.window)
+            self._redo, self._link_arrays = cpu_body.redo_nodes(self._edge_nodes, self._edge_grid, links, b.window)
         else:
             self._redo, self._link_arrays = self._edge_nodes, (_EMPTY_I,) * 5 + (_EMPTY_F,) * 8
         self._mask_links = links
@@ -131,10 +132,6 @@ class CpuSolver(NumpySolver):
         (solver/cpu_body.py: the same numbers, a fraction of the time per move)."""
         if shape is None:
             return None
-        from feelflow.shapes.cylinder import Cylinder
-        from feelflow.solver import cpu_body
-        from feelflow.solver.body import make_body_state, window_margin
-
         return make_body_state(shape, velocity, omega, self.config, window_margin(self._models.values()), raster,
                                links=cpu_body.build_links,
                                rasteriser=cpu_body.cylinder_raster if type(shape) is Cylinder else None)
@@ -143,8 +140,6 @@ class CpuSolver(NumpySolver):
         """NumpySolver._move_body, compiled for the equilibrium refill (solver/cpu_body.py)."""
         if self.body_refill != "equilibrium":
             return super()._move_body(old, new)
-        from feelflow.solver import cpu_body
-
         return cpu_body.move_body(old, new, self.config, self.g, self.body_impulse)
 
     # --- stepping -------------------------------------------------------------

@@ -19,7 +19,8 @@ import numpy as np
 
 from feelflow.shapes.base import BodyRaster
 from feelflow.shapes.cylinder import GRAZE
-from feelflow.solver.bouzidi import BodyLinks
+from feelflow.solver.body import expand_box, union_box
+from feelflow.solver.bouzidi import BodyLinks, periodic_wrap
 from feelflow.solver.lattice import C, OPP, RHO0, W
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
@@ -304,9 +305,6 @@ def _refill(g, x0, y0, old, new, xc, yc, vx, vy, omega, wrap_x, wrap_y, impulse)
 def move_body(old, new, config, g, impulse: str) -> tuple[float, float]:
     """solver/body.py `move_body` with the equilibrium refill, on the shifted state g (9, ny, nx)
     in place, compiled. Returns the impulse (Jx, Jy)."""
-    from feelflow.solver.body import expand_box, union_box
-    from feelflow.solver.bouzidi import periodic_wrap
-
     box = union_box(old.raster.window if old else None, new.raster.window if new else None)
     if box is None:
         return 0.0, 0.0
