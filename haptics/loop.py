@@ -3,7 +3,9 @@
 Every tick: read the device pose (non-blocking), map it into the tunnel, move the body through
 the virtual coupling (haptics.virtual_coupling), turn the solver's latest force samples into a smooth
 force (haptics.shaping), apply the safety gain (haptics.safety), clamp to the device maximum and
-send it. The app talks to it only through thread-safe calls:
+send it. The samples' torque takes the same path (its own hold and low-pass, the same gain, so
+the same ramp, pause, stall and NaN zeroing, its own scale and clamp) to a device with a
+rotational axis that outputs force (Capabilities.max_torque > 0); to no other. The app talks to it only through thread-safe calls:
 
     loop = ForceLoop(device, LoopConfig(tunnel_rect=(20, 10, 180, 70), expected_peak=0.02))
     loop.start()                         # ramps force up from zero
@@ -45,6 +47,7 @@ class LoopConfig:
     tunnel_rect: tuple[float, float, float, float] = (0.0, 0.0, 1.0, 1.0)  # lattice nodes
     flip_y: bool | None = None  # None: flip for pantographs (device y points at the student)
     expected_peak: float = 1.0  # lattice force the scene expects at most
+    expected_peak_torque: float = 1.0  # lattice torque the scene expects at most (rotational axis)
     comfort_fraction: float = 0.5  # that peak is felt as this fraction of the device maximum
     rate_hz: float = 1000.0
     filter_hz: float = 30.0
@@ -90,6 +93,9 @@ class ForceLoop:
         self.scale = ForceScale(cfg.expected_peak, cfg.comfort_fraction, caps.max_force)
         self.coupling = VirtualCoupling(cfg.coupling_hz, cfg.coupling_damping, cfg.max_body_speed)
         self.shaper = ForceInterpolator(cfg.filter_hz)
+        self.torque_scale = ForceScale(cfg.expected_peak_torque, cfg.comfort_fraction, caps.max_torque)
+        self.torque_shaper = ForceInterpolator(cfg.filter_hz)  # the torque as (torque, 0)
+        self.torque_sent = 0.0
         self.gate = SafetyGate(cfg.safety)
         self.ticker = Ticker(cfg.rate_hz, cfg.spin_s)
         self.on_disconnect = on_disconnect
@@ -159,7 +165,7 @@ class ForceLoop:
         arrival = time.monotonic()
         with self._lock:
             self._samples += 1
-            if not (math.isfinite(sample.fx) and math.isfinite(sample.fy)):
+            if not (math.isfinite(sample.fx) and math.isfinite(sample.fy) and math.isfinite(sample.torque)):
                 self._nan += 1
                 self._mailbox = None
                 self.gate.set_fault("nan", True)
@@ -176,6 +182,8 @@ class ForceLoop:
         """Change the force scaling (raises ValueError for nonsense; the clamp always applies)."""
         self.scale = ForceScale(expected_peak, self.scale.comfort_fraction if comfort_fraction is None
                                 else comfort_fraction, self.scale.device_max)
+        self.torque_scale = ForceScale(self.torque_scale.expected_peak, self.scale.comfort_fraction,
+                                       self.torque_scale.device_max)
 
     def body_target(self) -> BodyTarget:
         """Where the coupled body is now (tunnel coordinates) and how fast it moves."""
@@ -202,8 +210,10 @@ class ForceLoop:
     # -- the loop -----------------------------------------------------------------------------
     def _zero_device(self) -> None:
         self.force_sent = (0.0, 0.0)
+        self.torque_sent = 0.0
         try:
             self.device.write_force(0.0, 0.0)
+            self.device.write_torque(0.0)
         except DeviceError:
             pass
 
@@ -277,10 +287,12 @@ class ForceLoop:
                 self.gate.set_fault("nan", False)
         if sample is not None:
             self.shaper.add(sample.fx, sample.fy, arrival)
+            self.torque_shaper.add(sample.torque, 0.0, arrival)
         due = self.shaper.next_due
         stalled = due is None or now > due + self.config.safety.stall_timeout
         self.gate.set_fault("stall", stalled)
         lx, ly = self.shaper.evaluate(now)
+        lt, _ = self.torque_shaper.evaluate(now)
         # 3. safety gain, scale, map to device axes, clamp
         g = self.gate.update(now)
         k = self.scale.gain * g
@@ -288,6 +300,8 @@ class ForceLoop:
         fx, fy = clamp_force(fx, fy, dev.capabilities.max_force)
         # 4. command
         self.force_sent = dev.write_force(fx, fy)
+        if dev.capabilities.max_torque > 0:   # the same gain g: ramp, pause, stall, NaN zero it too
+            self.torque_sent = dev.write_torque(self.map.torque_to_device(lt * self.torque_scale.gain * g))
         self._max_cmd = max(self._max_cmd, math.hypot(*self.force_sent))
         if rec is not None:
             rec["t"].append(now)

@@ -11,7 +11,8 @@ emergency_stop, clear_stop, submit_force, body_target, status, set_tunnel, set_s
 capabilities) plus close(). The child (`python -m feelflow.haptics.process_loop`, started with
 subprocess: no multiprocessing, so the app's __main__ is never re-run, and nothing is pickled)
 opens the device itself; sim:// simulators live there too.
-  parent -> child: its stdin, length-prefixed messages: b'F' + 3 doubles (a force sample) or
+  parent -> child: its stdin, length-prefixed messages: b'F' + 4 doubles (a force sample: fx,
+                   fy, t, torque) or
                    JSON commands;
   child -> parent: body target and status in a shared memory-mapped file (a seqlock over
                    doubles), and rare length-prefixed JSON on its stdout (ready, error,
@@ -39,7 +40,7 @@ from feelflow.haptics.timing import try_realtime
 from feelflow.haptics.types import BodyTarget, Capabilities, ForceSample
 
 _LEN = struct.Struct("<I")
-_SAMPLE = struct.Struct("<cddd")
+_SAMPLE = struct.Struct("<cdddd")
 _FIELDS = ("seq", "x", "y", "vx", "vy", "t", "buttons", "valid", "running", "ticks", "rate_hz",
            "jitter_p99_ms", "overruns", "samples", "nan_samples", "stalls", "gain", "fx", "fy",
            "max_force_commanded", "state")
@@ -155,8 +156,8 @@ def child_main(argv) -> int:
             if data is None:
                 break  # the parent is gone: zero the force and leave
             if data[:1] == b"F" and len(data) == _SAMPLE.size:
-                _, fx, fy, t = _SAMPLE.unpack(data)
-                loop.submit_force(ForceSample(fx, fy, t))
+                _, fx, fy, t, torque = _SAMPLE.unpack(data)
+                loop.submit_force(ForceSample(fx, fy, t, torque=torque))
                 continue
             cmd = json.loads(data)
             op = cmd.get("op")
@@ -323,7 +324,7 @@ class ProcessForceLoop:
         self._cmd("set_scaling", expected_peak=expected_peak, comfort_fraction=comfort_fraction)
 
     def submit_force(self, sample: ForceSample) -> None:
-        self._send(_SAMPLE.pack(b"F", sample.fx, sample.fy, sample.t))
+        self._send(_SAMPLE.pack(b"F", sample.fx, sample.fy, sample.t, sample.torque))
 
     def body_target(self) -> BodyTarget:
         v = self._read()

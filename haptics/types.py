@@ -33,12 +33,16 @@ class ForceSample:
     fx, fy: LATTICE units (force per time step on the lattice, as the force models return it),
     in tunnel axes (x downstream, y up). The force loop scales them to newtons; nothing else does.
     t: time.monotonic() when the sample was produced. step: the solver step (optional, for logs).
+    torque: the torque on the body about its centre, LATTICE units, counter-clockwise positive
+    in tunnel axes (Solver.torques); the loop scales it to newton metres for a device with a
+    rotational axis (Capabilities.max_torque > 0) and sends it nowhere else.
     """
 
     fx: float
     fy: float
     t: float
     step: int | None = None
+    torque: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -51,6 +55,8 @@ class Capabilities:
     can_output_force: False for input-only devices (SpaceMouse).
     input_mode: 'position' (the pose is where the hand is) or 'velocity' (integrated deflection).
     nominal_rate_hz: the update rate the device is meant to run at.
+    max_torque: newton metres the device's rotational axis may give at most (0: it has none
+    that outputs force; drivers clamp to it).
     """
 
     name: str
@@ -60,6 +66,7 @@ class Capabilities:
     can_output_force: bool = True
     input_mode: str = "position"
     nominal_rate_hz: float = 1000.0
+    max_torque: float = 0.0
 
 
 @dataclass(frozen=True)

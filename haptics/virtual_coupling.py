@@ -52,6 +52,11 @@ class TunnelMap:
         """A tunnel-axis vector expressed in device axes (signs only; magnitudes unchanged)."""
         return fx, (-fy if self.flip_y else fy)
 
+    def torque_to_device(self, torque: float) -> float:
+        """A tunnel-axis torque (counter-clockwise positive) about the device's rotational axis:
+        a flipped y axis turns the sense of rotation round."""
+        return -torque if self.flip_y else torque
+
 
 class VirtualCoupling:
     """A critically damped spring-damper pulling the body towards the device proxy."""

@@ -21,7 +21,7 @@ def wait_for(cond, timeout=3.0, step=0.002):
 
 
 class Feeder:
-    """Plays the solver: submits (fx, fy) lattice force samples at `hz` from its own thread.
+    """Plays the solver: submits (fx, fy) lattice force samples (and `torque`) at `hz` from its own thread.
 
     It asks for a real-time slot (as the loop does) so that a loaded test machine does not
     starve it: a starved feeder IS a solver stall, and the loop would rightly zero the force.
@@ -32,6 +32,7 @@ class Feeder:
         from feelflow.haptics import ForceSample
 
         self.loop, self.fx, self.fy, self.hz = loop, fx, fy, hz
+        self.torque = 0.0
         self.sending = True
         self._stop = threading.Event()
         self._sample = ForceSample
@@ -43,7 +44,7 @@ class Feeder:
         next_t = time.monotonic()
         while not self._stop.is_set():
             if self.sending:
-                self.loop.submit_force(self._sample(self.fx, self.fy, time.monotonic()))
+                self.loop.submit_force(self._sample(self.fx, self.fy, time.monotonic(), torque=self.torque))
             next_t += 1.0 / self.hz
             time.sleep(max(0.0, next_t - time.monotonic()))
 

@@ -98,7 +98,7 @@ def test_score_with_force_replaces_the_results_atomically(exercise, capsys):
     results.write_text("old\n")
     before = digest(exercise.parent / "shapes")
     code, out, err = run(capsys, "exercise", "score", exercise, exercise.parent / "shapes" / "ref.json",
-                         "--out", results, "--force", "--workers", "1")
+                         "--out", results, "--force", "--workers", "1", "--backend", "numpy")
     assert code == 0, err
     text = results.read_text()
     assert text.startswith("rank,file,status") and "ref.json" in text and len(text.splitlines()) == 2
@@ -208,7 +208,7 @@ def test_memory_a_run_needs_is_checked_before_it_starts(exercise, capsys, monkey
     edited(exercise, "average_steps = 500", "average_steps = 50")
     code, _, err = run(capsys, "exercise", "score", exercise, exercise.parent / "shapes" / "ref.json",
                        exercise.parent / "shapes" / "cylinder.json", "--scale", "2", "--workers", "2",
-                       "--out", exercise.parent / "s.csv")
+                       "--out", exercise.parent / "s.csv", "--backend", "numpy")
     assert code == 0, err
     assert "1 processes instead of 2" in err
     monkeypatch.setattr(inputs, "available_memory", lambda: 20 << 20)
@@ -287,7 +287,8 @@ def test_a_class_folder_of_odd_entries_gets_a_row_each_and_changes_nothing(exerc
     (folder / "notes.txt").write_text("not a shape")
     before = digest(folder)
     out = tmp_path / "scores.csv"
-    code, stdout, err = run(capsys, "exercise", "score", exercise, folder, "--out", out, "--workers", "1")
+    code, stdout, err = run(capsys, "exercise", "score", exercise, folder, "--out", out, "--workers", "1",
+                            "--backend", "numpy")
     assert code == 0, err
     assert "Traceback" not in err
     import csv

@@ -129,7 +129,7 @@ def test_score_table_prints_the_supported_digits(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(grading, "grade", lambda *a, **k: (fake, 1.0))
     monkeypatch.setattr(grading, "shape_files", lambda paths: [pathlib.Path(p) for p in paths])
     args = argparse.Namespace(shapes=["one.json", "two.json"], out=str(tmp_path / "s.csv"), force=False,
-                              workers="1", scale=None)
+                              workers="1", scale=None, backend="numpy")
     assert cmd._score(ex, args) == 0
     out = capsys.readouterr().out
     assert "grid uncertainty of a score: 0.1" in out

@@ -315,7 +315,7 @@ def test_check_bad_file_is_one_line_exit_2(tmp_path):
 
 
 def test_check_scores_the_reference():
-    r = feelflow("exercise", "check", TINY)
+    r = feelflow("exercise", "check", TINY, "--backend", "numpy")
     assert r.returncode == 0, r.stdout + r.stderr
     assert "reference wedge pointing upstream: score" in r.stdout and "DIFFERS" not in r.stdout
 
@@ -324,7 +324,8 @@ def test_score_folder_with_broken_files(tmp_path):
     reasons = make_broken(tmp_path / "class")
     good = make_class(tmp_path / "class", 2)
     out = tmp_path / "scores.csv"
-    r = feelflow("exercise", "score", TINY, tmp_path / "class", "--out", out, "--workers", "2")
+    r = feelflow("exercise", "score", TINY, tmp_path / "class", "--out", out, "--workers", "2",
+                 "--backend", "numpy")
     assert r.returncode == 0, r.stderr
     rows = list(csv.DictReader(out.open()))
     assert len(rows) == len(reasons) + len(good)
@@ -376,3 +377,22 @@ def test_gui_exercise_option_checks_the_file_first(tmp_path):
 def test_list_names_the_shipped_exercises():
     r = feelflow("exercise", "list")
     assert r.returncode == 0 and len(r.stdout.strip().splitlines()) == len(SHIPPED)
+
+
+def test_auto_scores_on_the_faster_backend_timed_once_in_a_child_and_remembered(tmp_path, monkeypatch):
+    """`--backend auto` (the default of `exercise score|check`): a backend named is used as it
+    is; auto times the candidates on the exercise's grid in a child process, says so in one line,
+    and remembers the winner per grid (the candidates cut to numpy here: no kernel compiles in
+    the default tier; the child inherits the cut, as it inherits the parent by fork)."""
+    from feelflow.app.exercises import grading
+
+    ex = load_exercise(TINY)
+    store = tmp_path / "choice.json"
+    assert grading.resolve_backend("cpu", ex, store_path=store) == ("cpu", None)
+    monkeypatch.setattr(scoring, "BACKENDS", ("numpy",))
+    name, line = grading.resolve_backend("auto", ex, store_path=store)
+    s = ex.scene
+    assert name == "numpy" and line.startswith("scoring backend numpy: ") and f"at {s.nx} x {s.ny}" in line
+    assert "float64_scoring" in store.read_text()
+    assert grading.resolve_backend("auto", ex, store_path=store) == (
+        "numpy", f"scoring backend numpy (remembered for {s.nx} x {s.ny})")

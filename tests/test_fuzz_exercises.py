@@ -287,7 +287,7 @@ def test_fuzz_class_folders(first, tmp_path, capsys, monkeypatch):
         quiet.mkdir()
         before = digest(tmp_path / str(seed), skip={"scores.csv"})
         before_out = out.exists()
-        rc = check_cli(["exercise", "score", exercise, folder, "--out", out, "--workers", "1"], capsys, quiet,
+        rc = check_cli(["exercise", "score", exercise, folder, "--out", out, "--workers", "1", "--backend", "numpy"], capsys, quiet,
                        what=f"seed {seed}")
         assert digest(tmp_path / str(seed), skip={"scores.csv"}) == before, seed
         if rc == 0:

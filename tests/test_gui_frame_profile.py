@@ -3,6 +3,8 @@ on the running window, every part is reported, and detaching leaves the window a
 the frame length the frame loop aims at (app/gui/window/frame_loop.py)."""
 from __future__ import annotations
 
+import subprocess
+import sys
 
 import pytest
 
@@ -14,6 +16,19 @@ def test_the_command_line_takes_frame_profile():
 
     args = build_parser().parse_args(["--selftest", "--frame-profile", "--seconds", "5"])
     assert args.selftest and args.frame_profile
+
+
+@pytest.mark.slow
+def test_a_lessons_frames_are_measured_and_profiled():
+    """`feelflow --selftest --frame-profile --lesson KEY` measures the lesson's frames as the
+    default scene's: frames and solver steps per second, and the profile's table."""
+    r = subprocess.run([sys.executable, "-m", "feelflow.app", "--selftest", "--frame-profile", "--seconds", "4",
+                        "--lesson", "vortex_street", "gui", "--backend", "numpy"],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    out = r.stdout
+    assert "grid 256x128" in out and "frames/s" in out and "solver steps/s" in out, out
+    assert "frame profile: solver steps" in out and out.rstrip().endswith("selftest: ok"), out
 
 
 def test_frame_profile_times_every_part_and_leaves_the_window_as_it_was(window, qtbot):

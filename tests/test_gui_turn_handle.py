@@ -291,3 +291,18 @@ def test_loading_a_lesson_clears_the_undo_history(window):
     assert window.undo.count() > 0
     assert window.lessons.apply("seed_protocol")
     assert window.undo.count() == 0
+
+
+def test_the_handle_shows_the_torque_that_resists_the_turn(window, qtbot):
+    """While the handle turns the plate counter-clockwise, the fluid's torque pulls it back: the
+    handle's torque arc (readouts.torque_arc of the model's torque) runs clockwise, and the
+    overlay draws it (a frame grabbed while it shows)."""
+    sim = plate(window)
+    vp = window.viewport
+    drag_handle(window, 60)
+    arcs = []
+    qtbot.waitUntil(lambda: (arcs.append(vp.torque_arc) or sim.body.rate > 0.002), timeout=20000)
+    qtbot.waitUntil(lambda: (arcs.append(vp.torque_arc) or len(arcs) > 12), timeout=20000)
+    turning = [a for a in arcs[-8:] if a is not None]
+    assert turning and sum(a < 0 for a in turning) >= 0.75 * len(turning), turning
+    vp.grab()   # the arc paints (with the handle shown or not) without error

@@ -85,3 +85,13 @@ def test_format_coefficient():
     assert readouts.format_coefficient(-0.001) == "0.00"
     assert readouts.format_coefficient(math.nan) == "\u2013"
     assert readouts.format_coefficient(0.7620, 4) == "0.7620"
+
+
+def test_the_torque_arc_follows_the_torque_and_is_capped():
+    from feelflow.app.model.readouts import TORQUE_ARC_CAP_DEG, TORQUE_ARC_DEG, torque_arc
+    from feelflow.solver import units
+
+    reference = units.dynamic_pressure(0.1) * 16.0 ** 2
+    assert torque_arc(-0.5 * reference, 16.0, 0.1) == pytest.approx(-0.5 * TORQUE_ARC_DEG)   # clockwise
+    assert torque_arc(100 * reference, 16.0, 0.1) == TORQUE_ARC_CAP_DEG
+    assert torque_arc(float("nan"), 16.0, 0.1) is None and torque_arc(None, 16.0, 0.1) is None

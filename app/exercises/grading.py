@@ -1,8 +1,10 @@
 """Grading a class: score many shape files on every core, one row per file, ranked.
 
 A file that is not a valid shape file, or a shape that breaks a constraint, gets its row with
-the reason; it never stops the grading. Scores come from `scoring.score_shape` (numpy float64),
-the same function the window calls, so a shape scores the same digits here and there.
+the reason; it never stops the grading. Scores come from `scoring.score_shape` (float64 on numpy,
+the reference, or on the compiled cpu backend, which gives the same digits; `resolve_backend`
+picks the faster for `--backend auto`), the same function the window calls, so a shape scores
+the same digits here and there.
 """
 from __future__ import annotations
 
@@ -113,8 +115,54 @@ def _worker(job) -> Row:
     return score_file(_exercise(exercise_path), path, scale, backend)
 
 
+def _share_cores(threads: int) -> None:
+    """A grading process's initializer: the compiled cpu backend's threads it may use (the
+    processes share the cores: more threads than cores wait on each other at every step)."""
+    import numba
+
+    numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+
+
 def default_workers() -> int:
     return os.cpu_count() or 1
+
+
+#: `--backend auto` (the command line's default): the faster of scoring.BACKENDS on this machine
+AUTO = "auto"
+#: the choice store's "renderer" part for scoring (float64 on the CPU: no GL renderer decides it)
+CHOICE_KEY = "float64 scoring"
+
+
+def _timed_choice(config, store_path: str) -> tuple[str, str]:
+    from feelflow.app.model.backend_choice import JsonFileStore, choose_backend
+    from feelflow.solver.backend import create_solver
+
+    choice = choose_backend(config, lambda name, cfg: create_solver(name, cfg), JsonFileStore(store_path),
+                            renderer=CHOICE_KEY, candidates=scoring.BACKENDS)
+    return choice.backend, choice.describe(config.nx, config.ny)
+
+
+def resolve_backend(backend: str, exercise, scale: int = 1, store_path=None) -> tuple[str, str | None]:
+    """`backend` as given, or for AUTO the faster of scoring.BACKENDS (both float64, the same
+    scores: docs/science/cpu-backend.md) on the exercise's grid at `scale`, timed briefly once
+    and remembered per grid (app/model/backend_choice.py, in the user's cache like `feelflow run
+    --backend auto`); returns (backend, the line saying why, or None). The timing runs in a
+    child process: numba's OpenMP threads, once started, would make the forked graders abort."""
+    if backend != AUTO:
+        return backend, None
+    from feelflow.app.model.backend_choice import JsonFileStore, choice_key, default_store_path
+
+    config = exercise.scene.scaled(scale).flow_config()
+    path = str(store_path if store_path is not None else default_store_path())
+    known = JsonFileStore(path).get(choice_key(CHOICE_KEY, config.nx, config.ny))
+    if known in scoring.BACKENDS:
+        return known, f"scoring backend {known} (remembered for {config.nx} x {config.ny})"
+    try:
+        with ProcessPoolExecutor(max_workers=1) as pool:
+            name, line = pool.submit(_timed_choice, config, path).result()
+    except RuntimeError as exc:   # neither can run (choose_backend says why)
+        raise UserError(f"--backend auto: {exc}") from None
+    return name, f"scoring {line}"
 
 
 def grade(exercise, paths, workers: int | None = None, scales=(1,), progress=None,
@@ -134,7 +182,10 @@ def grade(exercise, paths, workers: int | None = None, scales=(1,), progress=Non
             if progress:
                 progress(i + 1, len(jobs))
     else:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
+        initializer, initargs = None, ()
+        if backend == "cpu":
+            initializer, initargs = _share_cores, (max(1, default_workers() // workers),)
+        with ProcessPoolExecutor(max_workers=workers, initializer=initializer, initargs=initargs) as pool:
             futures = {pool.submit(_worker, job): i for i, job in enumerate(jobs)}
             for n, fut in enumerate(as_completed(futures), 1):
                 rows[futures[fut]] = fut.result()

@@ -18,7 +18,7 @@ from feelflow.solver import units
 class DeviceInput(QObject):
     disconnected = Signal(str)
 
-    def __init__(self, url: str, tunnel_size, expected_peak: float, parent=None):
+    def __init__(self, url: str, tunnel_size, expected_peak: float, parent=None, expected_peak_torque: float = 1.0):
         from feelflow.haptics import LoopConfig, ProcessForceLoop
 
         super().__init__(parent)
@@ -26,7 +26,8 @@ class DeviceInput(QObject):
         nx, ny = tunnel_size
         # DeviceError / BadDeviceURL: one line for the user
         self.loop = ProcessForceLoop(url, LoopConfig(tunnel_rect=(0.0, 0.0, nx - 1.0, ny - 1.0),
-                                                     expected_peak=expected_peak),
+                                                     expected_peak=expected_peak,
+                                                     expected_peak_torque=expected_peak_torque),
                                      on_disconnect=lambda reason: self.disconnected.emit(str(reason)))
         self.loop.start()
         self.name = url
@@ -36,15 +37,22 @@ class DeviceInput(QObject):
         """The force the scene can reach: C about 2 at the Mach-limit speed over the body size."""
         return 2.0 * units.dynamic_pressure(sim.config.max_speed) * sim.params.size
 
+    @staticmethod
+    def expected_peak_torque(sim) -> float:
+        """The torque the scene can reach: that force at half the body size from its centre."""
+        return DeviceInput.expected_peak(sim) * sim.params.size / 2.0
+
     def target(self):
         """(x, y) in lattice nodes where the device puts the body, or None before its first pose."""
         bt = self.loop.body_target()
         return (bt.x, bt.y) if bt.valid else None
 
-    def submit(self, force, step: int):
+    def submit(self, force, step: int, torque: float = 0.0):
+        """The selected model's force and torque (lattice units) to the device's loop."""
         from feelflow.haptics import ForceSample
 
-        self.loop.submit_force(ForceSample(float(force[0]), float(force[1]), time.monotonic(), step))
+        self.loop.submit_force(ForceSample(float(force[0]), float(force[1]), time.monotonic(), step,
+                                           torque=float(torque)))
 
     def pause(self, paused: bool):
         self.loop.pause() if paused else self.loop.resume()

@@ -238,6 +238,8 @@ class Overlay:
             target = turn_handle.knob_position(centre, reach, math.radians(turn.target))
             turn_handle.paint_turn_target(p, centre, target)
         state = "refused" if v.turn_blocker() else "active" if turn is not None or v.hover == "handle" else "idle"
+        if v.torque_arc:
+            turn_handle.paint_torque_arc(p, centre, reach, v.sim.angle, v.torque_arc)
         turn_handle.paint_handle(p, centre, knob, state)
         if turn is not None:
             shown = (turn.target + 180.0) % 360.0 - 180.0

@@ -85,6 +85,35 @@ def paint_handle(p: QPainter, centre: QPointF, knob: QPointF, state: str):
     p.drawEllipse(knob, KNOB_RADIUS, KNOB_RADIUS)
 
 
+TORQUE = QColor(120, 220, 255)
+
+
+def paint_torque_arc(p: QPainter, centre: QPointF, reach: float, angle: float, degrees: float):
+    """The torque the fluid puts on the body (app/model/readouts.py torque_arc): an arc on the
+    knob's circle from the knob, `degrees` long (counter-clockwise positive, as the torque turns
+    the body), with an arrowhead at its end; the body turned against the fluid shows it pulling
+    back."""
+    start = math.degrees(angle) + 180.0   # the knob's direction (knob_position)
+    rect = QRectF(centre.x() - reach, centre.y() - reach, 2 * reach, 2 * reach)
+    path = QPainterPath()
+    path.arcMoveTo(rect, start)
+    path.arcTo(rect, start, degrees)     # Qt's angles run counter-clockwise on screen (y down)
+    p.setBrush(Qt.NoBrush)
+    p.setPen(QPen(HALO, 6, Qt.SolidLine, Qt.RoundCap))
+    p.drawPath(path)
+    p.setPen(QPen(TORQUE, 3, Qt.SolidLine, Qt.RoundCap))
+    p.drawPath(path)
+    end = math.radians(start + degrees)
+    tip = QPointF(centre.x() + reach * math.cos(end), centre.y() - reach * math.sin(end))
+    sense = 1.0 if degrees > 0 else -1.0   # the tangent along the arc's direction, on screen
+    tx, ty = -math.sin(end) * sense, -math.cos(end) * sense
+    nx, ny = -ty, tx
+    head = QPolygonF([tip + QPointF(8 * tx, 8 * ty), tip + QPointF(5 * nx, 5 * ny), tip - QPointF(5 * nx, 5 * ny)])
+    p.setPen(QPen(HALO, 1.5))
+    p.setBrush(QBrush(TORQUE))
+    p.drawPolygon(head)
+
+
 def paint_turn_target(p: QPainter, centre: QPointF, knob: QPointF):
     """Where the pointer asks the body to turn: dashed, like the drag's target line."""
     p.setPen(QPen(QColor(255, 255, 255, 200), 2, Qt.DashLine))

@@ -151,6 +151,23 @@ def arrows(force, wind, length: ReferenceLength) -> dict | None:
     return out
 
 
+#: the turn handle's torque arc: degrees of arc per reference torque, and its most
+TORQUE_ARC_DEG = 180.0
+TORQUE_ARC_CAP_DEG = 150.0
+
+
+def torque_arc(torque, size: float, max_speed: float) -> float | None:
+    """The turn handle's torque arc for one frame's torque about the body's centre: degrees,
+    counter-clockwise positive like the torque, TORQUE_ARC_DEG per reference torque
+    q(max_speed) size^2 (the dynamic pressure at the Mach limit on the body's size, at a lever arm
+    of its size: what a turn the tunnel allows can reach), at most TORQUE_ARC_CAP_DEG; None
+    without a finite torque. Lattice units."""
+    if torque is None or not math.isfinite(torque) or size <= 0:
+        return None
+    reference = units.dynamic_pressure(max_speed) * size * size
+    return math.copysign(min(abs(torque) / reference * TORQUE_ARC_DEG, TORQUE_ARC_CAP_DEG), torque)
+
+
 def arrow_coefficient(vector, length: ReferenceLength) -> float:
     """The coefficient an arrow of `arrows` shows: its length over half the reference length."""
     return math.hypot(*vector) / (0.5 * length.cells)

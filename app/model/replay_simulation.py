@@ -38,6 +38,7 @@ class ReplaySimulation:
         self.player = SessionPlayer(session, backend, ctx=ctx, factory=factory)
         self.name = Path(session.source).name
         self.history = History()
+        self.last_torques: dict[str, float] = {}   # each model's torque, the mean of the last rows replayed
         self.paused = False
         self.last_steps = 0
         self._last_forces: dict = {}
@@ -176,9 +177,10 @@ class ReplaySimulation:
         for row in rows:
             vx, vy = (0.0, 0.0) if math.isnan(row.body[2]) else row.body[2:4]
             self.history.add(row.step, (vx, vy), (row.inflow_speed - vx, -vy), row.forces, row.torques)
-            mean.add(row.forces, row.n)
+            mean.add(row.forces, row.n, row.torques)
         if rows:
             self._last_forces = mean.mean()
+            self.last_torques = mean.torque_mean()
         return self._last_forces
 
     def close(self) -> None:

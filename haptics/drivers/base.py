@@ -25,6 +25,13 @@ def clamp_force(fx: float, fy: float, max_force: float) -> tuple[float, float]:
     return fx, fy
 
 
+def clamp_torque(torque: float, max_torque: float) -> float:
+    """A torque within +-max_torque; non-finite gives 0 (never pass NaN to a motor)."""
+    if not math.isfinite(torque):
+        return 0.0
+    return max(-max_torque, min(max_torque, torque))
+
+
 class Device(ABC):
     """A haptic device (or an input-only one) behind a transport."""
 
@@ -56,6 +63,8 @@ class Device(ABC):
         try:
             if self.capabilities is not None and self.capabilities.can_output_force:
                 self._send_force(0.0, 0.0)
+                if self.capabilities.max_torque > 0:
+                    self._send_torque(0.0)
         except DeviceError:
             pass
         self.transport.close()
@@ -107,6 +116,20 @@ class Device(ABC):
     @abstractmethod
     def _send_force(self, fx: float, fy: float) -> None:
         """Encode and send an already clamped force."""
+
+    def write_torque(self, torque: float) -> float:
+        """Command `torque` newton metres on the rotational axis, clamped to its maximum; returns
+        what was sent (0 where the device has no rotational axis that outputs force)."""
+        caps = self.capabilities
+        if caps is None or not caps.can_output_force or caps.max_torque <= 0:
+            return 0.0
+        torque = clamp_torque(torque, caps.max_torque)
+        self._send_torque(torque)
+        return torque
+
+    def _send_torque(self, torque: float) -> None:
+        """Encode and send an already clamped torque (devices with max_torque > 0 define it)."""
+        raise DeviceError(f"{self.url or self.driver_name}: no rotational axis to drive")
 
     @property
     def counters(self) -> dict:

@@ -38,18 +38,20 @@ def add_arguments(parser):
                    help="score at N times the exercise's resolution (1..8; default 1; 2 to confirm a close "
                         "ranking); refused before scoring when the grid, the steps or the memory it "
                         "needs are beyond the bounds")
-    p.add_argument("--backend", choices=("numpy", "cpu"), default="numpy",
-                   help="float64 solver for the runs: numpy (default, the reference) or the compiled cpu "
-                        "backend (the same digits in about a third of the time: docs/science/cpu-backend.md)")
+    p.add_argument("--backend", choices=("auto", "numpy", "cpu"), default="auto",
+                   help="float64 solver for the runs: auto (default: the faster of the two here, timed once "
+                        "and remembered), numpy (the reference) or the compiled cpu backend (the same "
+                        "scores in about a quarter of the time: docs/science/cpu-backend.md)")
     p = sub.add_parser("check", help="validate an exercise file and score its reference solutions")
     p.add_argument("exercise", metavar="EXERCISE.toml")
     p.add_argument("--convergence", action="store_true",
                    help="also score the [check] shapes; everything at 1x and 2x the resolution; "
                         "exit 1 unless the ranking is the same")
     p.add_argument("--markdown", action="store_true", help="--convergence: print the table as Markdown")
-    p.add_argument("--backend", choices=("numpy", "cpu"), default="numpy",
-                   help="float64 solver for the runs: numpy (default; what the window and 'score' use) or "
-                        "the compiled cpu backend (the same digits, less CPU time)")
+    p.add_argument("--backend", choices=("auto", "numpy", "cpu"), default="auto",
+                   help="float64 solver for the runs: auto (default: the faster here, as for 'score'), "
+                        "numpy (the reference; what the window uses) or the compiled cpu backend (the "
+                        "same scores, less time)")
     p.add_argument("--workers", default=None, metavar="N", help="processes (default: every core)")
     sub.add_parser("list", help="list the shipped exercises")
 
@@ -178,6 +180,17 @@ def _rank_labels(ranks) -> list[str]:
     return [next(it) if k is not None else "-" for k in ranks]
 
 
+def _backend(exercise, asked: str, scale: int = 1) -> str:
+    """The solver the runs use: `asked`, or for auto the faster float64 one here (one line says
+    which and why: app/exercises/grading.py `resolve_backend`)."""
+    from feelflow.app.exercises import grading
+
+    backend, line = grading.resolve_backend(asked, exercise, scale)
+    if line is not None:
+        print(f"feelflow: {line}", flush=True)
+    return backend
+
+
 def _score(exercise, args) -> int:
     from feelflow.app.exercises import grading
     from feelflow.app.exercises.uncertainty import fmt
@@ -193,10 +206,11 @@ def _score(exercise, args) -> int:
     workers = _fit(exercise, (scale,), workers, len(files), "--scale" if args.scale is not None else "")
     s = exercise.scene.scaled(scale)
     print(_machine_line())
+    backend = _backend(exercise, args.backend, scale)
     print(f"{exercise.title}: scoring {len(files)} shape files on {min(workers, len(files))} processes "
-          f"({getattr(args, 'backend', 'numpy')} float64, {s.nx} x {s.ny}, {s.steps} steps each)", flush=True)
+          f"({backend} float64, {s.nx} x {s.ny}, {s.steps} steps each)", flush=True)
     rows, wall = grading.grade(exercise, files, workers, scales=(scale,), progress=ProgressBar("shapes"),
-                               backend=getattr(args, "backend", "numpy"))
+                               backend=backend)
     rows = grading.ranked(exercise, rows)
     save_csv(out, grading.CSV_HEADER, grading.csv_rows(rows, exercise), "--out")
     o = exercise.objective
@@ -225,14 +239,15 @@ def _check(exercise, args) -> int:
     workers = _fit(exercise, scales, workers, len(exercise.references) + len(exercise.check_shapes),
                    "--convergence at scale" if args.convergence else "")
     print(_machine_line())
+    backend = _backend(exercise, args.backend)
     s = exercise.scene
     print(f"{exercise.source}: valid. {exercise.title}: {s.nx} x {s.ny}, Re {s.reynolds:g}, "
           f"U {s.inflow_speed:g}, L {s.reference_length:g} cells, {s.steps} steps; objective "
-          f"{exercise.objective.kind}; {args.backend} float64", flush=True)
+          f"{exercise.objective.kind}; {backend} float64", flush=True)
     print(_uncertainty_line(exercise))
     refs = [r.path for r in exercise.references]
     paths = refs + (list(exercise.check_shapes) if args.convergence else [])
-    rows, wall = grading.grade(exercise, paths, workers, scales, progress=ProgressBar("runs"), backend=args.backend)
+    rows, wall = grading.grade(exercise, paths, workers, scales, progress=ProgressBar("runs"), backend=backend)
     by = {(r.file, r.scale): r for r in rows}
     failed = False
     for ref in exercise.references:
