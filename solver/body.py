@@ -277,21 +277,24 @@ class BodyState:
         return self.window_solid_q
 
 
-def make_body_state(shape, velocity, omega, config, margin: int, raster=None) -> BodyState:
+def make_body_state(shape, velocity, omega, config, margin: int, raster=None, links=build_links,
+                    rasteriser=None) -> BodyState:
     """Rasterise `shape` (unless `raster` is given: a BodyRaster of this shape with any
-    window margin), cap its motion and build its links on raster.window + margin."""
+    window margin), cap its motion and build its links on raster.window + margin. `links`:
+    `build_links` or an equal; `rasteriser(shape, nx, ny)`: one for this shape equal to
+    `rasterise(shape, nx, ny, 0)`, or None (the compiled ones: solver/cpu_body.py)."""
     from feelflow.shapes.raster import rasterise
 
     nx, ny = config.nx, config.ny
     shape.validate(nx, ny)
     vel, om, capped = capped_motion(shape, velocity, omega, config.max_speed)
     if raster is None:
-        raster = rasterise(shape, nx, ny, 0)
+        raster = rasteriser(shape, nx, ny) if rasteriser is not None else rasterise(shape, nx, ny, 0)
     window = expand_box(raster.window, margin, nx, ny)
     x0, y0 = window[:2]
     solid, q = raster.crop(window)
-    links = build_links(q, solid, x0, y0, (shape.x, shape.y), vel, om, wrap=periodic_wrap(config, window))
-    return BodyState(shape, vel, om, capped, raster, window, links, (solid, q))
+    body_links = links(q, solid, x0, y0, (shape.x, shape.y), vel, om, wrap=periodic_wrap(config, window))
+    return BodyState(shape, vel, om, capped, raster, window, body_links, (solid, q))
 
 
 def shifted(f: np.ndarray) -> np.ndarray:

@@ -550,3 +550,139 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
         return n, True
 
     return advance
+
+
+# --- the AA streaming pattern, measured against the two buffers above --------------------------
+@numba.njit(inline="always", **_JIT)
+def _gather_aa(g, b, y, ym, yp, x0, n):
+    """The odd AA step's reads: b[i, k] = g[opp(i), y - c_iy, x - c_ix] at x = x0 + k, the
+    population the last (even) step stored at the node it came from, 1 <= x0, x0 + n < nx."""
+    x1 = x0 + n
+    b[0, :n] = g[0, y, x0:x1]
+    b[1, :n] = g[3, y, x0 - 1:x1 - 1]
+    b[2, :n] = g[4, ym, x0:x1]
+    b[3, :n] = g[1, y, x0 + 1:x1 + 1]
+    b[4, :n] = g[2, yp, x0:x1]
+    b[5, :n] = g[7, ym, x0 - 1:x1 - 1]
+    b[6, :n] = g[8, ym, x0 + 1:x1 + 1]
+    b[7, :n] = g[5, yp, x0 + 1:x1 + 1]
+    b[8, :n] = g[6, yp, x0 - 1:x1 - 1]
+
+
+@numba.njit(inline="always", **_JIT)
+def _scatter_aa(g, o, y, ym, yp, x0, n):
+    """The odd AA step's writes: g[i, y + c_iy, x + c_ix] = o[i, k], the very places its reads
+    came from (so each node touches its own nine places and the step runs in place)."""
+    x1 = x0 + n
+    g[0, y, x0:x1] = o[0, :n]
+    g[1, y, x0 + 1:x1 + 1] = o[1, :n]
+    g[2, yp, x0:x1] = o[2, :n]
+    g[3, y, x0 - 1:x1 - 1] = o[3, :n]
+    g[4, ym, x0:x1] = o[4, :n]
+    g[5, yp, x0 + 1:x1 + 1] = o[5, :n]
+    g[6, yp, x0 - 1:x1 - 1] = o[6, :n]
+    g[7, ym, x0 - 1:x1 - 1] = o[7, :n]
+    g[8, ym, x0 + 1:x1 + 1] = o[8, :n]
+
+
+@numba.njit(inline="always", **_JIT)
+def _seam_aa(g, b, o, y, ym, yp, x, op, om, trt, K):
+    """The odd AA step at one node of the first or last column (periodic neighbours)."""
+    nx = g.shape[2]
+    xm = x - 1 if x > 0 else nx - 1
+    xp = x + 1 if x < nx - 1 else 0
+    b[0, 0] = g[0, y, x]
+    b[1, 0] = g[3, y, xm]
+    b[2, 0] = g[4, ym, x]
+    b[3, 0] = g[1, y, xp]
+    b[4, 0] = g[2, yp, x]
+    b[5, 0] = g[7, ym, xm]
+    b[6, 0] = g[8, ym, xp]
+    b[7, 0] = g[5, yp, xp]
+    b[8, 0] = g[6, yp, xm]
+    s = _chunk(b, o, 1, op, om, K[0] * 0, trt, False, K[0] * 0, K[0] * 0, False, K)
+    g[0, y, x] = o[0, 0]
+    g[1, y, xp] = o[1, 0]
+    g[2, yp, x] = o[2, 0]
+    g[3, y, xm] = o[3, 0]
+    g[4, ym, x] = o[4, 0]
+    g[5, yp, xp] = o[5, 0]
+    g[6, yp, xm] = o[6, 0]
+    g[7, ym, xm] = o[7, 0]
+    g[8, ym, xp] = o[8, 0]
+    return s
+
+
+@functools.lru_cache(maxsize=None)
+def make_box_aa(kind: str = "trt", dtype: str = "float32"):
+    """`advance_aa`: the periodic box (BGK or TRT, no force, no sponge) stepped in place in ONE
+    buffer with the AA pattern (Bailey, Myre, Walsh, Lilja & Saar 2009, "Accelerating lattice
+    Boltzmann fluid flow simulations using graphics processors"), for `feelflow bench streaming`
+    to measure against the two-buffer kernel above (docs/science/cpu-backend.md). Not used by
+    the solver backends.
+
+    The state between steps is the pre-collision populations f_i(x) in natural order after an
+    odd number of AA steps' pairs (an "even" state). An even step collides each node in place
+    and stores f*_i in slot opp(i) of the same node; an odd step reads each node's incoming
+    populations from the slots the even step filled at its neighbours, collides, and writes
+    f*_i to slot i of node x + c_i: streamed, in natural order again. Each node of either step
+    reads and writes the same nine places, which no other node touches, so the rows run in
+    parallel without a second buffer. After two AA steps the buffer holds what streaming the
+    two-buffer kernel's state (post-collision) gives after two steps."""
+    if kind not in ("bgk", "trt"):
+        raise ValueError(f"the AA box kernel compiles bgk and trt, not {kind!r}")
+    K = constants(dtype)
+    trt = kind == "trt"
+
+    @numba.njit(parallel=True, **_JIT)
+    def advance_aa(n, odd, g, op, om, scratch, sums):
+        """n AA steps in place on g (9, ny, nx), the first an odd step if `odd`; op, om the
+        rates; scratch (B, 2, 9, CHUNK), sums (B,). Returns (steps done, finite) as `advance`."""
+        ny, nx = g.shape[1], g.shape[2]
+        nb = scratch.shape[0]
+        per = (ny + nb - 1) // nb
+        zero = K[0] * 0
+        for step in range(n):
+            is_odd = (step + odd) % 2 == 1
+            for blk in prange(nb):
+                bb = scratch[blk, 0]
+                o = scratch[blk, 1]
+                s = 0.0
+                for y in range(blk * per, min(ny, (blk + 1) * per)):
+                    ym = y - 1 if y > 0 else ny - 1
+                    yp = y + 1 if y < ny - 1 else 0
+                    if is_odd:
+                        s += _seam_aa(g, bb, o, y, ym, yp, 0, op, om, trt, K)
+                        x0 = 1
+                        while x0 < nx - 1:
+                            m = min(CHUNK, nx - 1 - x0)
+                            _gather_aa(g, bb, y, ym, yp, x0, m)
+                            s += _chunk(bb, o, m, op, om, zero, trt, False, zero, zero, False, K)
+                            _scatter_aa(g, o, y, ym, yp, x0, m)
+                            x0 += m
+                        if nx > 1:
+                            s += _seam_aa(g, bb, o, y, ym, yp, nx - 1, op, om, trt, K)
+                    else:
+                        x0 = 0
+                        while x0 < nx:
+                            m = min(CHUNK, nx - x0)
+                            x1 = x0 + m
+                            for i in range(9):
+                                bb[i, :m] = g[i, y, x0:x1]
+                            s += _chunk(bb, o, m, op, om, zero, trt, False, zero, zero, False, K)
+                            g[0, y, x0:x1] = o[0, :m]
+                            g[3, y, x0:x1] = o[1, :m]
+                            g[4, y, x0:x1] = o[2, :m]
+                            g[1, y, x0:x1] = o[3, :m]
+                            g[2, y, x0:x1] = o[4, :m]
+                            g[7, y, x0:x1] = o[5, :m]
+                            g[8, y, x0:x1] = o[6, :m]
+                            g[5, y, x0:x1] = o[7, :m]
+                            g[6, y, x0:x1] = o[8, :m]
+                            x0 = x1
+                sums[blk] = s
+            if not np.isfinite(sums.sum()):
+                return step + 1, False
+        return n, True
+
+    return advance_aa

@@ -75,15 +75,13 @@ class NumpySolver(Solver):
 
     # --- body -----------------------------------------------------------------
     def set_body(self, shape, velocity=(0.0, 0.0), omega: float = 0.0, *, raster=None) -> None:
-        cfg = self.config
         old = self.body
         new = self._body_state(shape, velocity, omega, raster)
         if same_solid_motion(old, new):   # a sub-cell move at the same motion: nothing to write
             self.body = new
             self.speed_capped = new.capped or self.inflow_capped
             return
-        jx, jy = move_body(old, new, cfg, self._read_window, self._write_nodes,
-                           refill_scheme=self.body_refill, impulse=self.body_impulse)
+        jx, jy = self._move_body(old, new)
         self._impulse = (self._impulse[0] + jx, self._impulse[1] + jy)
         self.body = new
         if new is not None:
@@ -96,6 +94,12 @@ class NumpySolver(Solver):
         else:
             self._solid_idx = self._solid_g = None
             self.speed_capped = self.inflow_capped
+
+    def _move_body(self, old, new) -> tuple[float, float]:
+        """Cover/uncover bookkeeping and refill between two body states (solver/body.py
+        `move_body`); the impulse (Jx, Jy)."""
+        return move_body(old, new, self.config, self._read_window, self._write_nodes,
+                         refill_scheme=self.body_refill, impulse=self.body_impulse)
 
     def _read_window(self, x0, y0, x1, y1) -> np.ndarray:
         return unshifted(self.g[:, y0:y1, x0:x1])

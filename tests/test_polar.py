@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from feelflow.app.model.polar import (PolarSweep, lift_slope, max_lift, naca_zero_lift_angle, run_sweep,
+from feelflow.app.model.polar import (PolarSweep, lift_slope, max_lift, max_lift_fit, naca_zero_lift_angle, run_sweep,
                                       thin_airfoil_cl)
 
 U, CHORD = 0.05, 20.0
@@ -49,6 +49,21 @@ def test_slope_maximum_and_thin_airfoil_line():
     pts = [PolarPoint(a, 0.1 * a, 0.1, 0.0, 1, True) for a in (-4, -2, 0, 2, 4)] + [PolarPoint(8, 0.6, 0.2, 0.1, 1, True)]
     assert lift_slope(pts) == pytest.approx(0.1 * 180 / math.pi)
     assert max_lift(pts) == (8, 0.6)
+    assert max_lift_fit(pts) is None   # the sweep ends at its largest C_L: the maximum is not pinned
+
+
+def test_the_fitted_maximum_sees_through_the_jitter_of_the_window_means():
+    from feelflow.app.model.polar import PolarPoint
+
+    # C_L = 1.2 - 0.002 (alpha - 27)^2 with +-0.1 jitter: the largest single point is at 23 degrees
+    jitter = {17: 0.0, 19: -0.05, 21: 0.05, 23: 0.1, 25: -0.1, 27: -0.08, 29: 0.0, 31: -0.1, 33: 0.05, 35: -0.05}
+    pts = [PolarPoint(a, 1.2 - 0.002 * (a - 27) ** 2 + d, 0.5, 0.2, 1, True) for a, d in jitter.items()]
+    assert max_lift(pts)[0] == 23
+    alpha, cl = max_lift_fit(pts, half_width=12.0)
+    assert alpha == pytest.approx(27.0, abs=2.0) and cl == pytest.approx(1.2, abs=0.06)
+    # still rising at the end of the sweep, or a trough: not pinned
+    assert max_lift_fit([PolarPoint(a, 0.05 * a, 0.5, 0.0, 1, True) for a in range(20, 32, 2)]) is None
+    assert max_lift_fit([PolarPoint(a, 0.01 * (a - 26) ** 2, 0.5, 0.0, 1, True) for a in range(20, 32, 2)]) is None
     assert thin_airfoil_cl(5.0) == pytest.approx(2 * math.pi * math.radians(5))
     # NACA 4412's mean line: alpha_0 = -4.15 degrees (Abbott & von Doenhoff's thin-airfoil value)
     assert naca_zero_lift_angle(0.04, 0.4) == pytest.approx(-4.15, abs=0.02)

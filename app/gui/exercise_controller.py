@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, QThread, QTimer, Qt, Signal
 from PySide6.QtGui import QAction, QColor
@@ -23,6 +24,11 @@ from feelflow.app.gui.exercise_panel import PARAMETERS, PANEL_WIDTH, ExercisePan
 from feelflow.app.model import readouts
 from feelflow.app.model.readouts import EXERCISE_LENGTH, ReferenceLength
 from feelflow.shapes.base import ShapeError
+
+if TYPE_CHECKING:
+    from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.gui.window.frame_loop import FrameLoop
+    from feelflow.app.model.simulation import Simulation
 
 BROKEN_EDGE = QColor(230, 40, 40)
 CHECK_INTERVAL_MS = 250
@@ -61,9 +67,12 @@ class ExerciseController(QObject):
 
     attemptAdded = Signal(object)   # attempts.Attempt
 
-    def __init__(self, window):
+    def __init__(self, window, viewport: "Viewport", loop: "FrameLoop"):
         super().__init__(window)
         self.window = window
+        self.viewport, self.loop = viewport, loop
+        self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
+        window.events.liveCreated.connect(self._live_created)
         self.exercise = None
         self.attempts = None
         self.panel = None
@@ -76,6 +85,9 @@ class ExerciseController(QObject):
         self.timer.setInterval(CHECK_INTERVAL_MS)
         self.timer.timeout.connect(self.refresh_constraints)
         self.timer.timeout.connect(self.refresh_live)
+
+    def _live_created(self, sim):
+        self.sim = sim
 
     # --- menus -------------------------------------------------------------------------------
     def build_menu(self, bar, presets_menu=None):
@@ -136,7 +148,7 @@ class ExerciseController(QObject):
         from feelflow.app.shape_files import load_shape
 
         w = self.window
-        if w.sim is None or w.replays.refuse("exercises run in the live tunnel"):
+        if self.sim is None or w.replays.refuse("exercises run in the live tunnel"):
             return False
         if self.worker is not None:
             QMessageBox.information(w, "Scoring is running", "Wait for the score or cancel it first.")
@@ -153,13 +165,13 @@ class ExerciseController(QObject):
                 "body": {"kind": "cylinder", "diameter": s.reference_length, "x": s.body_x, "y": s.body_y},
                 "run": {"steps": s.steps}}, exercise.source)
             w.make_current()
-            w.sim.load_scene(scene)
+            self.sim.load_scene(scene)
         except (UserError, ShapeError, ValueError) as exc:
             w.flow.refuse_dialog("This exercise cannot be opened", exc)
             return False
         self.exercise = exercise
         # the live readouts use the length the score uses (app/model/readouts.py)
-        w.sim.reference_override = ReferenceLength(s.reference_length, EXERCISE_LENGTH)
+        self.sim.reference_override = ReferenceLength(s.reference_length, EXERCISE_LENGTH)
         w.undo.clear()
         w.bodies.set_hold_still(True)
         self._ensure_panel()
@@ -169,9 +181,9 @@ class ExerciseController(QObject):
         self.install_shape(start)
         self._load_attempts()
         self.close_action.setEnabled(True)
-        w.panel.show_params(w.sim.params, w.loop.display_mode)
+        w.panel.show_params(self.sim.params, self.loop.display_mode)
         w.flow.after_rebuild()
-        w.loop.set_paused(False)
+        self.loop.set_paused(False)
         self.timer.start()
         self.refresh_constraints()
         w.statusBar().showMessage(f"Exercise: {exercise.title}", 10000)
@@ -182,13 +194,13 @@ class ExerciseController(QObject):
         """Give the viewport the exercise tunnel's shape: the forces plot below takes the height
         a wide, low tunnel leaves empty, so the tunnel fills the viewport's width and height."""
         w = self.window
-        vp, plot_dock = w.viewport, w.plot.parentWidget()
-        if self.exercise is None or w.sim is None or not isinstance(plot_dock, QDockWidget):
+        vp, plot_dock = self.viewport, w.plot.parentWidget()
+        if self.exercise is None or self.sim is None or not isinstance(plot_dock, QDockWidget):
             return
         self.dock.raise_()
         from feelflow.app.gui.display_modes import COLOUR_BAR_MARGIN
 
-        nx, ny = w.sim.config.nx, w.sim.config.ny
+        nx, ny = self.sim.config.nx, self.sim.config.ny
         wanted = max(vp.minimumHeight(), int(math.ceil((vp.width() - COLOUR_BAR_MARGIN) * ny / nx)) + 8)
         spare = vp.height() - wanted
         if spare > 0:
@@ -249,9 +261,9 @@ class ExerciseController(QObject):
             self.cancel()
         self.timer.stop()
         self.exercise = None
-        if self.window.sim is not None:
-            self.window.sim.reference_override = None
-        self.window.viewport.body_edge = None
+        if self.sim is not None:
+            self.sim.reference_override = None
+        self.viewport.body_edge = None
         if self.dock is not None:
             self.dock.hide()
         self.close_action.setEnabled(False)
@@ -261,8 +273,8 @@ class ExerciseController(QObject):
         """The shape the student has now: the edited polygon, or the parameter fields' body."""
         if self.exercise is None:
             return None
-        if "polygon" in self.exercise.kinds and self.window.sim.params.shape == "polygon":
-            return self.window.sim.shape
+        if "polygon" in self.exercise.kinds and self.sim.params.shape == "polygon":
+            return self.sim.shape
         return self.param_shape
 
     def install_shape(self, shape):
@@ -272,11 +284,11 @@ class ExerciseController(QObject):
             self.panel.set_parameters(shape)
             return self._parameters_changed()
         w.make_current()
-        w.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in shape.vertices],
+        self.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in shape.vertices],
                         angle_deg=math.degrees(shape.angle))
         self.param_shape = None
-        w.panel.show_params(w.sim.params, w.loop.display_mode)
-        w.viewport.update()
+        w.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.viewport.update()
         self.refresh_constraints()
         return True
 
@@ -296,14 +308,14 @@ class ExerciseController(QObject):
         try:
             w.make_current()
             if shape.kind == "cylinder":
-                w.sim.set_shape(kind="cylinder", size=shape.diameter, angle_deg=math.degrees(shape.angle))
+                self.sim.set_shape(kind="cylinder", size=shape.diameter, angle_deg=math.degrees(shape.angle))
             else:
-                w.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in shape.local_vertices],
+                self.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in shape.local_vertices],
                                 angle_deg=math.degrees(shape.angle))
         except (ShapeError, ValueError):
             pass    # too big for the tunnel: the constraints say so
-        w.panel.show_params(w.sim.params, w.loop.display_mode)
-        w.viewport.update()
+        w.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.viewport.update()
         self.refresh_constraints()
         return True
 
@@ -322,13 +334,13 @@ class ExerciseController(QObject):
             self.problems = problems
             self.panel.set_problems(problems)
         edge = BROKEN_EDGE if problems else None
-        if self.window.viewport.body_edge != edge:
-            self.window.viewport.body_edge = edge
-            self.window.viewport.update()
+        if self.viewport.body_edge != edge:
+            self.viewport.body_edge = edge
+            self.viewport.update()
 
     def refresh_live(self):
         """The panel's line of the live tunnel's coefficients, as the plot shows them."""
-        sim = self.window.sim
+        sim = self.sim
         if self.exercise is None or self.panel is None or sim is None:
             return
         self.panel.show_live(readouts.readout(sim.history, sim.params.force_model, sim.reference_length()))

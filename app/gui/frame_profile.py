@@ -25,7 +25,7 @@ from PySide6.QtCore import QEvent
 #: part key -> the label the report prints, in the report's order
 PARTS = {
     "steps": "solver steps",
-    "forces": "force models (compute)",
+    "forces": "force models (evaluate)",
     "moves": "body moves (raster, upload)",
     "check": "physical-range check",
     "field": "field for drawing",
@@ -97,7 +97,7 @@ class FrameProfile:
         backend = session.solver              # the backend it drives
         self._wrap(backend, "step", "steps")
         for model in backend.force_models.values():
-            self._wrap(model, "compute", "forces")
+            self._wrap(model, "evaluate", "forces")
         self._wrap(backend, "check_physical", "check")
         self._wrap(session, "set_body", "moves")
         self._wrap_slot(loop.timer.timeout, loop.tick, "loop")

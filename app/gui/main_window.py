@@ -1,6 +1,7 @@
 """The FeelFlow window: the wind-tunnel viewport in the middle, the side panel, the live force
 plot below, the status bar; assembly only. What the window does lives in its controllers,
-app/gui/window/, one module per concept, each an object holding the window (`self.w`):
+app/gui/window/, one module per concept, each an object given the viewport and the frame loop
+it works on at construction, the live tunnel through `events.liveCreated`, and the window:
 
     window.store    settings.py    WindowSettings: remembered parameters, polygon, mode, geometry
     window.actions  menus.py       the menus, shortcuts and replay toolbar (`build_menus`)
@@ -23,7 +24,7 @@ through `TunnelModel.drive`.
 
 To add a menu entry: one `add_action(menu, text, slot, shortcut)` line in
 app/gui/window/menus.py `build_menus`, with `slot` a controller's method. To add a controller:
-a module in app/gui/window/ with a class taking the window; create it in `MainWindow.__init__`
+a module in app/gui/window/ with a class taking the window and what it works on; create it in `MainWindow.__init__`
 under "controllers" (before `build_menus`, so menus can point at it), connect the widgets'
 signals to it in `_connect`, and list it above.
 """
@@ -92,19 +93,20 @@ class MainWindow(QMainWindow):
 
         # controllers, and the events they tell each other (window/events.py)
         self.events = WindowEvents(self)
-        self.loop = FrameLoop(self)
-        self.replays = ReplayController(self)
-        self.inputs = InputController(self)
-        self.bodies = BodyController(self)
-        self.flow = FlowController(self)
-        self.exports = ExportController(self)
-        self.lessons = LessonController(self)
-        self.video = VideoController(self)
-        self.probes = ProbeController(self)
+        vp = self.viewport
+        self.loop = loop = FrameLoop(self, vp)
+        self.replays = ReplayController(self, vp, loop)
+        self.inputs = InputController(self, vp)
+        self.bodies = BodyController(self, vp, loop)
+        self.flow = FlowController(self, vp, loop)
+        self.exports = ExportController(self, vp)
+        self.lessons = LessonController(self, vp, loop)
+        self.video = VideoController(self, vp, loop)
+        self.probes = ProbeController(self, vp)
         self.plot.probes = self.probes.probes   # the forces CSV carries the probes' columns
         self.units = UnitsController(self)
-        self.backends = BackendController(self, backend)   # "auto": measured once the context exists
-        self.exercises = ExerciseController(self)   # the Exercises menu and panel
+        self.backends = BackendController(self, vp, backend)   # "auto": measured once the context exists
+        self.exercises = ExerciseController(self, vp, loop)   # the Exercises menu and panel
         self.actions = build_menus(self)
 
         self.params = params or self.store.params()
@@ -193,6 +195,7 @@ class MainWindow(QMainWindow):
         except (ConfigError, ShapeError, ValueError) as exc:   # remembered settings that no longer work
             self.statusBar().showMessage(f"Remembered settings ignored ({exc}); using the defaults.", 8000)
             self.sim = Simulation(Params(), backend=self.backend, ctx=ctx)
+        self.events.liveCreated.emit(self.sim)   # every controller keeps the live tunnel
         if self.sim.params.shape == "polygon" and self.sim.polygon is None:
             self.bodies.install_default_polygon()
 

@@ -194,6 +194,32 @@ def max_lift(points) -> tuple[float, float] | None:
     return best.alpha, best.cl
 
 
+def max_lift_fit(points, half_width: float = 8.0) -> tuple[float, float] | None:
+    """(alpha in degrees, C_L) at the vertex of a least-squares parabola through the points within
+    `half_width` degrees of the largest C_L, or None when the maximum is not pinned.
+
+    Past stall the window means jitter by about +-0.1 from angle to angle (the shed vortices'
+    lift swings by +-0.2 to +-0.4 and a window holds only a few of its periods), so the largest
+    single point is a noisy estimate of where C_L peaks; the parabola averages over the
+    neighbours. Not pinned: fewer than four points in the range, points on only one side of the
+    largest C_L (the sweep ends there), a parabola that opens upwards, or a vertex outside the
+    fitted range."""
+    if not points:
+        return None
+    top = max(points, key=lambda p: p.cl)
+    sel = [(p.alpha, p.cl) for p in points if abs(p.alpha - top.alpha) <= half_width + 1e-9]
+    alphas = np.array([s[0] for s in sel], dtype=np.float64)
+    if len(sel) < 4 or not (alphas.min() < top.alpha < alphas.max()):
+        return None
+    a, b, c = np.polyfit(alphas, [s[1] for s in sel], 2)
+    if a >= 0:
+        return None
+    vertex = -b / (2 * a)
+    if not alphas.min() <= vertex <= alphas.max():
+        return None
+    return float(vertex), float(c - b * b / (4 * a))
+
+
 def chord_of(shape) -> float:
     """The length the coefficients are referred to: a section's chord, else the body's extent
     along its own axis (a cylinder's diameter)."""

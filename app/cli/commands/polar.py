@@ -97,8 +97,8 @@ def main(args) -> int:
     from feelflow.app.cli.commands.run import positive_int_option
     from feelflow.app.files import check_output, save_csv
     from feelflow.app.headless import make_solver, resolve_backend
-    from feelflow.app.model.polar import (PolarSweep, chord_of, lift_slope, max_lift, naca_zero_lift_angle,
-                                          run_sweep)
+    from feelflow.app.model.polar import (PolarSweep, chord_of, lift_slope, max_lift, max_lift_fit,
+                                          naca_zero_lift_angle, run_sweep)
     from feelflow.app.model.scene import load_scene
     from feelflow.solver.backend import BACKENDS
 
@@ -183,11 +183,14 @@ def main(args) -> int:
         cp_image([(f"alpha {a:g} deg", cp) for a, cp in cps], Path(args.cp).with_suffix(".png"), f"C_p: {title}")
     slope = lift_slope(sweep.points)
     best = max_lift(sweep.points)
+    fitted = max_lift_fit(sweep.points)
     summary = [f"{out}: {len(sweep.points)} angles; image {plot}"]
     if slope is not None:
         summary.append(f"dC_L/dalpha {slope:.3f} per radian for |alpha| <= 4 ({slope / (2 * math.pi):.2f} x 2 pi)")
     if best is not None:
         summary.append(f"max C_L {best[1]:.4f} at {best[0]:g} degrees")
+    if fitted is not None:
+        summary.append(f"fitted maximum C_L {fitted[1]:.3f} at {fitted[0]:.1f} degrees (parabola within 8 degrees)")
     print("; ".join(summary))
     return 1 if len(sweep.points) < len(angles) else 0
 

@@ -19,6 +19,7 @@ from feelflow.app.model.flow_choice import default_base_config
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.viewport import Viewport
 
 SETTINGS_KEY = "backend"
 REMEASURE_KEY = "backend_remeasure"
@@ -44,8 +45,9 @@ class QSettingsStore:
 class BackendController:
     """Resolves "auto" to a backend when the context is ready; owns the backend menu."""
 
-    def __init__(self, window: "MainWindow", requested: str):
+    def __init__(self, window: "MainWindow", viewport: "Viewport", requested: str):
         self.w = window
+        self.viewport = viewport
         self.requested = requested
         self.description = ""   # why this backend runs, for the status bar's tooltip
         self.measured = None     # steps per second it was measured at on start, if it was
@@ -72,7 +74,7 @@ class BackendController:
 
         config = default_base_config(w.params.grid)
         try:
-            choice = choose_backend(config, make_solver, QSettingsStore(settings), renderer=w.viewport.renderer(),
+            choice = choose_backend(config, make_solver, QSettingsStore(settings), renderer=self.viewport.renderer(),
                                     candidates=candidates, remeasure=remeasure)
         except RuntimeError:
             self.description = "numpy solver (no other backend runs here)"

@@ -24,22 +24,32 @@ from feelflow.solver.config import ConfigError
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.gui.window.frame_loop import FrameLoop
+    from feelflow.app.model.simulation import Simulation
 
 
 class BodyController:
     """Changes the live body; every change is refused while a replay shows."""
 
-    def __init__(self, window: "MainWindow"):
+    def __init__(self, window: "MainWindow", viewport: "Viewport", loop: "FrameLoop"):
         self.w = window
+        self.viewport = viewport
+        self.loop = loop
+        self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
+        window.events.liveCreated.connect(self._live_created)
         window.events.replayStarted.connect(self._replay_started)
+
+    def _live_created(self, sim):
+        self.sim = sim
 
     def _replay_started(self):
         """A replay takes over: the polygon editor closes and a drag is cancelled."""
         self.set_editing(False)
-        self.w.viewport.cancel_drag()
+        self.viewport.cancel_drag()
 
     def _refused(self) -> bool:
-        return self.w.sim is None or self.w.replays.refuse("the body follows the recording")
+        return self.sim is None or self.w.replays.refuse("the body follows the recording")
 
     # --- kind, size, hold still -------------------------------------------------------------------
     def apply_shape(self, **changes) -> bool:
@@ -50,20 +60,20 @@ class BodyController:
             return False
         w.make_current()
         try:
-            w.sim.set_shape(**changes)
+            self.sim.set_shape(**changes)
         except (ShapeError, ConfigError, ValueError) as exc:
             w.flow.refuse_dialog("This shape cannot be used", exc)
             return False
-        w.panel.show_params(w.sim.params, w.loop.display_mode)
+        w.panel.show_params(self.sim.params, self.loop.display_mode)
         if w.flow.say_guard():
             w.flow.after_rebuild()
-        w.viewport.update()
+        self.viewport.update()
         return True
 
     def set_shape_kind(self, kind):
         if self._refused():
             return
-        if kind == "polygon" and self.w.sim.polygon is None:
+        if kind == "polygon" and self.sim.polygon is None:
             self.install_default_polygon()
             return
         self.apply_shape(kind=kind)
@@ -72,19 +82,19 @@ class BodyController:
 
     def install_default_polygon(self):
         w = self.w
-        verts = default_polygon(w.sim.params.size)
+        verts = default_polygon(self.sim.params.size)
         w.make_current()
         try:
-            w.sim.set_shape(kind="polygon", polygon=verts)
+            self.sim.set_shape(kind="polygon", polygon=verts)
         except (ShapeError, ValueError) as exc:
             w.flow.refuse_dialog("This shape cannot be used", exc)
-        w.panel.show_params(w.sim.params, w.loop.display_mode)
+        w.panel.show_params(self.sim.params, self.loop.display_mode)
 
     def install_loaded_shape(self, shape):
         """A shape read from a file (app/gui/window/exports.py): a polygon is an undoable edit."""
         from feelflow.app.model.bodies import params_for_shape
 
-        sim = self.w.sim
+        sim = self.sim
         kind, size, verts = params_for_shape(shape)
         if kind == "polygon":
             if sim.params.shape != "polygon":
@@ -97,8 +107,8 @@ class BodyController:
         w = self.w
         if w.replays.refuse("the body follows the recording"):
             return
-        if w.sim is not None:
-            w.sim.hold_still = bool(on)
+        if self.sim is not None:
+            self.sim.hold_still = bool(on)
         w.panel.hold_still.setChecked(bool(on))
 
     # --- turning ----------------------------------------------------------------------------------
@@ -107,10 +117,10 @@ class BodyController:
         through the angle spring, as with the wheel; paused or held still it turns at once, as
         with the panel's angle box. The panel shows the angle asked for."""
         w = self.w
-        sim = w.sim
+        sim = self.sim
         if self._refused():
             return False
-        if w.loop.paused or sim.hold_still:
+        if self.loop.paused or sim.hold_still:
             if sim.angle != math.radians(wrap_degrees(degrees)):
                 w.make_current()
                 try:
@@ -121,25 +131,25 @@ class BodyController:
         else:
             sim.drive(BodyInput.turn(degrees, source="mouse"))
         w.panel.show_angle(sim.params.angle_deg)
-        w.viewport.update()
+        self.viewport.update()
         return True
 
     def turn_done(self, before: float, after: float):
         """One drag of the handle: one undo step (the body is already at `after`)."""
-        if self.w.sim is not None and self.w.replays.replay is None:
+        if self.sim is not None and self.w.replays.replay is None:
             self.w.undo.push(TurnBody(self.turn_body, before, after))
 
     def _script_refuses_turn(self, how: str) -> bool:
         """A motion script drives the pose (it ignores the angle until it ends, when the body would
         swing to the last asked angle): refuse the turn with a status message."""
-        if getattr(self.w.sim, "runner", None) is None:
+        if getattr(self.sim, "runner", None) is None:
             return False
         self.turn_refused("A motion script", how)
         return True
 
     def turn_by_wheel(self, degrees: float) -> bool:
         """The mouse wheel turns the body like the handle does; a burst of notches is one undo step."""
-        sim = self.w.sim
+        sim = self.sim
         if sim is None or self._script_refuses_turn("the mouse wheel"):
             return False
         before = sim.target_degrees()
@@ -151,7 +161,7 @@ class BodyController:
     def set_angle(self, degrees: float) -> bool:
         """The panel's angle box turns the body at once; a burst of edits (typed digits, arrow
         steps) is one undo step, whose undo puts the body back at once too."""
-        sim = self.w.sim
+        sim = self.sim
         if sim is None:
             return False
         if self._script_refuses_turn("the Angle box"):
@@ -177,19 +187,19 @@ class BodyController:
         w = self.w
         if on and w.replays.refuse("the body follows the recording"):
             return
-        w.viewport.editing = bool(on) and w.sim is not None and w.sim.params.shape == "polygon"
-        w.panel.edit.setChecked(w.viewport.editing)
-        if w.viewport.editing:
+        self.viewport.editing = bool(on) and self.sim is not None and self.sim.params.shape == "polygon"
+        w.panel.edit.setChecked(self.viewport.editing)
+        if self.viewport.editing:
             self.set_hold_still(True)
             w.statusBar().showMessage(f"Editing the polygon (the body holds still): {w.panel.edit.toolTip()}; "
                                       "Ctrl+Z undoes an edit.", 20000)
         elif on is False and w.statusBar().currentMessage().startswith("Editing the polygon"):
             w.statusBar().clearMessage()
-        w.viewport.update()
+        self.viewport.update()
 
     def check_polygon(self, verts):
         """Build and validate the polygon without installing it; raises ShapeError."""
-        sim = self.w.sim
+        sim = self.sim
         shape = sim.make_shape(replace(sim.params, shape="polygon"), verts, *sim.pos, sim.angle)
         return shape.validate(sim.config.nx, sim.config.ny)
 
@@ -202,14 +212,14 @@ class BodyController:
             self.check_polygon(verts)
         except (ShapeError, ValueError) as exc:
             QMessageBox.warning(w, "This polygon cannot be used", f"{exc}\nThe previous shape is kept.")
-            w.viewport.update()
+            self.viewport.update()
             return False
-        w.undo.push(SetPolygon(self._install_polygon, w.sim.polygon, verts, text))
+        w.undo.push(SetPolygon(self._install_polygon, self.sim.polygon, verts, text))
         return True
 
     def _install_polygon(self, verts):
         w = self.w
         w.make_current()
-        w.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in verts])
-        w.panel.show_params(w.sim.params, w.loop.display_mode)
-        w.viewport.update()
+        self.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in verts])
+        w.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.viewport.update()

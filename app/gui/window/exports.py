@@ -14,13 +14,21 @@ from feelflow.shapes.base import ShapeError
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.model.simulation import Simulation
 
 
 class ExportController:
     """The File menu's exports and shape files."""
 
-    def __init__(self, window: "MainWindow"):
+    def __init__(self, window: "MainWindow", viewport: "Viewport"):
         self.w = window
+        self.viewport = viewport
+        self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
+        window.events.liveCreated.connect(self._live_created)
+
+    def _live_created(self, sim):
+        self.sim = sim
 
     # --- forces, plot, screenshot -----------------------------------------------------------------
     def export_csv_dialog(self, _=None):
@@ -44,7 +52,7 @@ class ExportController:
         w = self.w
         image = w.grab().toImage()
         painter = QPainter(image)
-        painter.drawImage(w.viewport.mapTo(w, QPoint(0, 0)), w.viewport.grabFramebuffer())
+        painter.drawImage(self.viewport.mapTo(w, QPoint(0, 0)), self.viewport.grabFramebuffer())
         painter.end()
         return image
 
@@ -66,7 +74,7 @@ class ExportController:
         from feelflow.app import shape_files as shape_io
 
         try:
-            shape_io.save_shape(path, self.w.sim.shape)
+            shape_io.save_shape(path, self.sim.shape)
         except (OSError, ShapeError, ValueError) as exc:
             QMessageBox.warning(self.w, "Could not save the shape", str(exc))
 

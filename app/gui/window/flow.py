@@ -13,69 +13,79 @@ from feelflow.solver.config import ConfigError
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.gui.window.frame_loop import FrameLoop
+    from feelflow.app.model.simulation import Simulation
 
 
 class FlowController:
     """Changes the live tunnel's flow; refused while a replay shows."""
 
-    def __init__(self, window: "MainWindow"):
+    def __init__(self, window: "MainWindow", viewport: "Viewport", loop: "FrameLoop"):
         self.w = window
+        self.viewport = viewport
+        self.loop = loop
+        self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
+        window.events.liveCreated.connect(self._live_created)
         window.events.replayStopped.connect(self._replay_stopped)
+
+    def _live_created(self, sim):
+        self.sim = sim
 
     def _replay_stopped(self, _paused: bool):
         """Back on the live tunnel: the panel shows its parameters, the status bar its operator."""
-        self.w.panel.show_params(self.w.sim.params, self.w.loop.display_mode)
+        self.w.panel.show_params(self.sim.params, self.loop.display_mode)
         self.after_rebuild()
 
     def apply(self, **changes):
         """`Simulation.set_flow(**changes)` (wind, nu, wall); a bad value is a dialog."""
         w = self.w
-        if w.sim is None or w.replays.refuse("the flow follows the recording"):
+        if self.sim is None or w.replays.refuse("the flow follows the recording"):
             return
         w.make_current()
         try:
-            w.sim.set_flow(**changes)
+            self.sim.set_flow(**changes)
         except ConfigError as exc:
             self.refuse_dialog("This flow setting cannot be used", exc)
             return
         if self.say_guard():
-            w.panel.show_params(w.sim.params, w.loop.display_mode)
+            w.panel.show_params(self.sim.params, self.loop.display_mode)
         self.after_rebuild()
 
     def set_grid(self, grid):
         w = self.w
-        if w.sim is None or w.replays.refuse("the grid is the recording's"):
+        if self.sim is None or w.replays.refuse("the grid is the recording's"):
             return
         w.make_current()
         try:
-            w.sim.set_grid(grid)
+            self.sim.set_grid(grid)
         except (ConfigError, ShapeError) as exc:
             self.refuse_dialog("This grid cannot be used", exc)
             return
-        w.viewport.tracers = None
+        self.viewport.tracers = None
         self.after_rebuild()
 
     def set_force_models(self, selected=None, compare_all=None):
         w = self.w
-        if w.sim is not None and not w.replays.refuse("the scene cannot be changed"):
+        if self.sim is not None and not w.replays.refuse("the scene cannot be changed"):
             w.make_current()
-            w.sim.set_force_models(selected=selected, compare_all=compare_all)
-            w.loop.refresh_readouts()
+            self.sim.set_force_models(selected=selected, compare_all=compare_all)
+            self.loop.refresh_readouts()
             w.plot.refresh(force=True)
 
     def reset(self, _=None):
         """Reset flow (R): the flow from its initial state, the body where it is."""
         w = self.w
-        if w.sim is None or w.replays.refuse("the flow follows the recording"):
+        if self.sim is None or w.replays.refuse("the flow follows the recording"):
             return
         w.make_current()
-        w.sim.reset_flow()
-        w.viewport.tracers = None
+        self.sim.reset_flow()
+        self.viewport.tracers = None
         w.events.flowChanged.emit()
 
     def say_guard(self) -> bool:
         """Show in the status bar what the stability guard changed (app/model/flow_choice.py stable_params)."""
-        note = self.w.sim.guard_note if self.w.sim is not None else None
+        note = self.sim.guard_note if self.sim is not None else None
         if note:
             self.w.statusBar().showMessage(note, 10000)
         return bool(note)
@@ -88,4 +98,4 @@ class FlowController:
     def refuse_dialog(self, title, exc):
         """A change the model refused: one-line dialog, the panel back at the model's values."""
         QMessageBox.warning(self.w, title, str(exc))
-        self.w.panel.show_params(self.w.sim.params, self.w.loop.display_mode)
+        self.w.panel.show_params(self.sim.params, self.loop.display_mode)

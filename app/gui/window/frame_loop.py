@@ -24,6 +24,8 @@ from feelflow.solver.backend import SolverDiverged
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.model.simulation import Simulation
 
 #: the frame's length: as short as 1/60 s (aim just above 60 fps), as long as keeps at least
 #: MIN_SOLVER_SHARE of it for the solver's steps, never longer than 1/30 s (just above 30 fps)
@@ -44,8 +46,10 @@ PHYSICAL_CHECK_STEPS = 64
 class FrameLoop:
     """Owns the frame timer, pause, the display mode and the steps-per-frame budget."""
 
-    def __init__(self, window: "MainWindow"):
+    def __init__(self, window: "MainWindow", viewport: "Viewport"):
         self.w = window
+        self.viewport = viewport
+        self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
         self.paused = False
         self.display_mode = "speed"
         self.steps_per_frame = 4
@@ -62,14 +66,18 @@ class FrameLoop:
         self.slow_timer = QTimer(window)
         self.slow_timer.setInterval(READOUT_MS)
         self.slow_timer.timeout.connect(self.refresh_readouts)
+        window.events.liveCreated.connect(self._live_created)
         window.events.shownChanged.connect(self.show_model)
         window.events.replayStarted.connect(lambda: self.timer.setInterval(0))
         window.events.replayStopped.connect(self._replay_stopped)
         window.events.flowChanged.connect(self._flow_changed)
 
+    def _live_created(self, sim):
+        self.sim = sim
+
     def start(self):
-        if self.w.sim is not None:
-            self.w.sim.solver.check_every = PHYSICAL_CHECK_STEPS
+        if self.sim is not None:
+            self.sim.solver.check_every = PHYSICAL_CHECK_STEPS
         self.timer.start()
         self.slow_timer.start()
 
@@ -80,9 +88,9 @@ class FrameLoop:
     def show_model(self, model):
         """Point the viewport and the plot at `model` (the live tunnel or a replay) and draw it."""
         w = self.w
-        vp = w.viewport
+        vp = self.viewport
         vp.sim = w.plot.sim = model
-        vp.locked = model is not w.sim
+        vp.locked = model is not self.sim
         vp.tracers = vp.arrow_forces = vp.torque_arc = None
         self.forget_last_frame()
         self.upload_field()
@@ -93,7 +101,7 @@ class FrameLoop:
         """The live tunnel changed: its field, the readouts and a redraw."""
         self.upload_field()
         self.refresh_readouts()
-        self.w.viewport.update()
+        self.viewport.update()
 
     def _replay_stopped(self, paused: bool):
         """Back on the live tunnel: its own pace and pause."""
@@ -116,8 +124,8 @@ class FrameLoop:
             w.actions.pause.setChecked(paused or replay.done)
             w.replays.show_progress()
             return
-        if w.sim is not None and paused != self.paused:
-            w.sim.solver.pause() if paused else w.sim.solver.resume()
+        if self.sim is not None and paused != self.paused:
+            self.sim.solver.pause() if paused else self.sim.solver.resume()
         self.paused = paused
         self.timer.setInterval(30 if paused else 0)   # paused: redraw at ~30 Hz, no busy loop
         w.inputs.pause(paused)
@@ -127,14 +135,14 @@ class FrameLoop:
     def set_display_mode(self, mode):
         w = self.w
         self.display_mode = mode
-        w.viewport.mode = mode
+        self.viewport.mode = mode
         if mode != "tracers":
-            w.viewport.tracers = None
+            self.viewport.tracers = None
         w.panel.show_params(w.params_now(), mode)
         if w.shown is not None:   # the field again (a gl texture computes the vorticity only where shown)
             w.make_current()
             self.upload_field()
-        w.viewport.update()
+        self.viewport.update()
 
     # --- the field ----------------------------------------------------------------------------
     def upload_field(self):
@@ -147,31 +155,31 @@ class FrameLoop:
             return None
         texture = model.field_texture(vorticity=self.display_mode == "vorticity")
         if texture is not None:
-            w.viewport.use_texture(texture)
+            self.viewport.use_texture(texture)
             return None
         rgba = model.field_rgba()
-        w.viewport.makeCurrent()
-        w.viewport.upload_field(rgba)
+        self.viewport.makeCurrent()
+        self.viewport.upload_field(rgba)
         return rgba
 
     def _field_array(self) -> np.ndarray:
         """gl backend: the field texture `upload_field` computed this frame, read back (ny, nx,
         4) float32, instead of running the field pass again."""
-        tex = self.w.viewport.field_texture
+        tex = self.viewport.field_texture
         return np.frombuffer(tex.read(), np.float32).reshape(tex.height, tex.width, 4)
 
     # --- one frame ------------------------------------------------------------------------------
     def tick(self):
         now = time.perf_counter()
         w = self.w
-        sim = w.sim
+        sim = self.sim
         if sim is None:
             return
         if w.replays.replay is not None:
             self._tick_replay(now)
             return
         if self.paused:
-            w.viewport.update()
+            self.viewport.update()
             self._last_tick = None
             return
         n = self.steps_per_frame
@@ -206,7 +214,7 @@ class FrameLoop:
         r = w.replays.replay
         w.inputs.watch_during_replay()
         if r.paused or r.done:
-            w.viewport.update()
+            self.viewport.update()
             self._last_tick = None
             return
         w.make_current()
@@ -226,7 +234,7 @@ class FrameLoop:
 
     def _frame_done(self, now, t0, t1, n, forces, rgba):
         """After n steps took t1 - t0 s: tracers, arrows, redraw, and the next frame's budget."""
-        vp = self.w.viewport
+        vp = self.viewport
         if self.display_mode == "tracers":
             self._advance_tracers(rgba, n)
         if self.display_mode == "pressure" and vp.frames % 5 == 0:
@@ -266,7 +274,7 @@ class FrameLoop:
     def _on_nan(self):
         w = self.w
         self.set_paused(True)
-        w.viewport.update()
+        self.viewport.update()
         answer = QMessageBox.question(
             w, "The simulation became unstable",
             "The flow became unstable and stopped (the numbers grew without bound).\n"
@@ -279,14 +287,14 @@ class FrameLoop:
     def update_arrows(self, forces):
         """The viewport's drag and lift arrows for this frame's force (app/model/readouts.py)."""
         model = self.w.shown
-        self.w.viewport.arrow_forces = readouts.arrows(forces.get(model.params.force_model), model.relative_wind(),
-                                                       model.reference_length())
-        self.w.viewport.torque_arc = readouts.torque_arc(model.last_torques.get(model.params.force_model),
-                                                         model.params.size, model.config.max_speed)
+        self.viewport.arrow_forces = readouts.arrows(forces.get(model.params.force_model), model.relative_wind(),
+                                                     model.reference_length())
+        self.viewport.torque_arc = readouts.torque_arc(model.last_torques.get(model.params.force_model),
+                                                       model.params.size, model.config.max_speed)
 
     def _advance_tracers(self, rgba, n):
         """Move the viewport's tracers n steps through the field (app/model/tracers.py)."""
-        model, vp = self.w.shown, self.w.viewport
+        model, vp = self.w.shown, self.viewport
         if rgba is None:
             rgba = self._field_array()
         vp.tracers = self.tracers.advance(rgba, n, model.shape, None if vp.tracers is None else vp.tracers[0])
@@ -299,7 +307,7 @@ class FrameLoop:
         if model is None:
             return
         p, panel = model.params, w.panel
-        live = model is w.sim
+        live = model is self.sim
         wind, nu = panel.flow_shown     # lattice units, whatever units the boxes show
         if live and (abs(wind - p.wind) > 5e-4   # a sweep, a lesson or the guard
                      or abs(nu - p.nu) > 5e-5):

@@ -18,6 +18,8 @@ from feelflow.app.model.body_input import BodyInput
 if TYPE_CHECKING:
     from feelflow.app.gui.device_input import DeviceInput
     from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.model.simulation import Simulation
 
 DEVICE_MOVE_CELLS = 3.0   # a device moved this far during a replay is told it does not move the body
 
@@ -25,13 +27,19 @@ DEVICE_MOVE_CELLS = 3.0   # a device moved this far during a replay is told it d
 class InputController:
     """Owns the haptic device (None while the mouse drives) and routes body input to the model."""
 
-    def __init__(self, window: "MainWindow"):
+    def __init__(self, window: "MainWindow", viewport: "Viewport"):
         self.w = window
+        self.viewport = viewport
+        self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
+        window.events.liveCreated.connect(self._live_created)
         window.events.replayStarted.connect(self.replay_started)
         window.events.replayStopped.connect(self.replay_stopped)
         window.events.flowChanged.connect(self.tunnel_changed)
         self.device: DeviceInput | None = None
         self._device_seen = None     # the device's target when the replay began
+
+    def _live_created(self, sim):
+        self.sim = sim
 
     # --- one way in -----------------------------------------------------------------------------
     def drive(self, request: BodyInput) -> bool:
@@ -49,7 +57,7 @@ class InputController:
         """After a live frame: the device's position becomes the body's target, and the selected
         force model's force and torque go to the device (lattice units; the loop scales them; a
         torque not computed goes as 0, so that it never zeroes the force as a NaN would)."""
-        dev, sim = self.device, self.w.sim
+        dev, sim = self.device, self.sim
         if dev is None:
             return
         target = dev.target()
@@ -98,25 +106,25 @@ class InputController:
         if w.replays.refuse("the input cannot be changed"):
             return
         self.close_device()
-        if url == "mouse" or w.sim is None:
+        if url == "mouse" or self.sim is None:
             w.panel.input_note.setText("")
             return
         try:
-            self.device = DeviceInput(url, (w.sim.config.nx, w.sim.config.ny), DeviceInput.expected_peak(w.sim), w,
-                                      expected_peak_torque=DeviceInput.expected_peak_torque(w.sim))
+            self.device = DeviceInput(url, (self.sim.config.nx, self.sim.config.ny), DeviceInput.expected_peak(self.sim), w,
+                                      expected_peak_torque=DeviceInput.expected_peak_torque(self.sim))
         except (DeviceError, BadDeviceURL, OSError, ValueError) as exc:
             QMessageBox.warning(w, "The device cannot be used", f"{exc}\nBack to the mouse.")
             self._back_to_mouse("")
             return
         self.device.disconnected.connect(self._device_lost)
-        w.viewport.driver = "The haptic device"
+        self.viewport.driver = "The haptic device"
         w.bodies.set_hold_still(False)
         w.panel.input_note.setText("The device moves the body; you feel the selected force model.")
 
     def tunnel_changed(self):
         """The grid was rebuilt: the device's workspace maps onto the new tunnel."""
         if self.device is not None:
-            cfg = self.w.sim.config
+            cfg = self.sim.config
             self.device.loop.set_tunnel((0.0, 0.0, cfg.nx - 1.0, cfg.ny - 1.0))
 
     # --- stopping ---------------------------------------------------------------------------
@@ -150,19 +158,19 @@ class InputController:
         w.panel.input_note.setText(message)
         if message:
             w.statusBar().showMessage(message, 10000)
-        if w.sim is not None:
-            w.sim.drive(BodyInput.release("device"))
+        if self.sim is not None:
+            self.sim.drive(BodyInput.release("device"))
 
     def close_device(self):
         device, self.device = self.device, None
-        self.w.viewport.driver = None
+        self.viewport.driver = None
         if device is not None:
             device.close()
 
     # --- during a replay ------------------------------------------------------------------------
     def replay_started(self):
         """The live body is let go; a device's force fades out and its moves are refused."""
-        self.w.sim.drive(BodyInput.release("mouse"))
+        self.sim.drive(BodyInput.release("mouse"))
         if self.device is not None:
             self.device.pause(True)
             self._device_seen = self.device.target()

@@ -15,14 +15,16 @@ from feelflow.app.model.probes import Probes
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.viewport import Viewport
 
 PLOT_REFRESH_MS = 250
 PLACING_HINT = "Click in the flow to place a probe (up to 4); right-click one to remove it. View > Place probes ends this."
 
 
 class ProbeController:
-    def __init__(self, window: "MainWindow"):
+    def __init__(self, window: "MainWindow", viewport: "Viewport"):
         self.w = window
+        self.viewport = viewport
         self.probes = Probes()
         self.plot = ProbePlot()
         self.plot.probes = self.probes
@@ -49,7 +51,7 @@ class ProbeController:
     # --- placing ------------------------------------------------------------------------------
     def set_placing(self, on: bool):
         w = self.w
-        w.viewport.probing = bool(on)
+        self.viewport.probing = bool(on)
         w.actions.place_probes.setChecked(bool(on))
         if on:
             self._ensure_dock()
@@ -57,7 +59,7 @@ class ProbeController:
             w.statusBar().showMessage(PLACING_HINT, 20000)
         elif w.statusBar().currentMessage() == PLACING_HINT:
             w.statusBar().clearMessage()
-        w.viewport.setCursor(Qt.CrossCursor if on else Qt.ArrowCursor)
+        self.viewport.setCursor(Qt.CrossCursor if on else Qt.ArrowCursor)
 
     def clicked(self, x: float, y: float, remove: bool):
         w = self.w
@@ -65,7 +67,7 @@ class ProbeController:
         if model is None:
             return
         if remove:
-            self.probes.remove_near(x, y, radius=max(2.0, 12.0 * model.config.nx / max(1, w.viewport.lattice_rect().width())))
+            self.probes.remove_near(x, y, radius=max(2.0, 12.0 * model.config.nx / max(1, self.viewport.lattice_rect().width())))
         else:
             try:
                 self.probes.add(x, y, model.config.nx, model.config.ny)
@@ -88,8 +90,8 @@ class ProbeController:
         self.plot.refresh(force=True)
 
     def show_marks(self):
-        self.w.viewport.probe_marks = [(p.x, p.y, probe_colour(k), str(k + 1)) for k, p in enumerate(self.probes)]
-        self.w.viewport.update()
+        self.viewport.probe_marks = [(p.x, p.y, probe_colour(k), str(k + 1)) for k, p in enumerate(self.probes)]
+        self.viewport.update()
 
     # --- each frame ---------------------------------------------------------------------------
     def sample_frame(self, field):

@@ -17,31 +17,41 @@ from feelflow.app.model.display_units import choice_to_dict
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.gui.window.frame_loop import FrameLoop
     from feelflow.app.model.replay_simulation import ReplaySimulation
+    from feelflow.app.model.simulation import Simulation
 
 
 class ReplayController:
     """Owns the replay (None while the live tunnel shows) and its status-bar label."""
 
-    def __init__(self, window: "MainWindow"):
+    def __init__(self, window: "MainWindow", viewport: "Viewport", loop: "FrameLoop"):
         self.w = window
+        self.viewport = viewport
+        self.loop = loop
+        self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
+        window.events.liveCreated.connect(self._live_created)
         self.replay: ReplaySimulation | None = None
         self.label = QLabel()   # "Replaying <name>: step N / M" (hidden by passing messages)
         window.statusBar().addWidget(self.label, 1)
         self.label.hide()
         self._full_said = False   # the recording's stop at the session bound has been shown
 
+    def _live_created(self, sim):
+        self.sim = sim
+
     # --- recording ----------------------------------------------------------------------------
     def toggle_recording(self, _=None):
         w = self.w
-        if w.sim is None:
+        if self.sim is None:
             return
-        solver = w.sim.solver
+        solver = self.sim.solver
         if self.refuse("recording is for the live tunnel"):
             w.actions.record.setChecked(solver.recorder is not None)
             return
         if solver.recorder is None:
-            solver.start_recording(renderer=w.viewport.renderer())
+            solver.start_recording(renderer=self.viewport.renderer())
             self._full_said = False
             w.actions.record.setChecked(True)
             w.statusBar().showMessage("Recording a session: inputs, parameter changes and forces.", 5000)
@@ -59,7 +69,7 @@ class ReplayController:
         """After each live frame: once the recording stopped at the most a session file may hold
         (SessionRecorder.full), say so in the status bar and on the Record action until it is
         saved; the tunnel runs on."""
-        rec = self.w.sim.solver.recorder if self.w.sim is not None else None
+        rec = self.sim.solver.recorder if self.sim is not None else None
         if rec is None or rec.full is None or self._full_said:
             return
         self._full_said = True
@@ -68,7 +78,7 @@ class ReplayController:
 
     # --- replaying ----------------------------------------------------------------------------
     def open_dialog(self, _=None):
-        if self.w.sim is None:
+        if self.sim is None:
             return
         path, _ = QFileDialog.getOpenFileName(self.w, "Replay session", "", "Sessions (*.ffsession)")
         if path:
@@ -78,9 +88,9 @@ class ReplayController:
         """Replay the session file at `path` in the window; a bad file is a one-line dialog and
         changes nothing. The live tunnel waits, untouched, until `stop`."""
         w = self.w
-        if w.sim is None:
+        if self.sim is None:
             return False
-        if w.sim.solver.recorder is not None:
+        if self.sim.solver.recorder is not None:
             QMessageBox.warning(w, "Could not replay the session",
                                 "A session is being recorded: stop the recording (File > Record session) first.")
             return False
@@ -112,7 +122,7 @@ class ReplayController:
         check_replay_memory(session, path)   # before any grid is allocated
         w = self.w
         w.make_current()
-        return ReplaySimulation(session, w.backend, ctx=w.viewport.ctx)
+        return ReplaySimulation(session, w.backend, ctx=self.viewport.ctx)
 
     def stop(self, _=None):
         """Back to the live tunnel exactly as it was when the replay began."""
@@ -121,15 +131,15 @@ class ReplayController:
             return
         w = self.w
         w.make_current()
-        w.events.shownChanged.emit(w.sim)
+        w.events.shownChanged.emit(self.sim)
         replay.close()
-        w.viewport.banner = None
+        self.viewport.banner = None
         self.label.hide()
         w.actions.replay_toolbar.hide()
         w.actions.stop_replay.setEnabled(False)
         w.actions.undo.setEnabled(w.undo.canUndo())
         w.actions.redo.setEnabled(w.undo.canRedo())
-        w.events.replayStopped.emit(w.loop.paused)
+        w.events.replayStopped.emit(self.loop.paused)
         w.statusBar().showMessage("Replay stopped: back to the live tunnel.", 4000)
 
     def close(self):
@@ -145,10 +155,10 @@ class ReplayController:
         where = f"step {r.step} / {r.total_steps}"
         if r.done:
             text = f"Replay of {r.name} finished at {where}: Stop replay (Esc) returns to the live tunnel."
-            self.w.viewport.banner = f"replay finished ({where})"
+            self.viewport.banner = f"replay finished ({where})"
         else:
             text = f"Replaying {r.name}: {where}" + (" (paused: space to run)" if r.paused else "")
-            self.w.viewport.banner = f"replay: {where}" + (", paused" if r.paused else "")
+            self.viewport.banner = f"replay: {where}" + (", paused" if r.paused else "")
         if r.player.diverged_at is not None:
             text += f"; the flow diverged at step {r.player.diverged_at}"
         self.label.setText(text)
@@ -163,9 +173,9 @@ class ReplayController:
         w.statusBar().showMessage(f"Replaying {r.name}: {why}. Stop replay (Esc) to return to the live tunnel.",
                                   6000)
         p = w.panel
-        if w.sim is not None:
-            p.show_params(w.sim.params, w.loop.display_mode)
-            for box, on in ((p.hold_still, w.sim.hold_still), (p.edit, w.viewport.editing)):
+        if self.sim is not None:
+            p.show_params(self.sim.params, self.loop.display_mode)
+            for box, on in ((p.hold_still, self.sim.hold_still), (p.edit, self.viewport.editing)):
                 box.blockSignals(True)
                 box.setChecked(on)
                 box.blockSignals(False)

@@ -20,6 +20,7 @@ from feelflow.solver.units import FLUIDS
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.model.simulation import Simulation
 
 REFRESH_MS = 500
 
@@ -71,6 +72,8 @@ class UnitsDialog(QDialog):
 class UnitsController:
     def __init__(self, window: "MainWindow"):
         self.w = window
+        self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
+        window.events.liveCreated.connect(self._live_created)
         self.choice = self._remembered()
         self.own_choice: UnitsChoice | None = None   # the user's choice while a replay shows the recorded one
         self.units = DisplayUnits()
@@ -78,6 +81,9 @@ class UnitsController:
         self.timer = QTimer(window)     # the physical reading follows the flow (wind, viscosity, body)
         self.timer.setInterval(REFRESH_MS)
         self.timer.timeout.connect(self.refresh)
+
+    def _live_created(self, sim):
+        self.sim = sim
 
     def _remembered(self) -> UnitsChoice:
         s = self.w.settings
@@ -119,7 +125,7 @@ class UnitsController:
             if self.own_choice is None:
                 self.own_choice = self.choice
             self.set_choice(recorded, remember=False)
-        elif model is self.w.sim and self.own_choice is not None:
+        elif model is self.sim and self.own_choice is not None:
             self.set_choice(self.own_choice)
 
     def default_size(self, fluid: str) -> float:

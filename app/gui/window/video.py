@@ -17,6 +17,8 @@ from feelflow.app.gui.window.dialogs import attempt
 
 if TYPE_CHECKING:
     from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.gui.window.frame_loop import FrameLoop
 
 LIVE_FPS = 25
 VIDEO_FILTER = "Video (*.mp4 *.gif)"
@@ -30,8 +32,10 @@ class VideoController:
     """The File menu's video entries; `job` is the session export running (or None), `live` the
     window's recording (or None)."""
 
-    def __init__(self, window: "MainWindow"):
+    def __init__(self, window: "MainWindow", viewport: "Viewport", loop: "FrameLoop"):
         self.w = window
+        self.viewport = viewport
+        self.loop = loop
         self.job = None
         self.progress: QProgressDialog | None = None
         self.live = None
@@ -89,7 +93,7 @@ class VideoController:
         check_output(out, "video", inputs=[session_path], force=force, hint="choose another name")
         session = load_session(session_path)
         backend = session.backend if session.backend in RENDER_BACKENDS else "numpy"
-        mode = self.w.loop.display_mode if self.w.loop.display_mode in ("speed", "vorticity", "pressure") else "speed"
+        mode = self.loop.display_mode if self.loop.display_mode in ("speed", "vorticity", "pressure") else "speed"
         render = SessionRender(session, out, backend=backend, steps_per_frame=steps_per_frame, width=width, mode=mode)
         return VideoExportJob(render, self.w)
 
@@ -124,7 +128,7 @@ class VideoController:
 
         def make():
             check_output(out, "video", force=force, hint="choose another name")
-            return LiveRecorder(self.w.viewport, out, LIVE_FPS)
+            return LiveRecorder(self.viewport, out, LIVE_FPS)
         live = attempt(self.w, make, "Could not record a video")
         if live is None:
             return False
