@@ -21,6 +21,7 @@ if TYPE_CHECKING:
     from feelflow.app.gui.window.frame_loop import FrameLoop
     from feelflow.app.model.replay_simulation import ReplaySimulation
     from feelflow.app.model.simulation import Simulation
+    from feelflow.app.model.tunnel import TunnelModel
 
 
 class ReplayController:
@@ -40,6 +41,11 @@ class ReplayController:
 
     def _live_created(self, sim):
         self.sim = sim
+
+    @property
+    def shown(self) -> "TunnelModel | None":
+        """What the viewport and the plot show: the replay while one runs, else the live tunnel."""
+        return self.replay if self.replay is not None else self.sim
 
     # --- recording ----------------------------------------------------------------------------
     def toggle_recording(self, _=None):
