@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from feelflow.shapes.cylinder import Cylinder
 from feelflow.solver import cpu_body
 from feelflow.solver.backend import SolverDiverged
 from feelflow.solver.body import make_body_state, window_margin
@@ -128,13 +127,12 @@ class CpuSolver(NumpySolver):
         return self._redo, self._link_arrays
 
     def _body_state(self, shape, velocity, omega, raster=None):
-        """As Solver._body_state, with the compiled raster of a cylinder and the compiled links
-        (solver/cpu_body.py: the same numbers, a fraction of the time per move)."""
+        """As Solver._body_state, with the compiled raster (a cylinder or a polygonal shape) and
+        the compiled links (solver/cpu_body.py: the same numbers, a fraction of the time per move)."""
         if shape is None:
             return None
         return make_body_state(shape, velocity, omega, self.config, window_margin(self._models.values()), raster,
-                               links=cpu_body.build_links,
-                               rasteriser=cpu_body.cylinder_raster if type(shape) is Cylinder else None)
+                               links=cpu_body.build_links, rasteriser=cpu_body.compiled_raster(shape))
 
     def _move_body(self, old, new) -> tuple[float, float]:
         """NumpySolver._move_body, compiled for the equilibrium refill (solver/cpu_body.py)."""

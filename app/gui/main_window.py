@@ -95,7 +95,8 @@ class MainWindow(QMainWindow):
         # controllers, and the events they tell each other (window/events.py)
         self.events = WindowEvents(self)
         vp, events, panel, plot, status = self.viewport, self.events, self.panel, self.plot, self.statusBar()
-        self.loop = loop = FrameLoop(self, vp)
+        self.loop = loop = FrameLoop(events, vp, panel, plot, status, self.status, self.make_current, self.params_now,
+                                     self)
         self.replays = replays = ReplayController(self, vp, loop)
         self.flow = FlowController(events, vp, loop, panel, plot, replays, status, self.make_current, self)
         self.bodies = BodyController(events, vp, loop, panel, self.undo, replays, self.flow, status,
