@@ -21,7 +21,7 @@ from feelflow.shapes.validation import (MAX_SIZE, check_extent, check_in_domain,
 #: points closer than this to an edge count as on the boundary (and so inside)
 BOUNDARY_TOLERANCE = 1e-9
 #: slack on the edge parameter so a link through a vertex is not missed by round-off
-_EDGE_SLACK = 1e-12
+EDGE_SLACK = 1e-12
 
 
 def polygon_area_centroid(vertices: np.ndarray) -> tuple[float, float, float]:
@@ -87,8 +87,8 @@ def link_edge_hit(px, py, dx, dy, ax, ay, ex, ey):
     with np.errstate(invalid="ignore", divide="ignore"):
         t = (wx * ey - wy * ex) / denom
         s = (wx * dy - wy * dx) / denom
-    hit = ((denom != 0.0) & (t > 0.0) & (t <= 1.0 + _EDGE_SLACK)
-           & (s >= -_EDGE_SLACK) & (s <= 1.0 + _EDGE_SLACK))
+    hit = ((denom != 0.0) & (t > 0.0) & (t <= 1.0 + EDGE_SLACK)
+           & (s >= -EDGE_SLACK) & (s <= 1.0 + EDGE_SLACK))
     return np.where(hit, t, np.inf)
 
 

@@ -8,7 +8,8 @@ quiet inlet's correction, walls b, body links a with the moving-wall term) into 
 `pre`, from the same post-collision state, sums the momentum exchange on the body links as it
 goes, collides again exactly the nodes that own such a population (a list of nodes and bit
 masks, rebuilt when the body's links change) and resets the solid nodes. Every operator is
-compiled: BGK, TRT and recursive-regularised BGK (with or without the Smagorinsky viscosity).
+compiled: BGK, TRT, recursive-regularised BGK and entropic KBC (the last two with or without the
+Smagorinsky viscosity).
 The moving body's cover/uncover bookkeeping and refill, the force models other than the
 momentum exchanges and the fields are the numpy backend's (this class is a NumpySolver whose
 step is compiled), so both compute the same numbers to float32 rounding
@@ -18,7 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from feelflow.solver import cpu_body
 from feelflow.solver.backend import SolverDiverged
+from feelflow.solver.body import make_body_state, window_margin
 from feelflow.solver.forces.momentum_exchange import ClassicMomentumExchange, GalileanMomentumExchange
 from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS
 from feelflow.solver.numpy_backend import NumpySolver, absorb_keep, relaxation_rates
@@ -69,7 +72,7 @@ class CpuSolver(NumpySolver):
         self._xs = xs
         self._target = np.zeros(ny, dt)  # the absorbing layer's target u_in(iy, t)
         self._fx, self._fy = (dt.type(v) for v in cfg.body_force)
-        smag = cfg.collision == "rr" and cfg.smagorinsky > 0
+        smag = cfg.collision in ("rr", "kbc") and cfg.smagorinsky > 0
         self._smag = float(smagorinsky_factor(cfg.smagorinsky)) if smag else 0.0
         self._advance = make_kernel(cfg.collision, bool(cfg.incompressible), keep is not None,
                                     tuple(cfg.body_force) != (0.0, 0.0), dt.name, smag)
@@ -118,33 +121,24 @@ class CpuSolver(NumpySolver):
         if self._redo is not None and links is self._mask_links:
             return self._redo, self._link_arrays
         if links is not None and len(links):
-            from feelflow.solver.cpu_body import redo_nodes
-
-            self._redo, self._link_arrays = redo_nodes(self._edge_nodes, self._edge_grid, links, b.window)
+            self._redo, self._link_arrays = cpu_body.redo_nodes(self._edge_nodes, self._edge_grid, links, b.window)
         else:
             self._redo, self._link_arrays = self._edge_nodes, (_EMPTY_I,) * 5 + (_EMPTY_F,) * 8
         self._mask_links = links
         return self._redo, self._link_arrays
 
     def _body_state(self, shape, velocity, omega, raster=None):
-        """As Solver._body_state, with the compiled raster of a cylinder and the compiled links
-        (solver/cpu_body.py: the same numbers, a fraction of the time per move)."""
+        """As Solver._body_state, with the compiled raster (a cylinder or a polygonal shape) and
+        the compiled links (solver/cpu_body.py: the same numbers, a fraction of the time per move)."""
         if shape is None:
             return None
-        from feelflow.shapes.cylinder import Cylinder
-        from feelflow.solver import cpu_body
-        from feelflow.solver.body import make_body_state, window_margin
-
         return make_body_state(shape, velocity, omega, self.config, window_margin(self._models.values()), raster,
-                               links=cpu_body.build_links,
-                               rasteriser=cpu_body.cylinder_raster if type(shape) is Cylinder else None)
+                               links=cpu_body.build_links, rasteriser=cpu_body.compiled_raster(shape))
 
     def _move_body(self, old, new) -> tuple[float, float]:
         """NumpySolver._move_body, compiled for the equilibrium refill (solver/cpu_body.py)."""
         if self.body_refill != "equilibrium":
             return super()._move_body(old, new)
-        from feelflow.solver import cpu_body
-
         return cpu_body.move_body(old, new, self.config, self.g, self.body_impulse)
 
     # --- stepping -------------------------------------------------------------

@@ -18,8 +18,10 @@ import numba
 import numpy as np
 
 from feelflow.shapes.base import BodyRaster
-from feelflow.shapes.cylinder import GRAZE
-from feelflow.solver.bouzidi import BodyLinks
+from feelflow.shapes.cylinder import GRAZE, Cylinder
+from feelflow.shapes.polygon import BOUNDARY_TOLERANCE, EDGE_SLACK, PolygonalShape
+from feelflow.solver.body import expand_box, union_box
+from feelflow.solver.bouzidi import BodyLinks, periodic_wrap
 from feelflow.solver.lattice import C, OPP, RHO0, W
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
@@ -62,7 +64,16 @@ def _cylinder_box(xc, yc, r, r2, graze, x0, y0, x1, y1):
                 t = c / (-half_b + math.sqrt(disc))
                 if t > 0.0 and t <= 1.0:
                     q[d, jy, jx] = t
-    for jy in range(h):      # a fluid -> solid link always crosses the boundary
+    _cut_every_link_into_solid(solid, q)
+    return solid, q
+
+
+@numba.njit(**_JIT)
+def _cut_every_link_into_solid(solid, q):
+    """shapes/raster.py `_cut_every_link_into_solid`: a fluid -> solid link always crosses the
+    boundary; where round-off at a vertex lost the crossing, the wall is at the solid node."""
+    h, w = solid.shape
+    for jy in range(h):
         for jx in range(w):
             if solid[jy, jx]:
                 continue
@@ -70,6 +81,100 @@ def _cylinder_box(xc, yc, r, r2, graze, x0, y0, x1, y1):
                 ty, tx = jy + _CYI[d], jx + _CXI[d]
                 if 0 <= ty < h and 0 <= tx < w and solid[ty, tx] and q[d, jy, jx] <= 0.0:
                     q[d, jy, jx] = 1.0
+
+
+@numba.njit(**_JIT)
+def _edge_distance(qx, qy, ax, ay, ex, ey):
+    """shapes/polygon.py `edge_distance` of one point and one edge."""
+    len2 = ex * ex + ey * ey
+    wx, wy = qx - ax, qy - ay
+    t = 0.0
+    if len2 > 0.0:
+        t = min(max((wx * ex + wy * ey) / len2, 0.0), 1.0)
+    return math.hypot(wx - t * ex, wy - t * ey)
+
+
+@numba.njit(**_JIT)
+def _polygon_box(world, edges, x0, y0, x1, y1, tolerance, slack):
+    """(box_solid, box_q) of a polygon (world vertices and edge vectors (n, 2)) over the box:
+    shapes/raster.py `_polygon_box` (scanline parity for the interior; each edge, cut into pieces
+    no longer than a cell, tested against the nodes of its 6 x 6 stencil; points within
+    `tolerance` of an edge count as inside; a link's first crossing wins) and
+    `_cut_every_link_into_solid`. Each (edge, node) pair is tested once: the pieces of an edge
+    come one after the other, so a node remembers the last edge that tested it."""
+    h, w = y1 - y0, x1 - x0
+    n = world.shape[0]
+    solid = np.zeros((h, w), np.bool_)
+    counts = np.zeros(w + 1, np.int64)
+    for r in range(h):       # interior: an odd number of crossings at x > node
+        qy = float(y0 + r)
+        for j in range(w + 1):
+            counts[j] = 0
+        for k in range(n):
+            ax, ay, ex, ey = world[k, 0], world[k, 1], edges[k, 0], edges[k, 1]
+            if (ay > qy) == ((ay + ey) > qy):
+                continue
+            xcross = ax + (qy - ay) * ex / ey
+            last = min(max(int(math.ceil(xcross)) - 1 - x0, -1), w - 1)
+            if last >= 0:
+                counts[last] += 1
+        parity = 0
+        for j in range(w - 1, -1, -1):
+            parity += counts[j]
+            solid[r, j] = parity % 2 == 1
+    band = math.sqrt(2.0) + 1e-9
+    q = np.empty((9, h, w))
+    seen = np.empty((h, w), np.int64)   # the last edge a node was tested against
+    for jy in range(h):
+        for jx in range(w):
+            for d in range(9):
+                q[d, jy, jx] = np.inf
+    for sweep in range(2):   # 0: boundary points inside; 1: links of fluid nodes near an edge
+        for jy in range(h):
+            for jx in range(w):
+                seen[jy, jx] = -1
+        for k in range(n):
+            ax, ay, ex, ey = world[k, 0], world[k, 1], edges[k, 0], edges[k, 1]
+            length = math.hypot(ex, ey)
+            if not length > 0.0:
+                continue
+            pieces = max(1, int(math.ceil(length / 1.0)))
+            for p in range(pieces):
+                frac = (p + 0.5) / pieces
+                bx = int(math.floor(ax + frac * ex)) - x0
+                by = int(math.floor(ay + frac * ey)) - y0
+                for jy in range(by - 2, by + 4):
+                    if jy < 0 or jy >= h:
+                        continue
+                    py = float(jy + y0)
+                    for jx in range(bx - 2, bx + 4):
+                        if jx < 0 or jx >= w or seen[jy, jx] == k:
+                            continue
+                        seen[jy, jx] = k
+                        px = float(jx + x0)
+                        dist = _edge_distance(px, py, ax, ay, ex, ey)
+                        if sweep == 0:
+                            if dist <= tolerance:
+                                solid[jy, jx] = True
+                            continue
+                        if solid[jy, jx] or not dist <= band:
+                            continue
+                        for d in range(1, 9):
+                            dx, dy = float(_CXI[d]), float(_CYI[d])
+                            denom = dx * ey - dy * ex
+                            if denom == 0.0:
+                                continue
+                            wx, wy = ax - px, ay - py
+                            t = (wx * ey - wy * ex) / denom
+                            s = (wx * dy - wy * dx) / denom
+                            if t > 0.0 and t <= 1.0 + slack and s >= -slack and s <= 1.0 + slack:
+                                q[d, jy, jx] = min(q[d, jy, jx], min(t, 1.0))
+    for d in range(9):
+        for jy in range(h):
+            for jx in range(w):
+                if q[d, jy, jx] == np.inf:
+                    q[d, jy, jx] = 0.0
+    _cut_every_link_into_solid(solid, q)
     return solid, q
 
 
@@ -94,17 +199,27 @@ def _raster_window(solid, q, x0, y0, nx, ny):
     return max(0, lo_x + x0), max(0, lo_y + y0), min(nx, hi_x + x0 + 1), min(ny, hi_y + y0 + 1)
 
 
-def cylinder_raster(shape, nx: int, ny: int) -> BodyRaster:
-    """shapes/raster.py `rasterise(shape, nx, ny, 0)` of a `Cylinder`, compiled."""
+def raster(shape, nx: int, ny: int) -> BodyRaster:
+    """shapes/raster.py `rasterise(shape, nx, ny, 0)` of a `Cylinder` or a polygonal shape
+    (`PolygonalShape`: polygon, plate, wedge, airfoils), compiled."""
     xmin, ymin, xmax, ymax = shape.bounding_box()
     x0, y0 = max(0, math.floor(xmin) - 1), max(0, math.floor(ymin) - 1)
     x1, y1 = min(nx, math.ceil(xmax) + 2), min(ny, math.ceil(ymax) + 2)
     if x0 >= x1 or y0 >= y1:
         return BodyRaster(np.zeros((0, 0), bool), np.zeros((9, 0, 0)), (0, 0, 0, 0), (nx, ny), (0, 0, 0, 0))
-    r = shape.radius
-    solid, q = _cylinder_box(float(shape.x), float(shape.y), r, r ** 2, (GRAZE * r) ** 2, x0, y0, x1, y1)
+    if isinstance(shape, PolygonalShape):
+        world, edges = shape.world_edges
+        solid, q = _polygon_box(world, edges, x0, y0, x1, y1, BOUNDARY_TOLERANCE, EDGE_SLACK)
+    else:
+        r = shape.radius
+        solid, q = _cylinder_box(float(shape.x), float(shape.y), r, r ** 2, (GRAZE * r) ** 2, x0, y0, x1, y1)
     window = tuple(int(v) for v in _raster_window(solid, q, x0, y0, nx, ny))
     return BodyRaster(solid, q, (x0, y0, x1, y1), (nx, ny), window)
+
+
+def compiled_raster(shape):
+    """`raster` where it has this shape's kind (a cylinder or a polygonal shape), else None."""
+    return raster if type(shape) is Cylinder or isinstance(shape, PolygonalShape) else None
 
 
 @numba.njit(**_JIT)
@@ -304,9 +419,6 @@ def _refill(g, x0, y0, old, new, xc, yc, vx, vy, omega, wrap_x, wrap_y, impulse)
 def move_body(old, new, config, g, impulse: str) -> tuple[float, float]:
     """solver/body.py `move_body` with the equilibrium refill, on the shifted state g (9, ny, nx)
     in place, compiled. Returns the impulse (Jx, Jy)."""
-    from feelflow.solver.body import expand_box, union_box
-    from feelflow.solver.bouzidi import periodic_wrap
-
     box = union_box(old.raster.window if old else None, new.raster.window if new else None)
     if box is None:
         return 0.0, 0.0

@@ -4,7 +4,8 @@ collide pass over the grid (rows in parallel) and one serial pass over what the 
 docs/science/algorithm.md, steps 1-3, and docs/science/cpu-backend.md. The collision is node by
 node that of solver/collision.py (BGK, Bhatnagar, Gross & Krook 1954; TRT, Ginzburg, Verhaeghe &
 d'Humieres 2008) or of solver/regularised.py (recursive-regularised BGK, Malaspinas 2015, Coreixas
-et al. 2017, with the optional Smagorinsky viscosity), with Guo, Zheng & Shi (2002) forcing, the
+et al. 2017, with the optional Smagorinsky viscosity) or of solver/kbc.py (entropic KBC, Karlin,
+Boesch & Chikatamarla 2014, likewise), with Guo, Zheng & Shi (2002) forcing, the
 compressible or He & Luo (1997) equilibrium and the outlet sponge's per-column rates and
 absorbing layer (solver/sponge.py). The boundary pass writes what rules d, c, b and a write in
 the numpy backend (solver/inflow.py's outlet and inlet, solver/quiet_inlet.py, the walls,
@@ -196,6 +197,86 @@ def _collide_rr(f0, f1, f2, f3, f4, f5, f6, f7, f8, omega, keep, target, incomp,
 
 
 @numba.njit(inline="always", **_JIT)
+def _kbc_node(b, o, k, omega, keep, target, incomp, has_keep, Fx, Fy, has_force, smag):
+    """Entropic KBC (solver/kbc.py: Karlin, Boesch & Chikatamarla 2014) of node k's gathered
+    populations b[:, k] into o[:, k], in float64 (the numpy reference mixes float32 storage with
+    float64 weights); smag > 0 only in the Smagorinsky variant. Two passes over the directions:
+    the first writes Delta h into o and sums the entropic products <Delta s|Delta h>,
+    <Delta h|Delta h>; the second the post-collision state. Returns drho."""
+    drho = 0.0
+    jx = 0.0
+    jy = 0.0
+    exx = 0.0
+    eyy = 0.0
+    exy = 0.0
+    for i in range(9):
+        v = np.float64(b[i, k])
+        drho += v
+        jx += _CX[i] * v
+        jy += _CY[i] * v
+        exx += _CX[i] * _CX[i] * v
+        eyy += _CY[i] * _CY[i] * v
+        exy += _CX[i] * _CY[i] * v
+    rho = R0 if incomp else R0 + drho
+    fx = np.float64(Fx)
+    fy = np.float64(Fy)
+    ux = (jx + 0.5 * fx) / rho
+    uy = (jy + 0.5 * fy) / rho
+    deq = drho
+    if has_keep:   # absorbing layer (solver/sponge.py)
+        kp = np.float64(keep)
+        deq = drho * kp
+        ux = kp * ux + (1.0 - kp) * np.float64(target)
+        uy = kp * uy
+    om = np.float64(omega)
+    a0 = drho - deq
+    a1x = jx - rho * ux
+    a1y = jy - rho * uy
+    n_diff = (exx - eyy) - rho * (ux * ux - uy * uy)
+    pxy = exy - rho * ux * uy
+    if smag > 0:
+        pxx = exx - deq / 3.0 - rho * ux * ux
+        pyy = eyy - deq / 3.0 - rho * uy * uy
+        stress = math.sqrt(pxx * pxx + pyy * pyy + 2.0 * pxy * pxy)
+        tau0 = 1.0 / om
+        om = 1.0 / (0.5 * (tau0 + math.sqrt(tau0 * tau0 + np.float64(smag) * stress / (drho + R0))))
+    beta = 0.5 * om
+    rho_uxy = rho * ux * uy
+    eq_xxy = rho_uxy * ux
+    eq_xyy = rho_uxy * uy
+    base = deq - 1.5 * rho * (ux * ux + uy * uy)
+    sh = 0.0
+    hh = 0.0
+    for i in range(9):
+        cx, cy, w = _CX[i], _CY[i], _W[i]
+        cu = 3.0 * (cx * ux + cy * uy)
+        feq = w * (base + rho * (cu + 0.5 * cu * cu) + 13.5 * (cy * cy - 1.0 / 3.0) * cx * eq_xyy
+                   + 13.5 * (cx * cx - 1.0 / 3.0) * cy * eq_xxy)
+        dk = w * (a0 + 3.0 * (cx * a1x + cy * a1y))
+        ds = 0.25 * cx * cy * pxy + 0.25 * (cx * cx - cy * cy) * n_diff
+        dh = np.float64(b[i, k]) - feq - dk - ds
+        inv = 1.0 / (feq + w * R0)
+        sh += ds * dh * inv
+        hh += dh * dh * inv
+        o[i, k] = dh
+    gamma = 1.0 / beta - (2.0 - 1.0 / beta) * sh / hh if hh > 1e-30 else 2.0
+    step = beta * gamma
+    src = 1.0 - 0.5 * om
+    uF = ux * fx + uy * fy
+    for i in range(9):
+        cx, cy, w = _CX[i], _CY[i], _W[i]
+        dk = w * (a0 + 3.0 * (cx * a1x + cy * a1y))
+        ds = 0.25 * cx * cy * pxy + 0.25 * (cx * cx - cy * cy) * n_diff
+        v = np.float64(b[i, k]) - om * dk - 2.0 * beta * ds - step * np.float64(o[i, k])
+        if has_force:
+            cF = cx * fx + cy * fy
+            cu = 3.0 * (cx * ux + cy * uy)
+            v += src * w * (3.0 * cu * cF - 3.0 * uF + 3.0 * cF)
+        o[i, k] = v
+    return drho
+
+
+@numba.njit(inline="always", **_JIT)
 def _store(out, y, x, r):
     out[0, y, x] = r[0]
     out[1, y, x] = r[1]
@@ -263,6 +344,25 @@ def _chunk_rr(b, o, n, op, t, incomp, Fx, Fy, has_force, smag, K):
                         op, op, t, incomp, False, Fx, Fy, has_force, smag, K)
         _store_k(o, k, r)
         s += r[9]
+    return s
+
+
+@numba.njit(inline="always", **_JIT)
+def _chunk_kbc(b, o, n, op, t, incomp, Fx, Fy, has_force, smag):
+    """As _chunk for the entropic KBC operator."""
+    s = 0.0
+    for k in range(n):
+        s += _kbc_node(b, o, k, op, op, t, incomp, False, Fx, Fy, has_force, smag)
+    return s
+
+
+@numba.njit(inline="always", **_JIT)
+def _columns_kbc(b, o, n, cols, op, keep, t, incomp, has_keep, Fx, Fy, has_force, smag):
+    """As _columns for the entropic KBC operator."""
+    s = 0.0
+    for k in range(n):
+        x = cols[k]
+        s += _kbc_node(b, o, k, op[x], keep[x], t, incomp, has_keep, Fx, Fy, has_force, smag)
     return s
 
 
@@ -443,12 +543,13 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
     Its closure holds only these flags and constants, never another compiled function: numba's
     on-disk cache keys a closure by its variables' pickled bytes, and a compiled function pickles
     with an id that is new in every process, so such a closure would compile again at every start."""
-    if kind not in ("bgk", "trt", "rr"):
-        raise ValueError(f"the cpu backend compiles bgk, trt and rr, not {kind!r}")
+    if kind not in ("bgk", "trt", "rr", "kbc"):
+        raise ValueError(f"the cpu backend compiles bgk, trt, rr and kbc, not {kind!r}")
     K = constants(dtype)
     rr = kind == "rr"   # the closure's branches on these constants are pruned before inlining,
     trt = kind == "trt"  # so each variant compiles one operator
-    smag_on = bool(smagorinsky) and rr
+    kbc = kind == "kbc"
+    smag_on = bool(smagorinsky) and (rr or kbc)
 
     @numba.njit(parallel=True, **_JIT)
     def advance(n, t0, ramp_steps, g, out, pre, op, om, keep, target, xs, Fx, Fy, smag, scratch, sums,
@@ -510,6 +611,8 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                         if x0 < xs:        # the rates of column 1 for the whole chunk
                             if rr:
                                 s += _chunk_rr(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm, K)
+                            elif kbc:
+                                s += _chunk_kbc(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm)
                             else:
                                 s += _chunk(bb, o, m, op0, om0, tg, trt, incomp, Fx, Fy, has_force, K)
                         else:              # each column its own rates (the sponge)
@@ -517,6 +620,8 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                             if rr:
                                 s += _columns_rr(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force,
                                                  sm, K)
+                            elif kbc:
+                                s += _columns_kbc(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force, sm)
                             else:
                                 s += _columns(bb, o, m, c, op, om, keep, tg, trt, incomp, has_keep, Fx, Fy,
                                               has_force, K)
@@ -536,6 +641,8 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                 if rr:
                     total += _columns_rr(bb, o, 1, c, op, keep, target[y], incomp, has_keep, Fx, Fy, has_force,
                                          sm, K)
+                elif kbc:
+                    total += _columns_kbc(bb, o, 1, c, op, keep, target[y], incomp, has_keep, Fx, Fy, has_force, sm)
                 else:
                     total += _columns(bb, o, 1, c, op, om, keep, target[y], trt, incomp, has_keep, Fx, Fy,
                                       has_force, K)
@@ -550,3 +657,139 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
         return n, True
 
     return advance
+
+
+# --- the AA streaming pattern, measured against the two buffers above --------------------------
+@numba.njit(inline="always", **_JIT)
+def _gather_aa(g, b, y, ym, yp, x0, n):
+    """The odd AA step's reads: b[i, k] = g[opp(i), y - c_iy, x - c_ix] at x = x0 + k, the
+    population the last (even) step stored at the node it came from, 1 <= x0, x0 + n < nx."""
+    x1 = x0 + n
+    b[0, :n] = g[0, y, x0:x1]
+    b[1, :n] = g[3, y, x0 - 1:x1 - 1]
+    b[2, :n] = g[4, ym, x0:x1]
+    b[3, :n] = g[1, y, x0 + 1:x1 + 1]
+    b[4, :n] = g[2, yp, x0:x1]
+    b[5, :n] = g[7, ym, x0 - 1:x1 - 1]
+    b[6, :n] = g[8, ym, x0 + 1:x1 + 1]
+    b[7, :n] = g[5, yp, x0 + 1:x1 + 1]
+    b[8, :n] = g[6, yp, x0 - 1:x1 - 1]
+
+
+@numba.njit(inline="always", **_JIT)
+def _scatter_aa(g, o, y, ym, yp, x0, n):
+    """The odd AA step's writes: g[i, y + c_iy, x + c_ix] = o[i, k], the very places its reads
+    came from (so each node touches its own nine places and the step runs in place)."""
+    x1 = x0 + n
+    g[0, y, x0:x1] = o[0, :n]
+    g[1, y, x0 + 1:x1 + 1] = o[1, :n]
+    g[2, yp, x0:x1] = o[2, :n]
+    g[3, y, x0 - 1:x1 - 1] = o[3, :n]
+    g[4, ym, x0:x1] = o[4, :n]
+    g[5, yp, x0 + 1:x1 + 1] = o[5, :n]
+    g[6, yp, x0 - 1:x1 - 1] = o[6, :n]
+    g[7, ym, x0 - 1:x1 - 1] = o[7, :n]
+    g[8, ym, x0 + 1:x1 + 1] = o[8, :n]
+
+
+@numba.njit(inline="always", **_JIT)
+def _seam_aa(g, b, o, y, ym, yp, x, op, om, trt, K):
+    """The odd AA step at one node of the first or last column (periodic neighbours)."""
+    nx = g.shape[2]
+    xm = x - 1 if x > 0 else nx - 1
+    xp = x + 1 if x < nx - 1 else 0
+    b[0, 0] = g[0, y, x]
+    b[1, 0] = g[3, y, xm]
+    b[2, 0] = g[4, ym, x]
+    b[3, 0] = g[1, y, xp]
+    b[4, 0] = g[2, yp, x]
+    b[5, 0] = g[7, ym, xm]
+    b[6, 0] = g[8, ym, xp]
+    b[7, 0] = g[5, yp, xp]
+    b[8, 0] = g[6, yp, xm]
+    s = _chunk(b, o, 1, op, om, K[0] * 0, trt, False, K[0] * 0, K[0] * 0, False, K)
+    g[0, y, x] = o[0, 0]
+    g[1, y, xp] = o[1, 0]
+    g[2, yp, x] = o[2, 0]
+    g[3, y, xm] = o[3, 0]
+    g[4, ym, x] = o[4, 0]
+    g[5, yp, xp] = o[5, 0]
+    g[6, yp, xm] = o[6, 0]
+    g[7, ym, xm] = o[7, 0]
+    g[8, ym, xp] = o[8, 0]
+    return s
+
+
+@functools.lru_cache(maxsize=None)
+def make_box_aa(kind: str = "trt", dtype: str = "float32"):
+    """`advance_aa`: the periodic box (BGK or TRT, no force, no sponge) stepped in place in ONE
+    buffer with the AA pattern (Bailey, Myre, Walsh, Lilja & Saar 2009, "Accelerating lattice
+    Boltzmann fluid flow simulations using graphics processors"), for `feelflow bench streaming`
+    to measure against the two-buffer kernel above (docs/science/cpu-backend.md). Not used by
+    the solver backends.
+
+    The state between steps is the pre-collision populations f_i(x) in natural order after an
+    odd number of AA steps' pairs (an "even" state). An even step collides each node in place
+    and stores f*_i in slot opp(i) of the same node; an odd step reads each node's incoming
+    populations from the slots the even step filled at its neighbours, collides, and writes
+    f*_i to slot i of node x + c_i: streamed, in natural order again. Each node of either step
+    reads and writes the same nine places, which no other node touches, so the rows run in
+    parallel without a second buffer. After two AA steps the buffer holds what streaming the
+    two-buffer kernel's state (post-collision) gives after two steps."""
+    if kind not in ("bgk", "trt"):
+        raise ValueError(f"the AA box kernel compiles bgk and trt, not {kind!r}")
+    K = constants(dtype)
+    trt = kind == "trt"
+
+    @numba.njit(parallel=True, **_JIT)
+    def advance_aa(n, odd, g, op, om, scratch, sums):
+        """n AA steps in place on g (9, ny, nx), the first an odd step if `odd`; op, om the
+        rates; scratch (B, 2, 9, CHUNK), sums (B,). Returns (steps done, finite) as `advance`."""
+        ny, nx = g.shape[1], g.shape[2]
+        nb = scratch.shape[0]
+        per = (ny + nb - 1) // nb
+        zero = K[0] * 0
+        for step in range(n):
+            is_odd = (step + odd) % 2 == 1
+            for blk in prange(nb):
+                bb = scratch[blk, 0]
+                o = scratch[blk, 1]
+                s = 0.0
+                for y in range(blk * per, min(ny, (blk + 1) * per)):
+                    ym = y - 1 if y > 0 else ny - 1
+                    yp = y + 1 if y < ny - 1 else 0
+                    if is_odd:
+                        s += _seam_aa(g, bb, o, y, ym, yp, 0, op, om, trt, K)
+                        x0 = 1
+                        while x0 < nx - 1:
+                            m = min(CHUNK, nx - 1 - x0)
+                            _gather_aa(g, bb, y, ym, yp, x0, m)
+                            s += _chunk(bb, o, m, op, om, zero, trt, False, zero, zero, False, K)
+                            _scatter_aa(g, o, y, ym, yp, x0, m)
+                            x0 += m
+                        if nx > 1:
+                            s += _seam_aa(g, bb, o, y, ym, yp, nx - 1, op, om, trt, K)
+                    else:
+                        x0 = 0
+                        while x0 < nx:
+                            m = min(CHUNK, nx - x0)
+                            x1 = x0 + m
+                            for i in range(9):
+                                bb[i, :m] = g[i, y, x0:x1]
+                            s += _chunk(bb, o, m, op, om, zero, trt, False, zero, zero, False, K)
+                            g[0, y, x0:x1] = o[0, :m]
+                            g[3, y, x0:x1] = o[1, :m]
+                            g[4, y, x0:x1] = o[2, :m]
+                            g[1, y, x0:x1] = o[3, :m]
+                            g[2, y, x0:x1] = o[4, :m]
+                            g[7, y, x0:x1] = o[5, :m]
+                            g[8, y, x0:x1] = o[6, :m]
+                            g[5, y, x0:x1] = o[7, :m]
+                            g[6, y, x0:x1] = o[8, :m]
+                            x0 = x1
+                sums[blk] = s
+            if not np.isfinite(sums.sum()):
+                return step + 1, False
+        return n, True
+
+    return advance_aa

@@ -2,8 +2,9 @@
 (solver/cpu_body.py) equals the numpy reference (solver/body.py, solver/bouzidi.py,
 shapes/raster.py).
 
-- the compiled raster and links equal the reference bit for bit, at poses on and just off a
-  node row, across a cell edge, against the domain's edge, and across a periodic seam;
+- the compiled raster (cylinders, plates, wedges, airfoils, polygons) and links equal the
+  reference bit for bit, at poses on and just off a node row, across a cell edge, against the
+  domain's edge, and across a periodic seam;
 - a move's refill over its window (both poses' raster windows grown by a node) equals the same
   refill over the whole grid, for a sub-cell move, a fast jump of several cells (a window cut
   to the new pose alone would leave the old pose's nodes solid) and beside a wall;
@@ -16,7 +17,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from feelflow.shapes import Cylinder
+from feelflow.shapes import Cylinder, FlatPlate, Polygon
+from feelflow.shapes.naca import NacaAirfoil
+from feelflow.shapes.polygon import HalfAirfoil, Wedge
 from feelflow.shapes.raster import rasterise
 from feelflow.solver import cpu_body
 from feelflow.solver.body import expand_box, make_body_state, move_body, refill, shifted, unshifted
@@ -41,7 +44,7 @@ def _random_poses(n=20, seed=7):
 def test_compiled_cylinder_raster_and_links_equal_the_reference(pose):
     x, y, d = pose
     shape = Cylinder(d, x=x, y=y)
-    ref, fast = rasterise(shape, NX, NY, 0), cpu_body.cylinder_raster(shape, NX, NY)
+    ref, fast = rasterise(shape, NX, NY, 0), cpu_body.raster(shape, NX, NY)
     assert (fast.box, fast.window) == (ref.box, ref.window)
     assert np.array_equal(fast.box_solid, ref.box_solid) and np.array_equal(fast.box_q, ref.box_q)
     window = expand_box(ref.window, 2, NX, NY)
@@ -54,12 +57,38 @@ def test_compiled_cylinder_raster_and_links_equal_the_reference(pose):
             assert np.array_equal(getattr(a, name), getattr(b, name)), name
 
 
+def _polygonal_shapes():
+    """Each polygonal kind at random poses and angles, and on node rows and at 45 degrees."""
+    rng = np.random.default_rng(11)
+    out = [FlatPlate(10.0, 1.0, x=40.0, y=30.0), FlatPlate(10.0, 1.0, x=40.5, y=30.5, angle=np.pi / 4),
+           Polygon(np.array([[0, 0], [8, 0], [8, 8], [0, 8]], float), x=40.0, y=30.0),
+           Polygon(np.array([[0, 0], [8, 0], [8, 8], [0, 8]], float), x=3.0, y=2.0)]
+    for _ in range(4):
+        x, y, a = rng.uniform(20, 76), rng.uniform(16, 48), rng.uniform(-3.2, 3.2)
+        th = np.sort(rng.uniform(0, 2 * np.pi, 9))
+        r = rng.uniform(4, 12, 9)
+        out += [FlatPlate(rng.uniform(3, 30), rng.uniform(0.1, 2.0), x=x, y=y, angle=a),
+                Wedge(rng.uniform(5, 25), rng.uniform(0.3, 1.5), x=x, y=y, angle=a),
+                HalfAirfoil(rng.uniform(10, 30), rng.uniform(0.05, 0.3), x=x, y=y, angle=a),
+                NacaAirfoil(rng.uniform(10, 30), 0.12, camber=0.04, x=x, y=y, angle=a),
+                Polygon(np.column_stack([r * np.cos(th), r * np.sin(th)]), x=x, y=y, angle=a)]
+    return out
+
+
+@pytest.mark.parametrize("shape", _polygonal_shapes(), ids=lambda s: s.kind)
+def test_compiled_polygon_raster_equals_the_reference(shape):
+    ref, fast = rasterise(shape, NX, NY, 0), cpu_body.raster(shape, NX, NY)
+    assert (fast.box, fast.window) == (ref.box, ref.window)
+    assert np.array_equal(fast.box_solid, ref.box_solid) and np.array_equal(fast.box_q, ref.box_q)
+    assert ref.box_q.any()
+
+
 def test_compiled_links_across_a_periodic_seam():
     """A window that spans the periodic x direction whole takes second nodes across the seam."""
     cfg = FlowConfig(nx=16, ny=32, x_boundary="periodic", y_boundary="periodic")
     ref = make_body_state(Cylinder(14.0, x=7.6, y=16.4), (0.02, 0.0), 0.0, cfg, 2)
     fast = make_body_state(Cylinder(14.0, x=7.6, y=16.4), (0.02, 0.0), 0.0, cfg, 2,
-                           links=cpu_body.build_links, rasteriser=cpu_body.cylinder_raster)
+                           links=cpu_body.build_links, rasteriser=cpu_body.raster)
     assert periodic_wrap(cfg, ref.window)[0]
     assert (ref.links.fx != ref.links.ix + C[ref.links.i, 0]).any()   # some second node wraps
     for name in LINK_FIELDS:

@@ -55,7 +55,8 @@ def test_cpu_colouring_matches_the_display_shader(gl_context, mode):
     import moderngl
 
     from feelflow.app.gui import cpu_field
-    from feelflow.app.gui.viewport import DISPLAY_MODES, display_program
+    from feelflow.app.gui.field_colours import display_program
+    from feelflow.app.gui.viewport import DISPLAY_MODES
 
     ctx = gl_context
     nx, ny = 64, 32

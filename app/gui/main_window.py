@@ -1,7 +1,8 @@
 """The FeelFlow window: the wind-tunnel viewport in the middle, the side panel, the live force
 plot below, the status bar; assembly only. What the window does lives in its controllers,
-app/gui/window/, one module per concept, each an object given the viewport and the frame loop
-it works on at construction, the live tunnel through `events.liveCreated`, and the window:
+app/gui/window/, one module per concept, each an object given what it works on at construction
+(the window itself only where it needs the menus' actions or the docks) and the live tunnel
+through `events.liveCreated`:
 
     window.store    settings.py    WindowSettings: remembered parameters, polygon, mode, geometry
     window.actions  menus.py       the menus, shortcuts and replay toolbar (`build_menus`)
@@ -24,7 +25,7 @@ through `TunnelModel.drive`.
 
 To add a menu entry: one `add_action(menu, text, slot, shortcut)` line in
 app/gui/window/menus.py `build_menus`, with `slot` a controller's method. To add a controller:
-a module in app/gui/window/ with a class taking the window and what it works on; create it in `MainWindow.__init__`
+a module in app/gui/window/ with a class taking what it works on; create it in `MainWindow.__init__`
 under "controllers" (before `build_menus`, so menus can point at it), connect the widgets'
 signals to it in `_connect`, and list it above.
 """
@@ -93,19 +94,22 @@ class MainWindow(QMainWindow):
 
         # controllers, and the events they tell each other (window/events.py)
         self.events = WindowEvents(self)
-        vp = self.viewport
-        self.loop = loop = FrameLoop(self, vp)
-        self.replays = ReplayController(self, vp, loop)
-        self.inputs = InputController(self, vp)
-        self.bodies = BodyController(self, vp, loop)
-        self.flow = FlowController(self, vp, loop)
-        self.exports = ExportController(self, vp)
-        self.lessons = LessonController(self, vp, loop)
+        vp, events, panel, plot, status = self.viewport, self.events, self.panel, self.plot, self.statusBar()
+        self.loop = loop = FrameLoop(events, vp, panel, plot, status, self.status, self.make_current, self.params_now,
+                                     self)
+        self.replays = replays = ReplayController(self, vp, loop)
+        self.flow = FlowController(events, vp, loop, panel, plot, replays, status, self.make_current, self)
+        self.bodies = BodyController(events, vp, loop, panel, self.undo, replays, self.flow, status,
+                                     self.make_current, self)
+        self.inputs = InputController(events, vp, panel, replays, self.bodies, status, self)
+        self.exports = ExportController(events, vp, plot, replays, self.bodies, self)
+        self.lessons = LessonController(events, vp, loop, panel, plot, self.undo, replays, self.flow, self.bodies,
+                                        status, self.make_current)
         self.video = VideoController(self, vp, loop)
         self.probes = ProbeController(self, vp)
         self.plot.probes = self.probes.probes   # the forces CSV carries the probes' columns
-        self.units = UnitsController(self)
-        self.backends = BackendController(self, vp, backend)   # "auto": measured once the context exists
+        self.units = UnitsController(events, self.settings, panel, plot, self.probes, replays, status, self)
+        self.backends = BackendController(self.settings, vp, status, backend)   # "auto": measured once the context exists
         self.exercises = ExerciseController(self, vp, loop)   # the Exercises menu and panel
         self.actions = build_menus(self)
 
@@ -156,8 +160,7 @@ class MainWindow(QMainWindow):
     @property
     def shown(self) -> TunnelModel | None:
         """What the viewport and the plot show: the replay while one runs, else the live tunnel."""
-        replay = self.replays.replay
-        return replay if replay is not None else self.sim
+        return self.replays.shown
 
     def params_now(self) -> Params:
         return self.sim.params if self.sim is not None else self.params
@@ -178,7 +181,7 @@ class MainWindow(QMainWindow):
     def on_context(self, ctx):
         from feelflow.solver.backend import BackendError
 
-        self.backend = self.backends.resolve(ctx)
+        self.backend = self.backends.resolve(ctx, self.params.grid)
         try:
             self._create_simulation(ctx)
         except (BackendError, RuntimeError) as exc:

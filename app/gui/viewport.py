@@ -1,51 +1,30 @@
-"""The wind tunnel view: a plain (raster) widget with an OpenGL context of its own on an
-offscreen surface. Its moderngl context colours the flow field (shaders/display*.glsl,
-colormaps from pyqtgraph) into a framebuffer that is read back and drawn with QPainter, with
-the overlay (app/gui/overlay.py: body, force arrows, tracers, colour bar, notes, the polygon
-editor's handles and the rotation handle) painted on top; and the mouse: dragging the body, the
-polygon editor, the rotation handle (app/gui/turn_handle.py) and the wheel, each a signal to
-the window. The gl solver runs on the same context (`makeCurrent`).
-
-Why not a QOpenGLWidget: with one in the window, Qt composites the whole window through OpenGL
-on every frame; on a machine without a GPU (llvmpipe) that took half or more of each frame
-(docs/science/performance.md, "The window"). Reading back the coloured field (a few MB a
-frame) costs far less, and on a GPU the frame already waits for the solver's own read-back.
-
-GL rules kept here: enable_only(NOTHING) before any pass, every texture bound before every draw.
+"""The wind tunnel view: a plain (raster) widget that draws the flow field coloured on the GPU
+(app/gui/field_colours.py: an OpenGL context of its own on an offscreen surface, the picture
+read back) with QPainter, the overlay (app/gui/overlay.py: body, force arrows, tracers, colour
+bar, notes, the polygon editor's handles and the rotation handle) painted on top; and the
+mouse: dragging the body, the polygon editor, the rotation handle (app/gui/turn_handle.py) and
+the wheel, each a signal to the window. The gl solver runs on the same context (`makeCurrent`).
 """
 from __future__ import annotations
 
 import math
-import sys
 
-import moderngl
 import numpy as np
-import pyqtgraph as pg
 from PySide6.QtCore import QEvent, QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QImage, QOffscreenSurface, QOpenGLContext, QPainter, QPolygonF
+from PySide6.QtGui import QImage, QPainter, QPolygonF
 from PySide6.QtWidgets import QToolTip, QWidget
 
 from feelflow.app.gui import turn_handle
 from feelflow.app.gui.cpu_field import BACKGROUND
-from feelflow.app.gui.first_start import required_gl
 from feelflow.app.gui.display_modes import COLOUR_BAR_MARGIN, DISPLAY_MODES
+from feelflow.app.gui.field_colours import FieldColours
 from feelflow.app.gui.overlay import Overlay
 from feelflow.app.model.tunnel import TunnelModel
 from feelflow.solver import units
-from feelflow.solver.gl_programs import create_program
-
-LITTLE_ENDIAN = sys.byteorder == "little"
 WHEEL_DEG_PER_NOTCH = 2.0  # one notch of the mouse wheel (120 eighths of a degree) turns the body this far
 MOUSE_HINT = ("Drag the body to move it; drag its round handle or turn the mouse wheel to rotate it "
               "(hold Shift for 15\u00b0 steps).")
 HANDLE_HINT = "Drag to rotate the body about its reference point (Shift: 15\u00b0 steps); the mouse wheel rotates it too."
-
-
-def display_program(ctx):
-    """The display program (shaders/display_vertex.glsl + display.glsl) on `ctx`, loaded as
-    every shader is (solver/gl_programs.py: the lattice constants injected, the driver's line
-    numbers kept, a compile error a ShaderError naming the file and line)."""
-    return create_program(ctx, "display_vertex.glsl", "display.glsl")
 
 
 class Viewport(QWidget):
@@ -68,7 +47,7 @@ class Viewport(QWidget):
     def __init__(self, parent=None):
         super().__init__(parent)
         self.sim: TunnelModel | None = None
-        self.ctx = None
+        self.colours = FieldColours(self)   # the GL context and the field's colouring pass
         self.mode = "speed"
         self.show_arrows = True
         self.editing = False
@@ -79,7 +58,6 @@ class Viewport(QWidget):
         self.torque_arc = None         # degrees of the turn handle's torque arc (readouts.torque_arc)
         self.tracers = None
         self.frames = 0
-        self.field_texture = None
         self.rho_ref = 1.0             # free-stream density for the pressure view (set by the window)
         self.locked = False            # True while a replay shows: the mouse does not move the body
         self.banner = None             # a line painted over the field (the replay's progress)
@@ -90,10 +68,7 @@ class Viewport(QWidget):
         self._turn = None              # the handle's drag in progress (turn_handle.Turn)
         self._hover = None             # "handle", "body" or "near" (the handle shows), or None
         self.overlay = Overlay(self)
-        self._gl = self._surface = None   # the QOpenGLContext and its offscreen surface
         self._gl_tried = False
-        self._image_fbo = None         # where display.glsl colours the field for the paint event
-        self._pixels = None
         self._outline_cache = None     # (shape, lattice rectangle, QPolygonF) of body_outline_points
         self.setAttribute(Qt.WA_OpaquePaintEvent)   # paintEvent fills every pixel
         self.setMinimumSize(480, 260)
@@ -110,25 +85,26 @@ class Viewport(QWidget):
             self.initializeGL()
 
     def initializeGL(self):
-        """An OpenGL context of its own on an offscreen surface (the default surface format,
-        app/cli/commands/gui.py), and the moderngl context on it; contextFailed where there is
-        none of OpenGL 3.3."""
-        gl = QOpenGLContext(self)
-        surface = QOffscreenSurface(None, self)
+        """The GL context (FieldColours.create); contextFailed where there is none of OpenGL
+        3.3, else the display program and contextReady."""
         try:
-            if not gl.create():
-                raise RuntimeError("Qt could not create an OpenGL context")
-            surface.setFormat(gl.format())
-            surface.create()
-            if not gl.makeCurrent(surface):
-                raise RuntimeError("Qt could not make its OpenGL context current")
-            self._gl, self._surface = gl, surface
-            self.ctx = moderngl.create_context(require=required_gl())
+            self.colours.create()
         except Exception as exc:   # moderngl.Error and friends: say so, never a traceback
-            self.ctx = None        # the window then draws on the CPU (app/gui/cpu_field.py)
+            self.colours.ctx = None   # the window then draws on the CPU (app/gui/cpu_field.py)
             self.contextFailed.emit(f"OpenGL 3.3 is not available here ({str(exc).splitlines()[0]})")
             return
-        self._init_programs()
+        self.colours.prepare()
+        self.contextReady.emit(self.ctx)
+
+    @property
+    def ctx(self):
+        """The moderngl context (FieldColours), or None before it exists or without OpenGL 3.3."""
+        return self.colours.ctx
+
+    @property
+    def field_texture(self):
+        """The texture drawn: the numpy path's upload or the gl solver's own, or None."""
+        return self.colours.field_texture
 
     @property
     def edit_preview(self):
@@ -147,48 +123,22 @@ class Viewport(QWidget):
 
     def makeCurrent(self):
         """The viewport's GL context current (the gl solver draws with it too)."""
-        if self._gl is not None:
-            self._gl.makeCurrent(self._surface)
-
-    def _init_programs(self):
-        self.program = display_program(self.ctx)
-        self.vao = self.ctx.vertex_array(self.program, [])
-        self._sampler = self.ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False)
-        self._lut = None
-        self._lut_name = None
-        self.contextReady.emit(self.ctx)
+        self.colours.make_current()
 
     def renderer(self) -> str:
-        return self.ctx.info.get("GL_RENDERER", "?") if self.ctx else "no GL"
-
-    def _ensure_lut(self, name):
-        if self._lut_name == name:
-            return
-        table = pg.colormap.get(name).getLookupTable(0.0, 1.0, 256, alpha=True).astype("u1")
-        if self._lut is None:
-            self._lut = self.ctx.texture((256, 1), 4, dtype="f1")
-            self._lut.repeat_x = self._lut.repeat_y = False
-        self._lut.write(np.ascontiguousarray(table).tobytes(), alignment=4)
-        self._lut_name = name
+        return self.colours.renderer()
 
     def upload_field(self, rgba: np.ndarray):
-        """numpy path: copy (ny, nx, 4) float32 (rho, ux, uy, vorticity) into the field texture."""
+        """numpy path: (ny, nx, 4) float32 (rho, ux, uy, vorticity) to draw."""
         if self.ctx is None:       # no OpenGL 3.3: cpu_field.CpuCanvas colours it on the CPU
             self.cpu_rgba = rgba
             self.cpu_canvas.update()   # set by first_start.run_on_cpu
             return
-        ny, nx = rgba.shape[:2]
-        tex = self.field_texture
-        if tex is None or tex.size != (nx, ny) or getattr(self, "_own_texture", False) is False:
-            self._own_texture = True
-            self.field_texture = tex = self.ctx.texture((nx, ny), 4, dtype="f4")
-            tex.repeat_x = tex.repeat_y = False
-        tex.write(np.ascontiguousarray(rgba, np.float32).tobytes(), alignment=4)
+        self.colours.upload(rgba)
 
     def use_texture(self, texture):
         """gl path: draw the solver's own field texture."""
-        self._own_texture = False
-        self.field_texture = texture
+        self.colours.use_texture(texture)
 
     def lattice_rect(self) -> QRectF:
         """Where the lattice is drawn (logical pixels), aspect ratio kept, colour bar beside it."""
@@ -238,39 +188,11 @@ class Viewport(QWidget):
         scales it up, smoothly. None before there is a field."""
         if self.sim is None or self.field_texture is None:
             return None
-        ctx = self.ctx
         dpr = self.devicePixelRatioF()
         r = self.lattice_rect()
         nx, ny = self.sim.config.nx, self.sim.config.ny
         size = (max(1, min(nx, int(round(r.width() * dpr)))), max(1, min(ny, int(round(r.height() * dpr)))))
-        self.makeCurrent()
-        ctx.enable_only(moderngl.NOTHING)
-        if self._image_fbo is None or self._image_fbo.size != size:
-            if self._image_fbo is not None:
-                self._image_fbo.color_attachments[0].release()
-                self._image_fbo.release()
-            self._image_fbo = ctx.framebuffer(color_attachments=[ctx.texture(size, 4, dtype="f1")])
-            self._pixels = bytearray(size[0] * size[1] * 4)
-        self._image_fbo.use()
-        ctx.viewport = (0, 0, *size)
-        mode = DISPLAY_MODES[self.mode]
-        self._ensure_lut(mode.colormap)
-        self.field_texture.use(0)
-        self._sampler.use(0)          # smooth, without changing the solver's own texture
-        self._lut.filter = (moderngl.LINEAR, moderngl.LINEAR)
-        self._lut.use(1)
-        self.program["field"] = 0
-        self.program["lut"] = 1
-        self.program["mode"] = mode.shader_mode
-        self.program["scale"] = self.display_scale()
-        self.program["range"] = mode.range
-        self.program["rho_ref"] = self.rho_ref
-        self.program["flip_y"] = 1.0  # the image's first row is the lattice's top
-        self.program["bgra"] = int(LITTLE_ENDIAN)   # B, G, R, A bytes are QImage.Format_RGB32 there
-        self.vao.render(moderngl.TRIANGLE_STRIP, vertices=4)
-        self._image_fbo.read_into(self._pixels, components=4, alignment=1)
-        fmt = QImage.Format_RGB32 if LITTLE_ENDIAN else QImage.Format_RGBA8888   # RGB32: QPainter's fastest
-        return QImage(self._pixels, size[0], size[1], 4 * size[0], fmt), r
+        return self.colours.image(size, DISPLAY_MODES[self.mode], self.display_scale(), self.rho_ref), r
 
     def display_scale(self) -> float:
         """Lattice value -> the colour bar's unit (reference speed: the wind, or half the cap)."""

@@ -1,6 +1,7 @@
-"""`feelflow bench [solver|accuracy|haptics|operators|motion]`: speed of the solver backends, their speed
+"""`feelflow bench [solver|accuracy|haptics|operators|motion|streaming]`: speed of the solver backends, their speed
 against their error, the haptic loop, the cost per step of each collision operator
-(`app/bench/operator_cost.py`), or of moving the body (`app/bench/motion_cost.py`).
+(`app/bench/operator_cost.py`), of moving the body (`app/bench/motion_cost.py`), or of the cpu
+backend's two streaming patterns (`app/bench/streaming.py`).
 
 The solver bench lives in `app/bench/solver_speed.py`, speed against error in
 `app/bench/accuracy.py`, the haptic one in `app/bench/haptic_loop.py`; this module only
@@ -14,7 +15,7 @@ from feelflow.app.bench.accuracy import AXES
 
 TARGETS = {"solver": "feelflow.app.bench.solver_speed", "accuracy": "feelflow.app.bench.accuracy",
            "haptics": "feelflow.app.bench.haptic_loop", "operators": "feelflow.app.bench.operator_cost",
-           "motion": "feelflow.app.bench.motion_cost"}
+           "motion": "feelflow.app.bench.motion_cost", "streaming": "feelflow.app.bench.streaming"}
 
 
 def add_arguments(parser):
@@ -26,9 +27,10 @@ def add_arguments(parser):
                         help="haptics: the device to run the loop against (default: a simulator)")
     parser.add_argument("--seconds", type=float, default=None, help="how long to measure")
     parser.add_argument("--rounds", type=int, default=None,
-                        help="solver, operators: alternating rounds (solver: numpy / cpu / gl) per scene, medians reported (default 3; --quick 1)")
+                        help="solver, operators, streaming: alternating rounds (solver: numpy / cpu / gl) per scene, medians reported (default 3; --quick 1)")
     parser.add_argument("--grid", action="append", metavar="NXxNY",
-                        help="solver: only this grid (repeatable; default 256x128, 512x256 and 1024x512); motion: default 256x128")
+                        help="solver: only this grid (repeatable; default 256x128, 512x256 and 1024x512); motion: default 256x128; "
+                             "streaming: default 512x256")
     parser.add_argument("--quick", action="store_true", help="solver, accuracy: fewer steps or points (smoke test)")
     parser.add_argument("--backend", action="append", choices=("numpy", "cpu", "gl"),
                         help="accuracy: only this backend (repeatable; default: numpy float64, numpy float32, gl); "

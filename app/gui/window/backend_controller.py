@@ -18,7 +18,9 @@ from feelflow.app.model.backend_choice import CANDIDATES, choose_backend
 from feelflow.app.model.flow_choice import default_base_config
 
 if TYPE_CHECKING:
-    from feelflow.app.gui.main_window import MainWindow
+    from PySide6.QtCore import QSettings
+    from PySide6.QtWidgets import QStatusBar
+
     from feelflow.app.gui.viewport import Viewport
 
 SETTINGS_KEY = "backend"
@@ -45,26 +47,25 @@ class QSettingsStore:
 class BackendController:
     """Resolves "auto" to a backend when the context is ready; owns the backend menu."""
 
-    def __init__(self, window: "MainWindow", viewport: "Viewport", requested: str):
-        self.w = window
-        self.viewport = viewport
+    def __init__(self, settings: "QSettings", viewport: "Viewport", status: "QStatusBar", requested: str):
+        self.settings, self.viewport, self.status = settings, viewport, status
         self.requested = requested
         self.description = ""   # why this backend runs, for the status bar's tooltip
         self.measured = None     # steps per second it was measured at on start, if it was
 
-    def resolve(self, ctx) -> str:
-        """The backend to build the tunnel with; for "auto", measured (or remembered) now."""
-        w = self.w
+    def resolve(self, ctx, grid) -> str:
+        """The backend to build the tunnel of `grid` (nx, ny) with; for "auto", measured (or
+        remembered) now."""
         if self.requested != "auto":
             if self.requested == "gl" and ctx is None:   # no OpenGL 3.3 (first_start): the CPU
                 self.description = "numpy solver (no OpenGL 3.3 here)"
                 return "numpy"
             self.description = f"{self.requested} solver (chosen in the menu or with --backend)"
             return self.requested
-        settings = w.settings
+        settings = self.settings
         remeasure = str(settings.value(REMEASURE_KEY, "false")).lower() == "true"
         candidates = CANDIDATES if ctx is not None else tuple(c for c in CANDIDATES if c != "gl")
-        w.statusBar().showMessage("Measuring the solver backends on this machine\u2026")
+        self.status.showMessage("Measuring the solver backends on this machine\u2026")
         QApplication.processEvents()
 
         def make_solver(name, config):
@@ -72,7 +73,7 @@ class BackendController:
 
             return create_solver(name, config, ctx=ctx)
 
-        config = default_base_config(w.params.grid)
+        config = default_base_config(grid)
         try:
             choice = choose_backend(config, make_solver, QSettingsStore(settings), renderer=self.viewport.renderer(),
                                     candidates=candidates, remeasure=remeasure)
@@ -86,7 +87,7 @@ class BackendController:
             rates = ", ".join(t.describe() for t in choice.timings)
             self.measured = next(t.steps_per_s for t in choice.timings if t.backend == choice.backend)
             self.description = f"{choice.backend} solver (the fastest here: {rates})"
-        w.statusBar().clearMessage()
+        self.status.clearMessage()
         return choice.backend
 
     def status_text(self, renderer: str, backend: str) -> str:
@@ -98,7 +99,7 @@ class BackendController:
         """Run > Solver backend: Automatic / cpu / gl / numpy, and Measure again."""
         sub = menu.addMenu("Solver &backend")
         group = QActionGroup(sub)
-        current = str(self.w.settings.value(SETTINGS_KEY, "auto"))
+        current = str(self.settings.value(SETTINGS_KEY, "auto"))
         for key in CHOICES:
             act = QAction(LABELS[key], sub, checkable=True)
             act.setChecked(key == current)
@@ -111,14 +112,14 @@ class BackendController:
         sub.addAction(again)
 
     def set_requested(self, key: str) -> None:
-        self.w.settings.setValue(SETTINGS_KEY, key)
-        self.w.statusBar().showMessage(f"Solver backend: {LABELS[key]}, from the next start of FeelFlow "
+        self.settings.setValue(SETTINGS_KEY, key)
+        self.status.showMessage(f"Solver backend: {LABELS[key]}, from the next start of FeelFlow "
                                        "(the running tunnel keeps its backend).", 8000)
 
     def remeasure(self) -> None:
-        self.w.settings.setValue(REMEASURE_KEY, "true")
-        self.w.settings.setValue(SETTINGS_KEY, "auto")
-        self.w.statusBar().showMessage("The backends will be measured again at the next start of FeelFlow.", 8000)
+        self.settings.setValue(REMEASURE_KEY, "true")
+        self.settings.setValue(SETTINGS_KEY, "auto")
+        self.status.showMessage("The backends will be measured again at the next start of FeelFlow.", 8000)
 
 
 def requested_backend(option: str | None, settings) -> str:

@@ -23,22 +23,34 @@ from feelflow.shapes.base import ShapeError
 from feelflow.solver.config import ConfigError
 
 if TYPE_CHECKING:
-    from feelflow.app.gui.main_window import MainWindow
+    from collections.abc import Callable
+
+    from PySide6.QtGui import QUndoStack
+    from PySide6.QtWidgets import QStatusBar, QWidget
+
+    from feelflow.app.gui.side_panel import SidePanel
     from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.gui.window.events import WindowEvents
+    from feelflow.app.gui.window.flow import FlowController
     from feelflow.app.gui.window.frame_loop import FrameLoop
+    from feelflow.app.gui.window.replay_controller import ReplayController
     from feelflow.app.model.simulation import Simulation
 
 
 class BodyController:
     """Changes the live body; every change is refused while a replay shows."""
 
-    def __init__(self, window: "MainWindow", viewport: "Viewport", loop: "FrameLoop"):
-        self.w = window
-        self.viewport = viewport
-        self.loop = loop
+    def __init__(self, events: "WindowEvents", viewport: "Viewport", loop: "FrameLoop", panel: "SidePanel",
+                 undo: "QUndoStack", replays: "ReplayController", flow: "FlowController", status: "QStatusBar",
+                 make_current: "Callable[[], None]", parent: "QWidget"):
+        """`make_current`: the viewport's GL context current where the solver draws on it;
+        `parent`: the dialogs' parent."""
+        self.viewport, self.loop, self.panel, self.undo = viewport, loop, panel, undo
+        self.replays, self.flow = replays, flow
+        self.status, self.make_current, self.parent = status, make_current, parent
         self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
-        window.events.liveCreated.connect(self._live_created)
-        window.events.replayStarted.connect(self._replay_started)
+        events.liveCreated.connect(self._live_created)
+        events.replayStarted.connect(self._replay_started)
 
     def _live_created(self, sim):
         self.sim = sim
@@ -49,24 +61,23 @@ class BodyController:
         self.viewport.cancel_drag()
 
     def _refused(self) -> bool:
-        return self.sim is None or self.w.replays.refuse("the body follows the recording")
+        return self.sim is None or self.replays.refuse("the body follows the recording")
 
     # --- kind, size, hold still -------------------------------------------------------------------
     def apply_shape(self, **changes) -> bool:
         """`Simulation.set_shape(**changes)`; a shape that cannot be used is a dialog and changes
         nothing."""
-        w = self.w
         if self._refused():
             return False
-        w.make_current()
+        self.make_current()
         try:
             self.sim.set_shape(**changes)
         except (ShapeError, ConfigError, ValueError) as exc:
-            w.flow.refuse_dialog("This shape cannot be used", exc)
+            self.flow.refuse_dialog("This shape cannot be used", exc)
             return False
-        w.panel.show_params(self.sim.params, self.loop.display_mode)
-        if w.flow.say_guard():
-            w.flow.after_rebuild()
+        self.panel.show_params(self.sim.params, self.loop.display_mode)
+        if self.flow.say_guard():
+            self.flow.after_rebuild()
         self.viewport.update()
         return True
 
@@ -81,14 +92,13 @@ class BodyController:
             self.set_editing(False)
 
     def install_default_polygon(self):
-        w = self.w
         verts = default_polygon(self.sim.params.size)
-        w.make_current()
+        self.make_current()
         try:
             self.sim.set_shape(kind="polygon", polygon=verts)
         except (ShapeError, ValueError) as exc:
-            w.flow.refuse_dialog("This shape cannot be used", exc)
-        w.panel.show_params(self.sim.params, self.loop.display_mode)
+            self.flow.refuse_dialog("This shape cannot be used", exc)
+        self.panel.show_params(self.sim.params, self.loop.display_mode)
 
     def install_loaded_shape(self, shape):
         """A shape read from a file (app/gui/window/exports.py): a polygon is an undoable edit."""
@@ -98,46 +108,44 @@ class BodyController:
         kind, size, verts = params_for_shape(shape)
         if kind == "polygon":
             if sim.params.shape != "polygon":
-                self.w.make_current()
+                self.make_current()
                 sim.params = replace(sim.params, shape="polygon")
             return self.edit_polygon(verts, "load shape")
         return self.apply_shape(kind=kind, size=size)
 
     def set_hold_still(self, on):
-        w = self.w
-        if w.replays.refuse("the body follows the recording"):
+        if self.replays.refuse("the body follows the recording"):
             return
         if self.sim is not None:
             self.sim.hold_still = bool(on)
-        w.panel.hold_still.setChecked(bool(on))
+        self.panel.hold_still.setChecked(bool(on))
 
     # --- turning ----------------------------------------------------------------------------------
     def turn_body(self, degrees: float) -> bool:
         """Turn the body to `degrees` (any number of turns). While the flow runs it swings there
         through the angle spring, as with the wheel; paused or held still it turns at once, as
         with the panel's angle box. The panel shows the angle asked for."""
-        w = self.w
         sim = self.sim
         if self._refused():
             return False
         if self.loop.paused or sim.hold_still:
             if sim.angle != math.radians(wrap_degrees(degrees)):
-                w.make_current()
+                self.make_current()
                 try:
                     sim.set_shape(angle_deg=wrap_degrees(degrees))
                 except (ShapeError, ConfigError, ValueError) as exc:   # no dialog in the middle of a drag
-                    w.statusBar().showMessage(f"The body cannot turn there: {exc}", 4000)
+                    self.status.showMessage(f"The body cannot turn there: {exc}", 4000)
                     return False
         else:
             sim.drive(BodyInput.turn(degrees, source="mouse"))
-        w.panel.show_angle(sim.params.angle_deg)
+        self.panel.show_angle(sim.params.angle_deg)
         self.viewport.update()
         return True
 
     def turn_done(self, before: float, after: float):
         """One drag of the handle: one undo step (the body is already at `after`)."""
-        if self.sim is not None and self.w.replays.replay is None:
-            self.w.undo.push(TurnBody(self.turn_body, before, after))
+        if self.sim is not None and self.replays.replay is None:
+            self.undo.push(TurnBody(self.turn_body, before, after))
 
     def _script_refuses_turn(self, how: str) -> bool:
         """A motion script drives the pose (it ignores the angle until it ends, when the body would
@@ -155,7 +163,7 @@ class BodyController:
         before = sim.target_degrees()
         if not self.turn_body(before + degrees):
             return False
-        self.w.undo.push(TurnBody(self.turn_body, before, before + degrees, "turn the body (wheel)", burst="wheel"))
+        self.undo.push(TurnBody(self.turn_body, before, before + degrees, "turn the body (wheel)", burst="wheel"))
         return True
 
     def set_angle(self, degrees: float) -> bool:
@@ -165,12 +173,12 @@ class BodyController:
         if sim is None:
             return False
         if self._script_refuses_turn("the Angle box"):
-            self.w.panel.show_angle(sim.params.angle_deg)   # the box goes back to the angle the body keeps
+            self.panel.show_angle(sim.params.angle_deg)   # the box goes back to the angle the body keeps
             return False
         before = sim.target_degrees()
         if not self._turn_at_once(degrees):
             return False
-        self.w.undo.push(TurnBody(self._turn_at_once, before, degrees, "set the angle", burst="angle box"))
+        self.undo.push(TurnBody(self._turn_at_once, before, degrees, "set the angle", burst="angle box"))
         return True
 
     def _turn_at_once(self, degrees: float) -> bool:
@@ -178,23 +186,22 @@ class BodyController:
 
     def turn_refused(self, driver: str, what: str = "the handle"):
         """`driver` (viewport.turn_blocker's words) drives the body, so `what` may not turn it."""
-        how = "choose Mouse under Input" if self.w.inputs.device is not None \
+        how = "choose Mouse under Input" if self.viewport.driver is not None \
             else "wait for it to end or reset the flow (R)"
-        self.w.statusBar().showMessage(f"{driver} drives the body: {what} cannot rotate it now ({how}).", 6000)
+        self.status.showMessage(f"{driver} drives the body: {what} cannot rotate it now ({how}).", 6000)
 
     # --- polygon editor ---------------------------------------------------------------------------
     def set_editing(self, on):
-        w = self.w
-        if on and w.replays.refuse("the body follows the recording"):
+        if on and self.replays.refuse("the body follows the recording"):
             return
         self.viewport.editing = bool(on) and self.sim is not None and self.sim.params.shape == "polygon"
-        w.panel.edit.setChecked(self.viewport.editing)
+        self.panel.edit.setChecked(self.viewport.editing)
         if self.viewport.editing:
             self.set_hold_still(True)
-            w.statusBar().showMessage(f"Editing the polygon (the body holds still): {w.panel.edit.toolTip()}; "
+            self.status.showMessage(f"Editing the polygon (the body holds still): {self.panel.edit.toolTip()}; "
                                       "Ctrl+Z undoes an edit.", 20000)
-        elif on is False and w.statusBar().currentMessage().startswith("Editing the polygon"):
-            w.statusBar().clearMessage()
+        elif on is False and self.status.currentMessage().startswith("Editing the polygon"):
+            self.status.clearMessage()
         self.viewport.update()
 
     def check_polygon(self, verts):
@@ -205,21 +212,19 @@ class BodyController:
 
     def edit_polygon(self, verts, text="edit polygon"):
         """Push an undoable polygon edit, or refuse it with a dialog (the previous shape stays)."""
-        w = self.w
-        if w.replays.refuse("the body follows the recording"):
+        if self.replays.refuse("the body follows the recording"):
             return False
         try:
             self.check_polygon(verts)
         except (ShapeError, ValueError) as exc:
-            QMessageBox.warning(w, "This polygon cannot be used", f"{exc}\nThe previous shape is kept.")
+            QMessageBox.warning(self.parent, "This polygon cannot be used", f"{exc}\nThe previous shape is kept.")
             self.viewport.update()
             return False
-        w.undo.push(SetPolygon(self._install_polygon, self.sim.polygon, verts, text))
+        self.undo.push(SetPolygon(self._install_polygon, self.sim.polygon, verts, text))
         return True
 
     def _install_polygon(self, verts):
-        w = self.w
-        w.make_current()
+        self.make_current()
         self.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in verts])
-        w.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.panel.show_params(self.sim.params, self.loop.display_mode)
         self.viewport.update()

@@ -16,9 +16,14 @@ from PySide6.QtWidgets import QMessageBox
 from feelflow.app.model.body_input import BodyInput
 
 if TYPE_CHECKING:
+    from PySide6.QtWidgets import QStatusBar, QWidget
+
     from feelflow.app.gui.device_input import DeviceInput
-    from feelflow.app.gui.main_window import MainWindow
+    from feelflow.app.gui.side_panel import SidePanel
     from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.gui.window.bodies import BodyController
+    from feelflow.app.gui.window.events import WindowEvents
+    from feelflow.app.gui.window.replay_controller import ReplayController
     from feelflow.app.model.simulation import Simulation
 
 DEVICE_MOVE_CELLS = 3.0   # a device moved this far during a replay is told it does not move the body
@@ -27,14 +32,19 @@ DEVICE_MOVE_CELLS = 3.0   # a device moved this far during a replay is told it d
 class InputController:
     """Owns the haptic device (None while the mouse drives) and routes body input to the model."""
 
-    def __init__(self, window: "MainWindow", viewport: "Viewport"):
-        self.w = window
-        self.viewport = viewport
+    def __init__(self, events: "WindowEvents", viewport: "Viewport", panel: "SidePanel", replays: "ReplayController",
+                 bodies: "BodyController", status: "QStatusBar", parent: "QWidget"):
+        """`parent`: the dialogs' and the device's parent."""
+        self.viewport, self.panel, self.replays, self.bodies = viewport, panel, replays, bodies
+        self.status, self.parent = status, parent
         self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
-        window.events.liveCreated.connect(self._live_created)
-        window.events.replayStarted.connect(self.replay_started)
-        window.events.replayStopped.connect(self.replay_stopped)
-        window.events.flowChanged.connect(self.tunnel_changed)
+        events.liveCreated.connect(self._live_created)
+        events.replayStarted.connect(self.replay_started)
+        events.replayStopped.connect(self.replay_stopped)
+        events.flowChanged.connect(self.tunnel_changed)
+        events.liveFrame.connect(self.after_frame)
+        events.livePaused.connect(self.pause)
+        events.replayTick.connect(self.watch_during_replay)
         self.device: DeviceInput | None = None
         self._device_seen = None     # the device's target when the replay began
 
@@ -44,14 +54,14 @@ class InputController:
     # --- one way in -----------------------------------------------------------------------------
     def drive(self, request: BodyInput) -> bool:
         """Pass `request` to the model shown (the live tunnel, or a replay that refuses it)."""
-        model = self.w.shown
+        model = self.replays.shown
         return model is not None and model.drive(request)
 
     def mouse_pulled(self, target):
         """The viewport's drag: pull the body to `target` (x, y), or let go (None)."""
         request = BodyInput.release("mouse") if target is None else BodyInput.pull(*target, source="mouse")
         if not self.drive(request) and target is not None:
-            self.w.replays.refuse("the mouse does not move the body")
+            self.replays.refuse("the mouse does not move the body")
 
     def after_frame(self, forces):
         """After a live frame: the device's position becomes the body's target, and the selected
@@ -73,7 +83,7 @@ class InputController:
         """Fill the input selector: the mouse, then every device the haptics layer can drive."""
         from feelflow.haptics import list_devices
 
-        panel = self.w.panel
+        panel = self.panel
         box = panel.input
         box.blockSignals(True)
         current = box.currentData()
@@ -93,7 +103,7 @@ class InputController:
 
     def show_selected(self):
         """The selector back at what drives the body now (after a refused change)."""
-        box = self.w.panel.input
+        box = self.panel.input
         box.blockSignals(True)
         box.setCurrentIndex(max(0, box.findData(self.device.url if self.device is not None else "mouse")))
         box.blockSignals(False)
@@ -102,24 +112,23 @@ class InputController:
         from feelflow.app.gui.device_input import DeviceInput
         from feelflow.haptics import BadDeviceURL, DeviceError
 
-        w = self.w
-        if w.replays.refuse("the input cannot be changed"):
+        if self.replays.refuse("the input cannot be changed"):
             return
         self.close_device()
         if url == "mouse" or self.sim is None:
-            w.panel.input_note.setText("")
+            self.panel.input_note.setText("")
             return
         try:
-            self.device = DeviceInput(url, (self.sim.config.nx, self.sim.config.ny), DeviceInput.expected_peak(self.sim), w,
+            self.device = DeviceInput(url, (self.sim.config.nx, self.sim.config.ny), DeviceInput.expected_peak(self.sim), self.parent,
                                       expected_peak_torque=DeviceInput.expected_peak_torque(self.sim))
         except (DeviceError, BadDeviceURL, OSError, ValueError) as exc:
-            QMessageBox.warning(w, "The device cannot be used", f"{exc}\nBack to the mouse.")
+            QMessageBox.warning(self.parent, "The device cannot be used", f"{exc}\nBack to the mouse.")
             self._back_to_mouse("")
             return
         self.device.disconnected.connect(self._device_lost)
         self.viewport.driver = "The haptic device"
-        w.bodies.set_hold_still(False)
-        w.panel.input_note.setText("The device moves the body; you feel the selected force model.")
+        self.bodies.set_hold_still(False)
+        self.panel.input_note.setText("The device moves the body; you feel the selected force model.")
 
     def tunnel_changed(self):
         """The grid was rebuilt: the device's workspace maps onto the new tunnel."""
@@ -132,13 +141,13 @@ class InputController:
         """Esc: the haptic device's force goes to zero at once (haptics safety: the stop key)."""
         if self.device is not None:
             self.device.emergency_stop()
-            self.w.statusBar().showMessage("Device force stopped (Esc). Choose the device again to feel the flow.",
+            self.status.showMessage("Device force stopped (Esc). Choose the device again to feel the flow.",
                                            10000)
 
     def escape(self, _=None):
         """Esc: the device's force to zero at once, and the replay, if one runs, stopped."""
         self.stop_device_force()
-        self.w.replays.stop()
+        self.replays.stop()
 
     def pause(self, paused: bool):
         """The flow paused or runs again: the device's force fades out or comes back."""
@@ -150,14 +159,13 @@ class InputController:
         self._back_to_mouse(f"The device disconnected ({reason}); the mouse moves the body again.")
 
     def _back_to_mouse(self, message):
-        w = self.w
-        box = w.panel.input
+        box = self.panel.input
         box.blockSignals(True)
         box.setCurrentIndex(box.findData("mouse"))
         box.blockSignals(False)
-        w.panel.input_note.setText(message)
+        self.panel.input_note.setText(message)
         if message:
-            w.statusBar().showMessage(message, 10000)
+            self.status.showMessage(message, 10000)
         if self.sim is not None:
             self.sim.drive(BodyInput.release("device"))
 
@@ -185,5 +193,5 @@ class InputController:
         if target is None:
             return
         if self._device_seen is not None and math.dist(target, self._device_seen) > DEVICE_MOVE_CELLS:
-            self.w.replays.refuse("the device does not move the body")
+            self.replays.refuse("the device does not move the body")
         self._device_seen = target

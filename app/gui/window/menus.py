@@ -78,6 +78,7 @@ def build_menus(w: "MainWindow") -> Actions:
     e.addAction(redo)
     r = bar.addMenu("&Run")
     pause = add_action(w, r, "Pause / run", w.loop.toggle_pause, "Space", checkable=True)
+    w.events.pauseShown.connect(pause.setChecked)   # the frame loop says when it pauses
     add_action(w, r, "Reset flow", w.flow.reset, "R")
     add_action(w, r, "Stop device force / replay", w.inputs.escape, "Esc")
     r.addSeparator()

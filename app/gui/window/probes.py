@@ -33,6 +33,7 @@ class ProbeController:
         self.timer.setInterval(PLOT_REFRESH_MS)
         self.timer.timeout.connect(self.plot.refresh)
         window.events.shownChanged.connect(self.model_changed)
+        window.events.fieldShown.connect(self.sample_frame)
 
     def _ensure_dock(self):
         if self.dock is not None:

@@ -19,7 +19,14 @@ from feelflow.app.model.display_units import (DEFAULT_SIZE_M, DEFAULT_SPAN_M, LA
 from feelflow.solver.units import FLUIDS
 
 if TYPE_CHECKING:
-    from feelflow.app.gui.main_window import MainWindow
+    from PySide6.QtCore import QSettings
+    from PySide6.QtWidgets import QStatusBar, QWidget
+
+    from feelflow.app.gui.force_plot import ForcePlot
+    from feelflow.app.gui.side_panel import SidePanel
+    from feelflow.app.gui.window.events import WindowEvents
+    from feelflow.app.gui.window.probes import ProbeController
+    from feelflow.app.gui.window.replay_controller import ReplayController
     from feelflow.app.model.simulation import Simulation
 
 REFRESH_MS = 500
@@ -70,15 +77,18 @@ class UnitsDialog(QDialog):
 
 
 class UnitsController:
-    def __init__(self, window: "MainWindow"):
-        self.w = window
+    def __init__(self, events: "WindowEvents", settings: "QSettings", panel: "SidePanel", plot: "ForcePlot",
+                 probes: "ProbeController", replays: "ReplayController", status: "QStatusBar", parent: "QWidget"):
+        """`parent`: the dialog's and the timer's parent."""
+        self.settings, self.panel, self.plot, self.probes, self.replays = settings, panel, plot, probes, replays
+        self.status, self.parent = status, parent
         self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
-        window.events.liveCreated.connect(self._live_created)
+        events.liveCreated.connect(self._live_created)
         self.choice = self._remembered()
         self.own_choice: UnitsChoice | None = None   # the user's choice while a replay shows the recorded one
         self.units = DisplayUnits()
-        window.events.shownChanged.connect(self.model_changed)
-        self.timer = QTimer(window)     # the physical reading follows the flow (wind, viscosity, body)
+        events.shownChanged.connect(self.model_changed)
+        self.timer = QTimer(parent)     # the physical reading follows the flow (wind, viscosity, body)
         self.timer.setInterval(REFRESH_MS)
         self.timer.timeout.connect(self.refresh)
 
@@ -86,7 +96,7 @@ class UnitsController:
         self.sim = sim
 
     def _remembered(self) -> UnitsChoice:
-        s = self.w.settings
+        s = self.settings
         try:
             return UnitsChoice(str(s.value("units/fluid", LATTICE)), float(s.value("units/size_m", 0.01)),
                                float(s.value("units/span_m", DEFAULT_SPAN_M)))
@@ -94,7 +104,7 @@ class UnitsController:
             return UnitsChoice()
 
     def dialog(self, _=None):
-        d = UnitsDialog(self.choice, self.w)
+        d = UnitsDialog(self.choice, self.parent)
         self.last_dialog = d
         if d.exec() == QDialog.Accepted:
             self.set_choice(d.choice())
@@ -105,7 +115,7 @@ class UnitsController:
         self.choice = choice
         if remember:
             self.own_choice = None
-            s = self.w.settings
+            s = self.settings
             s.setValue("units/fluid", choice.fluid)
             s.setValue("units/size_m", choice.size_m)
             s.setValue("units/span_m", choice.span_m)
@@ -114,7 +124,7 @@ class UnitsController:
             self.timer.start()
         else:
             self.timer.stop()
-        self.w.statusBar().showMessage(f"Units: {self.units.describe()}", 8000)
+        self.status.showMessage(f"Units: {self.units.describe()}", 8000)
 
     def model_changed(self, model):
         """A replay started (its session's recorded units, if it has them) or stopped (back to
@@ -133,13 +143,12 @@ class UnitsController:
 
     def refresh(self):
         """The units for the flow shown now, to every widget that shows numbers."""
-        w = self.w
-        units = for_model(self.choice, w.shown)
+        units = for_model(self.choice, self.replays.shown)
         self.units = units
-        w.plot.set_units(units)
-        w.panel.show_units(units)
-        w.probes.plot.units = units if units.is_si else None
-        w.probes.plot.refresh(force=True)
+        self.plot.set_units(units)
+        self.panel.show_units(units)
+        self.probes.plot.units = units if units.is_si else None
+        self.probes.plot.refresh(force=True)
 
     def start(self):
         """The tunnel runs: apply the remembered choice."""
