@@ -127,8 +127,11 @@ class CpuSolver(NumpySolver):
         return self._redo, self._link_arrays
 
     def _move_body(self, old, new) -> tuple[float, float]:
-        """NumpySolver._move_body, compiled for the equilibrium refill (solver/body_compiled.py)."""
-        if self.body_refill != "equilibrium":
+        """NumpySolver._move_body, compiled for the equilibrium refill of float32 storage, the
+        window's (solver/body_compiled.py); float64 storage (scoring, validation: bodies placed
+        once or seldom) and Caiazzo's refill run the numpy code, which spares a second compiled
+        variant (tens of seconds on a fresh machine)."""
+        if self.body_refill != "equilibrium" or self.dtype != np.float32:
             return super()._move_body(old, new)
         return body_compiled.move_body(old, new, self.config, self.g, self.body_impulse)
 
