@@ -166,3 +166,25 @@ def test_schaefer_turek_lengths_keep_the_benchmark_ratios(d):
     assert 10 * g.ny == 41 * d and g.nx == 22 * d
     cx, cy = g.centre
     assert (cx + 0.5, cy + 0.5) == (2 * d, 2 * d) and (g.ny - 0.5) - cy == pytest.approx(2.1 * d)
+
+
+def test_the_oscillating_cylinder_check_tells_a_shifted_or_scaled_force_from_the_paper():
+    """Duetsch et al.'s fig. 10 (digitised): the case's deviation is nil for the reference
+    itself and outside its bounds for the force of a tenth of a period late or 15 % too strong,
+    or for an inertia force alone (the added mass of potential flow, -rho pi D^2/4 dU/dt), so the
+    bounds are tighter than those errors (the case itself, minutes, is `slow`)."""
+    import math
+
+    import numpy as np
+
+    from feelflow.solver.validation import oscillating_cylinder as osc
+
+    ref = np.asarray(osc.REFERENCE)
+    phase = np.linspace(-0.2, 1.2, 561)
+    curve = np.interp(phase % 1.0, ref[:, 0], ref[:, 1])
+    assert max(osc.compare(phase, curve)[1:]) < 0.005   # (the sampled curve's own interpolation)
+    late = np.interp((phase - 0.1) % 1.0, ref[:, 0], ref[:, 1])
+    inertia = -math.pi ** 2 / (2 * osc.KC) * np.sin(2 * math.pi * phase)   # F / (rho U_m^2 D), U = -U_m cos
+    for wrong in (late, 1.15 * curve, inertia):
+        _, rms, worst = osc.compare(phase, wrong)
+        assert rms > osc.RMS_MAX or worst > osc.WORST_MAX

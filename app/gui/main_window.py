@@ -95,7 +95,8 @@ class MainWindow(QMainWindow):
         # controllers, and the events they tell each other (window/events.py)
         self.events = WindowEvents(self)
         vp, events, panel, plot, status = self.viewport, self.events, self.panel, self.plot, self.statusBar()
-        self.loop = loop = FrameLoop(self, vp)
+        self.loop = loop = FrameLoop(events, vp, panel, plot, status, self.status, self.make_current, self.params_now,
+                                     self)
         self.replays = replays = ReplayController(self, vp, loop)
         self.flow = FlowController(events, vp, loop, panel, plot, replays, status, self.make_current, self)
         self.bodies = BodyController(events, vp, loop, panel, self.undo, replays, self.flow, status,
@@ -104,8 +105,8 @@ class MainWindow(QMainWindow):
         self.exports = ExportController(events, vp, plot, replays, self.bodies, self)
         self.lessons = LessonController(events, vp, loop, panel, plot, self.undo, replays, self.flow, self.bodies,
                                         status, self.make_current)
-        self.video = VideoController(self, vp, loop)
-        self.probes = ProbeController(self, vp)
+        self.video = VideoController(events, vp, loop, status, self)
+        self.probes = ProbeController(events, vp, plot, replays, status, self)
         self.plot.probes = self.probes.probes   # the forces CSV carries the probes' columns
         self.units = UnitsController(events, self.settings, panel, plot, self.probes, replays, status, self)
         self.backends = BackendController(self.settings, vp, status, backend)   # "auto": measured once the context exists

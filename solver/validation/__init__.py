@@ -21,6 +21,7 @@ CASES: dict[str, str] = {
     "strouhal-re100": "feelflow.solver.validation.strouhal",
     "cylinder-re200": "feelflow.solver.validation.cylinder_re200",
     "cylinder-re1000": "feelflow.solver.validation.cylinder_re1000",
+    "oscillating-cylinder": "feelflow.solver.validation.oscillating_cylinder",
 }
 
 

@@ -38,12 +38,21 @@ class FlowController:
         self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
         events.liveCreated.connect(self._live_created)
         events.replayStopped.connect(self._replay_stopped)
+        events.guardActed.connect(self._guard_acted)
+        events.resetAsked.connect(self.reset)
 
     def _live_created(self, sim):
         self.sim = sim
 
     def _replay_stopped(self, _paused: bool):
         """Back on the live tunnel: the panel shows its parameters, the status bar its operator."""
+        self.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.after_rebuild()
+
+    def _guard_acted(self):
+        """The local stability guard raised the viscosity: the status bar says so, the panel
+        shows it, and the tunnel's followers follow."""
+        self.say_guard()
         self.panel.show_params(self.sim.params, self.loop.display_mode)
         self.after_rebuild()
 

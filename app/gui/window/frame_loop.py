@@ -5,8 +5,10 @@ so that the solver keeps at least half of each frame), uploads
 the field, moves the tracers, sets the force arrows and redraws; twice a second the readouts
 follow. Pause, the display mode and the unstable-flow dialog live here too.
 
-A frame advances the model shown (`MainWindow.shown`, a `TunnelModel`): the live tunnel, or
-a replay at the same steps-per-frame budget.
+A frame advances the model shown (a `TunnelModel`, as `shownChanged` says): the live tunnel,
+or a replay at the same steps-per-frame budget. What follows a frame elsewhere (the device, the
+recording, the probes, the replay's progress, the guard's note) follows the loop's events
+(app/gui/window/events.py).
 """
 from __future__ import annotations
 
@@ -23,9 +25,16 @@ from feelflow.app.model.tracers import Tracers
 from feelflow.solver.backend import SolverDiverged
 
 if TYPE_CHECKING:
-    from feelflow.app.gui.main_window import MainWindow
+    from collections.abc import Callable
+
+    from PySide6.QtWidgets import QLabel, QStatusBar, QWidget
+
+    from feelflow.app.gui.force_plot import ForcePlot
+    from feelflow.app.gui.side_panel import SidePanel
     from feelflow.app.gui.viewport import Viewport
-    from feelflow.app.model.simulation import Simulation
+    from feelflow.app.gui.window.events import WindowEvents
+    from feelflow.app.model.simulation import Params, Simulation
+    from feelflow.app.model.tunnel import TunnelModel
 
 #: the frame's length: as short as 1/60 s (aim just above 60 fps), as long as keeps at least
 #: MIN_SOLVER_SHARE of it for the solver's steps, never longer than 1/30 s (just above 30 fps)
@@ -46,10 +55,19 @@ PHYSICAL_CHECK_STEPS = 64
 class FrameLoop:
     """Owns the frame timer, pause, the display mode and the steps-per-frame budget."""
 
-    def __init__(self, window: "MainWindow", viewport: "Viewport"):
-        self.w = window
-        self.viewport = viewport
+    def __init__(self, events: "WindowEvents", viewport: "Viewport", panel: "SidePanel", plot: "ForcePlot",
+                 status: "QStatusBar", labels: "dict[str, QLabel]", make_current: "Callable[[], None]",
+                 params_now: "Callable[[], Params]", parent: "QWidget"):
+        """`labels`: the status bar's numbers by name; `make_current`: the viewport's GL context
+        current where the solver draws on it; `params_now`: the parameters the panel shows
+        (the live tunnel's, or the remembered ones before it exists); `parent`: the dialogs'
+        and the timers' parent."""
+        self.events, self.viewport, self.panel, self.plot = events, viewport, panel, plot
+        self.status, self.labels, self.make_current, self.params_now = status, labels, make_current, params_now
+        self.parent = parent
         self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
+        self.shown: "TunnelModel | None" = None   # the model drawn (events.shownChanged)
+        self.replay = None                         # the shown model while it is a replay, else None
         self.paused = False
         self.display_mode = "speed"
         self.steps_per_frame = 4
@@ -60,17 +78,17 @@ class FrameLoop:
         self._rate_window = [time.perf_counter(), 0, 0]   # start, steps, frames
         self.rates = {"steps_per_s": 0.0, "fps": 0.0, "mlups": 0.0}
         self.tracers = Tracers(N_TRACERS)
-        self.timer = QTimer(window)
+        self.timer = QTimer(parent)
         self.timer.setInterval(0)
         self.timer.timeout.connect(self.tick)
-        self.slow_timer = QTimer(window)
+        self.slow_timer = QTimer(parent)
         self.slow_timer.setInterval(READOUT_MS)
         self.slow_timer.timeout.connect(self.refresh_readouts)
-        window.events.liveCreated.connect(self._live_created)
-        window.events.shownChanged.connect(self.show_model)
-        window.events.replayStarted.connect(lambda: self.timer.setInterval(0))
-        window.events.replayStopped.connect(self._replay_stopped)
-        window.events.flowChanged.connect(self._flow_changed)
+        events.liveCreated.connect(self._live_created)
+        events.shownChanged.connect(self.show_model)
+        events.replayStarted.connect(lambda: self.timer.setInterval(0))
+        events.replayStopped.connect(self._replay_stopped)
+        events.flowChanged.connect(self._flow_changed)
 
     def _live_created(self, sim):
         self.sim = sim
@@ -87,14 +105,15 @@ class FrameLoop:
 
     def show_model(self, model):
         """Point the viewport and the plot at `model` (the live tunnel or a replay) and draw it."""
-        w = self.w
+        self.shown = model
+        self.replay = model if model is not self.sim else None
         vp = self.viewport
-        vp.sim = w.plot.sim = model
+        vp.sim = self.plot.sim = model
         vp.locked = model is not self.sim
         vp.tracers = vp.arrow_forces = vp.torque_arc = None
         self.forget_last_frame()
         self.upload_field()
-        w.plot.refresh(force=True)
+        self.plot.refresh(force=True)
         vp.update()
 
     def _flow_changed(self):
@@ -105,7 +124,7 @@ class FrameLoop:
 
     def _replay_stopped(self, paused: bool):
         """Back on the live tunnel: its own pace and pause."""
-        self.w.actions.pause.setChecked(paused)
+        self.events.pauseShown.emit(paused)
         self.timer.setInterval(30 if paused else 0)
 
     def forget_last_frame(self):
@@ -117,30 +136,28 @@ class FrameLoop:
         self.set_paused(not self.paused)
 
     def set_paused(self, paused: bool):
-        w = self.w
-        replay = w.replays.replay
+        replay = self.replay
         if replay is not None:   # Space pauses the replay; the live tunnel keeps its own state
             replay.paused = paused
-            w.actions.pause.setChecked(paused or replay.done)
-            w.replays.show_progress()
+            self.events.pauseShown.emit(paused or replay.done)
+            self.events.replayProgressed.emit()
             return
         if self.sim is not None and paused != self.paused:
             self.sim.solver.pause() if paused else self.sim.solver.resume()
         self.paused = paused
         self.timer.setInterval(30 if paused else 0)   # paused: redraw at ~30 Hz, no busy loop
-        w.inputs.pause(paused)
-        w.actions.pause.setChecked(paused)
-        w.statusBar().showMessage("Paused (space to run)" if paused else "Running", 2000)
+        self.events.livePaused.emit(paused)
+        self.events.pauseShown.emit(paused)
+        self.status.showMessage("Paused (space to run)" if paused else "Running", 2000)
 
     def set_display_mode(self, mode):
-        w = self.w
         self.display_mode = mode
         self.viewport.mode = mode
         if mode != "tracers":
             self.viewport.tracers = None
-        w.panel.show_params(w.params_now(), mode)
-        if w.shown is not None:   # the field again (a gl texture computes the vorticity only where shown)
-            w.make_current()
+        self.panel.show_params(self.params_now(), mode)
+        if self.shown is not None:   # the field again (a gl texture computes the vorticity only where shown)
+            self.make_current()
             self.upload_field()
         self.viewport.update()
 
@@ -149,8 +166,7 @@ class FrameLoop:
         """The shown model's field into the viewport: the flow's own texture where it has one
         (the gl backend, on the viewport's context; the vorticity, five nodes a texel, only where
         it is shown), else its (ny, nx, 4) array, which it returns."""
-        w = self.w
-        model = w.shown
+        model = self.shown
         if model is None:
             return None
         texture = model.field_texture(vorticity=self.display_mode == "vorticity")
@@ -171,11 +187,10 @@ class FrameLoop:
     # --- one frame ------------------------------------------------------------------------------
     def tick(self):
         now = time.perf_counter()
-        w = self.w
         sim = self.sim
         if sim is None:
             return
-        if w.replays.replay is not None:
+        if self.replay is not None:
             self._tick_replay(now)
             return
         if self.paused:
@@ -183,7 +198,7 @@ class FrameLoop:
             self._last_tick = None
             return
         n = self.steps_per_frame
-        w.make_current()
+        self.make_current()
         t0 = time.perf_counter()
         try:
             forces = sim.advance(n)
@@ -199,38 +214,33 @@ class FrameLoop:
             return
         if getattr(sim, "guard_changed", False):   # the local stability guard raised the viscosity
             sim.guard_changed = False
-            w.flow.say_guard()
-            w.panel.show_params(sim.params, self.display_mode)
-            w.flow.after_rebuild()
-        w.inputs.after_frame(forces)
-        w.replays.watch_recording()
+            self.events.guardActed.emit()
+        self.events.liveFrame.emit(forces)
         self._frame_done(now, t0, t1, n, forces, rgba)
 
     def _tick_replay(self, now):
         """One frame of the replay, at the live tunnel's steps-per-frame budget."""
         from feelflow.app.sessions import SessionError
 
-        w = self.w
-        r = w.replays.replay
-        w.inputs.watch_during_replay()
+        r = self.replay
+        self.events.replayTick.emit()
         if r.paused or r.done:
             self.viewport.update()
             self._last_tick = None
             return
-        w.make_current()
+        self.make_current()
         t0 = time.perf_counter()
         try:
             forces = r.advance(self.steps_per_frame)
         except SessionError as exc:   # the file asks for something impossible: one line
-            w.replays.stop()
-            QMessageBox.warning(w, "Could not replay the session", str(exc))
+            self.events.replayFailed.emit(str(exc))
             return
         t1 = time.perf_counter()
         rgba = self.upload_field()
         self._frame_done(now, t0, t1, max(1, r.last_steps), forces, rgba)
-        w.replays.show_progress()
+        self.events.replayProgressed.emit()
         if r.done:
-            w.actions.pause.setChecked(True)
+            self.events.pauseShown.emit(True)
 
     def _frame_done(self, now, t0, t1, n, forces, rgba):
         """After n steps took t1 - t0 s: tracers, arrows, redraw, and the next frame's budget."""
@@ -240,7 +250,7 @@ class FrameLoop:
         if self.display_mode == "pressure" and vp.frames % 5 == 0:
             vp.rho_ref = self._free_stream_density(rgba)
         self.update_arrows(forces)
-        self.w.probes.sample_frame(rgba if rgba is not None else self._field_array)   # app/gui/window/probes.py
+        self.events.fieldShown.emit(rgba if rgba is not None else self._field_array)   # the probes sample it
         vp.update()
         # adaptive stepping: cost per step and the rest of the frame, smoothed
         self.step_cost = 0.8 * self.step_cost + 0.2 * (t1 - t0) / n
@@ -255,7 +265,7 @@ class FrameLoop:
         rw[2] += 1
         if now - rw[0] >= 1.0:
             dt = now - rw[0]
-            cfg = self.w.shown.config
+            cfg = self.shown.config
             self.rates = {"steps_per_s": rw[1] / dt, "fps": rw[2] / dt, "mlups": rw[1] * cfg.nx * cfg.ny / dt / 1e6}
             self._rate_window = [now, 0, 0]
 
@@ -272,21 +282,20 @@ class FrameLoop:
         return readouts.free_stream_density(self._field_array() if rgba is None else rgba)
 
     def _on_nan(self):
-        w = self.w
         self.set_paused(True)
         self.viewport.update()
         answer = QMessageBox.question(
-            w, "The simulation became unstable",
+            self.parent, "The simulation became unstable",
             "The flow became unstable and stopped (the numbers grew without bound).\n"
             "This happens when the flow is too fast for the grid or the viscosity is too low.\n\n"
             "Reset the flow and continue?", QMessageBox.Reset | QMessageBox.Cancel, QMessageBox.Reset)
         if answer == QMessageBox.Reset:
-            w.flow.reset()
+            self.events.resetAsked.emit()
             self.set_paused(False)
 
     def update_arrows(self, forces):
         """The viewport's drag and lift arrows for this frame's force (app/model/readouts.py)."""
-        model = self.w.shown
+        model = self.shown
         self.viewport.arrow_forces = readouts.arrows(forces.get(model.params.force_model), model.relative_wind(),
                                                      model.reference_length())
         self.viewport.torque_arc = readouts.torque_arc(model.last_torques.get(model.params.force_model),
@@ -294,7 +303,7 @@ class FrameLoop:
 
     def _advance_tracers(self, rgba, n):
         """Move the viewport's tracers n steps through the field (app/model/tracers.py)."""
-        model, vp = self.w.shown, self.viewport
+        model, vp = self.shown, self.viewport
         if rgba is None:
             rgba = self._field_array()
         vp.tracers = self.tracers.advance(rgba, n, model.shape, None if vp.tracers is None else vp.tracers[0])
@@ -302,11 +311,10 @@ class FrameLoop:
     # --- readouts -----------------------------------------------------------------------------
     def refresh_readouts(self):
         """The panel's numbers, the plot and the status bar, from the model shown."""
-        w = self.w
-        model = w.shown
+        model = self.shown
         if model is None:
             return
-        p, panel = model.params, w.panel
+        p, panel = model.params, self.panel
         live = model is self.sim
         wind, nu = panel.flow_shown     # lattice units, whatever units the boxes show
         if live and (abs(wind - p.wind) > 5e-4   # a sweep, a lesson or the guard
@@ -317,11 +325,11 @@ class FrameLoop:
         panel.show_numbers(model.reynolds(), model.mach(), model.config.mach_limit)
         r = readouts.readout(model.history, p.force_model, model.reference_length())
         panel.show_forces(r.drag, r.lift) if r.has_forces else panel.show_forces(None, None)
-        w.plot.refresh()
+        self.plot.refresh()
         r = self.rates
-        w.status["steps"].setText(f"{r['steps_per_s']:.0f} steps/s")
-        w.status["mlups"].setText(f"{r['mlups']:.1f} MLUPS")
-        w.status["fps"].setText(f"{r['fps']:.0f} fps")
-        w.status["re"].setText(f"Re {model.reynolds():.0f}")
-        w.status["ma"].setText(f"Ma {model.mach():.3f}")
-        w.status["operator"].setText(model.operator_line())   # the collision operator and why
+        self.labels["steps"].setText(f"{r['steps_per_s']:.0f} steps/s")
+        self.labels["mlups"].setText(f"{r['mlups']:.1f} MLUPS")
+        self.labels["fps"].setText(f"{r['fps']:.0f} fps")
+        self.labels["re"].setText(f"Re {model.reynolds():.0f}")
+        self.labels["ma"].setText(f"Ma {model.mach():.3f}")
+        self.labels["operator"].setText(model.operator_line())   # the collision operator and why

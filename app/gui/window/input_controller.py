@@ -42,6 +42,9 @@ class InputController:
         events.replayStarted.connect(self.replay_started)
         events.replayStopped.connect(self.replay_stopped)
         events.flowChanged.connect(self.tunnel_changed)
+        events.liveFrame.connect(self.after_frame)
+        events.livePaused.connect(self.pause)
+        events.replayTick.connect(self.watch_during_replay)
         self.device: DeviceInput | None = None
         self._device_seen = None     # the device's target when the replay began
 

@@ -33,6 +33,9 @@ class ReplayController:
         self.loop = loop
         self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
         window.events.liveCreated.connect(self._live_created)
+        window.events.liveFrame.connect(lambda _forces: self.watch_recording())
+        window.events.replayProgressed.connect(self.show_progress)
+        window.events.replayFailed.connect(self._failed)
         self.replay: ReplaySimulation | None = None
         self.label = QLabel()   # "Replaying <name>: step N / M" (hidden by passing messages)
         window.statusBar().addWidget(self.label, 1)
@@ -147,6 +150,11 @@ class ReplayController:
         w.actions.redo.setEnabled(w.undo.canRedo())
         w.events.replayStopped.emit(self.loop.paused)
         w.statusBar().showMessage("Replay stopped: back to the live tunnel.", 4000)
+
+    def _failed(self, message: str):
+        """The session asked for something impossible: back to the live tunnel, one line."""
+        self.stop()
+        QMessageBox.warning(self.w, "Could not replay the session", message)
 
     def close(self):
         """The window closes: the replay's solver goes with it."""
