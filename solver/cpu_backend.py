@@ -10,10 +10,12 @@ goes, collides again exactly the nodes that own such a population (a list of nod
 masks, rebuilt when the body's links change) and resets the solid nodes. Every operator is
 compiled: BGK, TRT, recursive-regularised BGK and entropic KBC (the last two with or without the
 Smagorinsky viscosity).
-The moving body's cover/uncover bookkeeping and refill, the force models other than the
-momentum exchanges and the fields are the numpy backend's (this class is a NumpySolver whose
-step is compiled), so both compute the same numbers to float32 rounding
-(tests/test_cpu_vs_numpy.py). docs/science/cpu-backend.md says why this layout.
+A move's raster, links, node list and (float32 storage, equilibrium scheme) cover/uncover refill
+are compiled equals of the numpy backend's code (solver/body_compiled.py); the force models other
+than the momentum exchanges and the fields are the numpy backend's (this class is a NumpySolver
+whose step is compiled), so both compute the same numbers to float32 rounding
+(tests/test_cpu_vs_numpy.py, tests/test_body_local_move.py). docs/science/cpu-backend.md says why
+this layout.
 """
 from __future__ import annotations
 
