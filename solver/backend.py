@@ -358,9 +358,9 @@ def needs_gl_context(backend: str) -> bool:
     return backend in GL_CONTEXT_BACKENDS
 
 
-#: collision operators only the numpy reference implements (solver/kbc.py: entropic KBC, kept for
-#: the comparison in docs/science/collision-operators.md)
-NUMPY_ONLY_COLLISIONS = ("kbc",)
+#: collision operators kept for the comparison in docs/science/collision-operators.md, not for
+#: scenes, and the backends that run them (solver/kbc.py: entropic KBC, numpy and compiled cpu)
+COMPARISON_COLLISIONS = {"kbc": ("numpy", "cpu")}
 
 
 def create_solver(backend: str, config: FlowConfig, ctx=None) -> Solver:
@@ -369,8 +369,10 @@ def create_solver(backend: str, config: FlowConfig, ctx=None) -> Solver:
     others ignore it."""
     if backend not in BACKENDS:
         raise BackendError(f"unknown backend {backend!r}; choose one of {sorted(BACKENDS)}")
-    if config.collision in NUMPY_ONLY_COLLISIONS and backend != "numpy":
-        raise BackendError(f"the {config.collision} collision runs on the numpy backend only, not {backend!r}")
+    runs_on = COMPARISON_COLLISIONS.get(config.collision)
+    if runs_on is not None and backend not in runs_on:
+        raise BackendError(f"the {config.collision} collision runs on the {' and '.join(runs_on)} backends only, "
+                           f"not {backend!r}")
     module_name, cls_name = BACKENDS[backend].split(":")
     cls = getattr(importlib.import_module(module_name), cls_name)
     return cls(config, ctx=ctx) if needs_gl_context(backend) else cls(config)

@@ -13,7 +13,7 @@ from feelflow.solver.quiet_inlet import shortest_ramp
 X_BOUNDARIES = ("tunnel", "periodic")
 Y_BOUNDARIES = ("no_slip", "free_slip", "periodic")
 #: bgk, trt, "rr": recursive-regularised BGK (solver/regularised.py), the high-Reynolds operator,
-#: and "kbc": entropic KBC (solver/kbc.py; numpy backend only, for comparison)
+#: and "kbc": entropic KBC (solver/kbc.py; numpy and cpu backends, for comparison)
 COLLISIONS = ("bgk", "trt", "rr", "kbc")
 #: the equilibrium's velocity terms: rho u (compressible, the seed's eq. 9) or RHO0 u with
 #: u = j / RHO0 (incompressible, He & Luo 1997, J. Stat. Phys. 88, 927)

@@ -8,7 +8,8 @@ quiet inlet's correction, walls b, body links a with the moving-wall term) into 
 `pre`, from the same post-collision state, sums the momentum exchange on the body links as it
 goes, collides again exactly the nodes that own such a population (a list of nodes and bit
 masks, rebuilt when the body's links change) and resets the solid nodes. Every operator is
-compiled: BGK, TRT and recursive-regularised BGK (with or without the Smagorinsky viscosity).
+compiled: BGK, TRT, recursive-regularised BGK and entropic KBC (the last two with or without the
+Smagorinsky viscosity).
 The moving body's cover/uncover bookkeeping and refill, the force models other than the
 momentum exchanges and the fields are the numpy backend's (this class is a NumpySolver whose
 step is compiled), so both compute the same numbers to float32 rounding
@@ -71,7 +72,7 @@ class CpuSolver(NumpySolver):
         self._xs = xs
         self._target = np.zeros(ny, dt)  # the absorbing layer's target u_in(iy, t)
         self._fx, self._fy = (dt.type(v) for v in cfg.body_force)
-        smag = cfg.collision == "rr" and cfg.smagorinsky > 0
+        smag = cfg.collision in ("rr", "kbc") and cfg.smagorinsky > 0
         self._smag = float(smagorinsky_factor(cfg.smagorinsky)) if smag else 0.0
         self._advance = make_kernel(cfg.collision, bool(cfg.incompressible), keep is not None,
                                     tuple(cfg.body_force) != (0.0, 0.0), dt.name, smag)

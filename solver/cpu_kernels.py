@@ -4,7 +4,8 @@ collide pass over the grid (rows in parallel) and one serial pass over what the 
 docs/science/algorithm.md, steps 1-3, and docs/science/cpu-backend.md. The collision is node by
 node that of solver/collision.py (BGK, Bhatnagar, Gross & Krook 1954; TRT, Ginzburg, Verhaeghe &
 d'Humieres 2008) or of solver/regularised.py (recursive-regularised BGK, Malaspinas 2015, Coreixas
-et al. 2017, with the optional Smagorinsky viscosity), with Guo, Zheng & Shi (2002) forcing, the
+et al. 2017, with the optional Smagorinsky viscosity) or of solver/kbc.py (entropic KBC, Karlin,
+Boesch & Chikatamarla 2014, likewise), with Guo, Zheng & Shi (2002) forcing, the
 compressible or He & Luo (1997) equilibrium and the outlet sponge's per-column rates and
 absorbing layer (solver/sponge.py). The boundary pass writes what rules d, c, b and a write in
 the numpy backend (solver/inflow.py's outlet and inlet, solver/quiet_inlet.py, the walls,
@@ -196,6 +197,86 @@ def _collide_rr(f0, f1, f2, f3, f4, f5, f6, f7, f8, omega, keep, target, incomp,
 
 
 @numba.njit(inline="always", **_JIT)
+def _kbc_node(b, o, k, omega, keep, target, incomp, has_keep, Fx, Fy, has_force, smag):
+    """Entropic KBC (solver/kbc.py: Karlin, Boesch & Chikatamarla 2014) of node k's gathered
+    populations b[:, k] into o[:, k], in float64 (the numpy reference mixes float32 storage with
+    float64 weights); smag > 0 only in the Smagorinsky variant. Two passes over the directions:
+    the first writes Delta h into o and sums the entropic products <Delta s|Delta h>,
+    <Delta h|Delta h>; the second the post-collision state. Returns drho."""
+    drho = 0.0
+    jx = 0.0
+    jy = 0.0
+    exx = 0.0
+    eyy = 0.0
+    exy = 0.0
+    for i in range(9):
+        v = np.float64(b[i, k])
+        drho += v
+        jx += _CX[i] * v
+        jy += _CY[i] * v
+        exx += _CX[i] * _CX[i] * v
+        eyy += _CY[i] * _CY[i] * v
+        exy += _CX[i] * _CY[i] * v
+    rho = R0 if incomp else R0 + drho
+    fx = np.float64(Fx)
+    fy = np.float64(Fy)
+    ux = (jx + 0.5 * fx) / rho
+    uy = (jy + 0.5 * fy) / rho
+    deq = drho
+    if has_keep:   # absorbing layer (solver/sponge.py)
+        kp = np.float64(keep)
+        deq = drho * kp
+        ux = kp * ux + (1.0 - kp) * np.float64(target)
+        uy = kp * uy
+    om = np.float64(omega)
+    a0 = drho - deq
+    a1x = jx - rho * ux
+    a1y = jy - rho * uy
+    n_diff = (exx - eyy) - rho * (ux * ux - uy * uy)
+    pxy = exy - rho * ux * uy
+    if smag > 0:
+        pxx = exx - deq / 3.0 - rho * ux * ux
+        pyy = eyy - deq / 3.0 - rho * uy * uy
+        stress = math.sqrt(pxx * pxx + pyy * pyy + 2.0 * pxy * pxy)
+        tau0 = 1.0 / om
+        om = 1.0 / (0.5 * (tau0 + math.sqrt(tau0 * tau0 + np.float64(smag) * stress / (drho + R0))))
+    beta = 0.5 * om
+    rho_uxy = rho * ux * uy
+    eq_xxy = rho_uxy * ux
+    eq_xyy = rho_uxy * uy
+    base = deq - 1.5 * rho * (ux * ux + uy * uy)
+    sh = 0.0
+    hh = 0.0
+    for i in range(9):
+        cx, cy, w = _CX[i], _CY[i], _W[i]
+        cu = 3.0 * (cx * ux + cy * uy)
+        feq = w * (base + rho * (cu + 0.5 * cu * cu) + 13.5 * (cy * cy - 1.0 / 3.0) * cx * eq_xyy
+                   + 13.5 * (cx * cx - 1.0 / 3.0) * cy * eq_xxy)
+        dk = w * (a0 + 3.0 * (cx * a1x + cy * a1y))
+        ds = 0.25 * cx * cy * pxy + 0.25 * (cx * cx - cy * cy) * n_diff
+        dh = np.float64(b[i, k]) - feq - dk - ds
+        inv = 1.0 / (feq + w * R0)
+        sh += ds * dh * inv
+        hh += dh * dh * inv
+        o[i, k] = dh
+    gamma = 1.0 / beta - (2.0 - 1.0 / beta) * sh / hh if hh > 1e-30 else 2.0
+    step = beta * gamma
+    src = 1.0 - 0.5 * om
+    uF = ux * fx + uy * fy
+    for i in range(9):
+        cx, cy, w = _CX[i], _CY[i], _W[i]
+        dk = w * (a0 + 3.0 * (cx * a1x + cy * a1y))
+        ds = 0.25 * cx * cy * pxy + 0.25 * (cx * cx - cy * cy) * n_diff
+        v = np.float64(b[i, k]) - om * dk - 2.0 * beta * ds - step * np.float64(o[i, k])
+        if has_force:
+            cF = cx * fx + cy * fy
+            cu = 3.0 * (cx * ux + cy * uy)
+            v += src * w * (3.0 * cu * cF - 3.0 * uF + 3.0 * cF)
+        o[i, k] = v
+    return drho
+
+
+@numba.njit(inline="always", **_JIT)
 def _store(out, y, x, r):
     out[0, y, x] = r[0]
     out[1, y, x] = r[1]
@@ -263,6 +344,25 @@ def _chunk_rr(b, o, n, op, t, incomp, Fx, Fy, has_force, smag, K):
                         op, op, t, incomp, False, Fx, Fy, has_force, smag, K)
         _store_k(o, k, r)
         s += r[9]
+    return s
+
+
+@numba.njit(inline="always", **_JIT)
+def _chunk_kbc(b, o, n, op, t, incomp, Fx, Fy, has_force, smag):
+    """As _chunk for the entropic KBC operator."""
+    s = 0.0
+    for k in range(n):
+        s += _kbc_node(b, o, k, op, op, t, incomp, False, Fx, Fy, has_force, smag)
+    return s
+
+
+@numba.njit(inline="always", **_JIT)
+def _columns_kbc(b, o, n, cols, op, keep, t, incomp, has_keep, Fx, Fy, has_force, smag):
+    """As _columns for the entropic KBC operator."""
+    s = 0.0
+    for k in range(n):
+        x = cols[k]
+        s += _kbc_node(b, o, k, op[x], keep[x], t, incomp, has_keep, Fx, Fy, has_force, smag)
     return s
 
 
@@ -443,12 +543,13 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
     Its closure holds only these flags and constants, never another compiled function: numba's
     on-disk cache keys a closure by its variables' pickled bytes, and a compiled function pickles
     with an id that is new in every process, so such a closure would compile again at every start."""
-    if kind not in ("bgk", "trt", "rr"):
-        raise ValueError(f"the cpu backend compiles bgk, trt and rr, not {kind!r}")
+    if kind not in ("bgk", "trt", "rr", "kbc"):
+        raise ValueError(f"the cpu backend compiles bgk, trt, rr and kbc, not {kind!r}")
     K = constants(dtype)
     rr = kind == "rr"   # the closure's branches on these constants are pruned before inlining,
     trt = kind == "trt"  # so each variant compiles one operator
-    smag_on = bool(smagorinsky) and rr
+    kbc = kind == "kbc"
+    smag_on = bool(smagorinsky) and (rr or kbc)
 
     @numba.njit(parallel=True, **_JIT)
     def advance(n, t0, ramp_steps, g, out, pre, op, om, keep, target, xs, Fx, Fy, smag, scratch, sums,
@@ -510,6 +611,8 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                         if x0 < xs:        # the rates of column 1 for the whole chunk
                             if rr:
                                 s += _chunk_rr(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm, K)
+                            elif kbc:
+                                s += _chunk_kbc(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm)
                             else:
                                 s += _chunk(bb, o, m, op0, om0, tg, trt, incomp, Fx, Fy, has_force, K)
                         else:              # each column its own rates (the sponge)
@@ -517,6 +620,8 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                             if rr:
                                 s += _columns_rr(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force,
                                                  sm, K)
+                            elif kbc:
+                                s += _columns_kbc(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force, sm)
                             else:
                                 s += _columns(bb, o, m, c, op, om, keep, tg, trt, incomp, has_keep, Fx, Fy,
                                               has_force, K)
@@ -536,6 +641,8 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                 if rr:
                     total += _columns_rr(bb, o, 1, c, op, keep, target[y], incomp, has_keep, Fx, Fy, has_force,
                                          sm, K)
+                elif kbc:
+                    total += _columns_kbc(bb, o, 1, c, op, keep, target[y], incomp, has_keep, Fx, Fy, has_force, sm)
                 else:
                     total += _columns(bb, o, 1, c, op, om, keep, target[y], trt, incomp, has_keep, Fx, Fy,
                                       has_force, K)

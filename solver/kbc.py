@@ -19,8 +19,8 @@ natural-moment representation of D2Q9, its eq. 8):
 The equilibrium is rr's third-order Hermite one (solver/regularised.py, solver/lattice.py
 `equilibrium(order=3)`); the paper uses the product-form entropic equilibrium, which agrees
 with it to third order in u. Smagorinsky as rr's (Hou et al. 1995): tau from the
-non-equilibrium stress |Pi| of Delta. Runs on the numpy backend only (solver/backend.py refuses
-it elsewhere).
+non-equilibrium stress |Pi| of Delta. Runs on the numpy backend and, compiled, on the cpu backend
+(solver/cpu_kernels.py); solver/backend.py refuses it on gl.
 """
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ The tunnel scene of `feelflow bench solver` (app/bench/solver_speed.py: inlet, p
 its sponge, a cylinder moved every 10 steps, the reference force every step) at the window's
 default grid 256 x 128, float32, with each operator of solver/operator_choice.py and the others:
 TRT, BGK, recursive-regularised BGK (rr), rr with a Smagorinsky constant 0.1, and entropic KBC
-with and without it (numpy only: solver/kbc.py). Operators run in
+with and without it (numpy and cpu only: solver/kbc.py). Operators run in
 alternating rounds; the table gives median steps per second and, per backend, the cost of a
 step relative to TRT's measured in the same run (the chooser's "cheapest" is read from it).
 """
@@ -49,10 +49,10 @@ def main(args) -> int:
     quick = bool(getattr(args, "quick", False))
     rounds = getattr(args, "rounds", None) or (1 if quick else 3)
     steps = {"numpy": 60 if quick else 300, "cpu": 300 if quick else 1500, "gl": 200 if quick else 1000}
-    from feelflow.solver.backend import NUMPY_ONLY_COLLISIONS
+    from feelflow.solver.backend import COMPARISON_COLLISIONS
 
     def runs_on(backend, op):
-        return backend == "numpy" or op[0] not in NUMPY_ONLY_COLLISIONS
+        return backend in COMPARISON_COLLISIONS.get(op[0], (backend,))
 
     rates = {(b, op): [] for b in steps for op in OPERATORS if runs_on(b, op)}
     for _ in range(rounds):

@@ -105,8 +105,8 @@ class MainWindow(QMainWindow):
         self.exports = ExportController(events, vp, plot, replays, self.bodies, self)
         self.lessons = LessonController(events, vp, loop, panel, plot, self.undo, replays, self.flow, self.bodies,
                                         status, self.make_current)
-        self.video = VideoController(self, vp, loop)
-        self.probes = ProbeController(self, vp)
+        self.video = VideoController(events, vp, loop, status, self)
+        self.probes = ProbeController(events, vp, plot, replays, status, self)
         self.plot.probes = self.probes.probes   # the forces CSV carries the probes' columns
         self.units = UnitsController(events, self.settings, panel, plot, self.probes, replays, status, self)
         self.backends = BackendController(self.settings, vp, status, backend)   # "auto": measured once the context exists

@@ -15,7 +15,7 @@ from feelflow.app.inputs import MAX_STEPS, check_work
 from feelflow.solver.motion import MOVES, MotionScript, Phase, phase_velocity
 from feelflow.solver import units
 from feelflow.solver.backend import BACKENDS
-from feelflow.solver.backend import NUMPY_ONLY_COLLISIONS
+from feelflow.solver.backend import COMPARISON_COLLISIONS
 from feelflow.solver.config import COLLISIONS, DTYPES, EQUILIBRIA, PROFILES, X_BOUNDARIES, Y_BOUNDARIES, ConfigError, FlowConfig
 from feelflow.solver.forces import MODELS
 
@@ -203,7 +203,7 @@ def scene_from_dict(data: dict, source: str = "scene") -> Scene:
 
     flow = top.table("flow")
     # None: solver/operator_choice.py picks; the numpy-only operators (KBC) are not for scenes
-    named_operator = flow.choice("collision", tuple(c for c in COLLISIONS if c not in NUMPY_ONLY_COLLISIONS), None)
+    named_operator = flow.choice("collision", tuple(c for c in COLLISIONS if c not in COMPARISON_COLLISIONS), None)
     smagorinsky = flow.number("smagorinsky", 0.0, nonnegative=True)
     trt_magic = flow.number("trt_magic", 3.0 / 16.0, positive=True)
     equilibrium = flow.choice("equilibrium", EQUILIBRIA, "compressible")

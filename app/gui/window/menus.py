@@ -67,6 +67,7 @@ def build_menus(w: "MainWindow") -> Actions:
     f.addSeparator()
     add_action(w, f, "Export video of a session\u2026", w.video.export_session_dialog)
     record_video = add_action(w, f, "Record video of the window", w.video.toggle_live, checkable=True)
+    w.events.videoRecording.connect(record_video.setChecked)
     f.addSeparator()
     add_action(w, f, "Quit", w.close, "Ctrl+Q")
     e = bar.addMenu("&Edit")
@@ -85,6 +86,7 @@ def build_menus(w: "MainWindow") -> Actions:
     w.backends.build_menu(r)   # Solver backend: Automatic / cpu / gl / numpy
     v = bar.addMenu("&View")
     place_probes = add_action(w, v, "Place probes (click in the flow)", w.probes.set_placing, "P", checkable=True)
+    w.events.probesPlacing.connect(place_probes.setChecked)
     add_action(w, v, "Remove all probes", w.probes.clear)
     add_action(w, v, "Units\u2026", w.units.dialog)
     v.addSeparator()
