@@ -133,13 +133,35 @@ AUTO = "auto"
 CHOICE_KEY = "float64 scoring"
 
 
-def _timed_choice(config, store_path: str) -> tuple[str, str]:
+def _timed_choice(config, store_path: str, body=None) -> tuple[str, str]:
+    """choose_backend on `config`, with `body` (a posed shape) placed as the scoring run places
+    it, so that the trial also compiles what scoring it needs (the body's raster of its kind)
+    once, before the graders start; None: the default trial's cylinder."""
     from feelflow.app.model.backend_choice import JsonFileStore, choose_backend
     from feelflow.solver.backend import create_solver
 
+    def setup(solver):
+        solver.enable_force_models([scoring.FORCE_MODEL])
+        solver.set_body(body)
+
+    kwargs = {} if body is None else {"setup": setup}
     choice = choose_backend(config, lambda name, cfg: create_solver(name, cfg), JsonFileStore(store_path),
-                            renderer=CHOICE_KEY, candidates=scoring.BACKENDS)
+                            renderer=CHOICE_KEY, candidates=scoring.BACKENDS, **kwargs)
     return choice.backend, choice.describe(config.nx, config.ny)
+
+
+def _trial_body(exercise, scale: int):
+    """The exercise's first reference shape, posed as scoring poses it, or None."""
+    from feelflow.app.exercises.constraints import posed
+    from feelflow.app.shape_files import load_shape
+    from feelflow.shapes.base import ShapeError
+
+    if not exercise.references:
+        return None
+    try:
+        return posed(exercise, load_shape(exercise.references[0].path), scale)
+    except (ShapeError, UserError):
+        return None
 
 
 def resolve_backend(backend: str, exercise, scale: int = 1, store_path=None) -> tuple[str, str | None]:
@@ -159,7 +181,7 @@ def resolve_backend(backend: str, exercise, scale: int = 1, store_path=None) -> 
         return known, f"scoring backend {known} (remembered for {config.nx} x {config.ny})"
     try:
         with ProcessPoolExecutor(max_workers=1) as pool:
-            name, line = pool.submit(_timed_choice, config, path).result()
+            name, line = pool.submit(_timed_choice, config, path, _trial_body(exercise, scale)).result()
     except RuntimeError as exc:   # neither can run (choose_backend says why)
         raise UserError(f"--backend auto: {exc}") from None
     return name, f"scoring {line}"
