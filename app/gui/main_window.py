@@ -111,7 +111,9 @@ class MainWindow(QMainWindow):
                                         status, self.make_current)
         self.video = VideoController(events, vp, loop, status, self)
         self.backends = BackendController(self.settings, vp, status, backend)   # "auto": measured once the context exists
-        self.exercises = ExerciseController(self, vp, loop)   # the Exercises menu and panel
+        self.exercises = ExerciseController(events, vp, loop, panel, plot, self.undo, replays, self.flow,
+                                            self.bodies, self.settings, status, self.make_current,
+                                            self)   # the Exercises menu and panel
         self.actions = build_menus(self)
 
         self.params = params or self.store.params()
