@@ -232,8 +232,13 @@ class MainWindow(QMainWindow):
             return True
         return super().event(ev)
 
+    def remember(self):
+        """What the next start comes back to (app/gui/window/settings.py)."""
+        self.store.save(self.params_now(), self.sim.polygon if self.sim is not None else None,
+                        self.loop.display_mode, self.saveGeometry())
+
     def closeEvent(self, ev):
-        self.store.save(self)
+        self.remember()
         self.loop.stop()
         self.exercises.shutdown()
         self.video.close()
