@@ -123,6 +123,29 @@ def _share_cores(threads: int) -> None:
     numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
 
 
+def _warm_up(exercise_path: str, path: str, scale: int) -> None:
+    """One step of a cpu-backend scoring run of `path` (without a body if it is not a valid shape
+    file): compiles, or loads from numba's disk cache, what the grading processes then load."""
+    from feelflow.app.exercises.constraints import posed
+    from feelflow.app.shape_files import load_shape
+    from feelflow.shapes.base import ShapeError
+    from feelflow.solver.backend import create_solver
+
+    exercise = _exercise(exercise_path)
+    try:
+        body = posed(exercise, load_shape(path), scale)
+    except (ShapeError, UserError):
+        body = None
+    solver = create_solver("cpu", exercise.scene.scaled(scale).flow_config())
+    try:
+        solver.enable_force_models([scoring.FORCE_MODEL])
+        if body is not None:
+            solver.set_body(body)
+        solver.step(1)
+    finally:
+        solver.close()
+
+
 def default_workers() -> int:
     return os.cpu_count() or 1
 
@@ -207,6 +230,13 @@ def grade(exercise, paths, workers: int | None = None, scales=(1,), progress=Non
         initializer, initargs = None, ()
         if backend == "cpu":
             initializer, initargs = _share_cores, (max(1, default_workers() // workers),)
+            # the kernels compile once here, in a process of its own, not in every grading
+            # process at once (a first run, or the first after an update of the kernels)
+            with ProcessPoolExecutor(max_workers=1) as warm:
+                try:
+                    warm.submit(_warm_up, *jobs[0][:3]).result()
+                except Exception:  # noqa: BLE001 - the graders' own runs report what is wrong
+                    pass
         with ProcessPoolExecutor(max_workers=workers, initializer=initializer, initargs=initargs) as pool:
             futures = {pool.submit(_worker, job): i for i, job in enumerate(jobs)}
             for n, fut in enumerate(as_completed(futures), 1):

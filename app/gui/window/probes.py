@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from feelflow.app.gui.force_plot import ForcePlot
     from feelflow.app.gui.viewport import Viewport
     from feelflow.app.gui.window.events import WindowEvents
-    from feelflow.app.gui.window.replay_controller import ReplayController
+    from feelflow.app.gui.window.frame_loop import FrameLoop
 
 PLOT_REFRESH_MS = 250
 PLACING_HINT = "Click in the flow to place a probe (up to 4); right-click one to remove it. View > Place probes ends this."
@@ -27,10 +27,10 @@ PLACING_HINT = "Click in the flow to place a probe (up to 4); right-click one to
 
 class ProbeController:
     def __init__(self, events: "WindowEvents", viewport: "Viewport", forces_plot: "ForcePlot",
-                 replays: "ReplayController", status: "QStatusBar", docks: "QMainWindow"):
+                 loop: "FrameLoop", status: "QStatusBar", docks: "QMainWindow"):
         """`forces_plot`: the force plot the probes' dock goes beside; `docks`: the main window
         that holds the docks (and the timer)."""
-        self.events, self.viewport, self.forces_plot, self.replays = events, viewport, forces_plot, replays
+        self.events, self.viewport, self.forces_plot, self.loop = events, viewport, forces_plot, loop
         self.status, self.docks = status, docks
         self.probes = Probes()
         self.plot = ProbePlot()
@@ -69,7 +69,7 @@ class ProbeController:
         self.viewport.setCursor(Qt.CrossCursor if on else Qt.ArrowCursor)
 
     def clicked(self, x: float, y: float, remove: bool):
-        model = self.replays.shown
+        model = self.loop.shown
         if model is None:
             return
         if remove:
@@ -105,7 +105,7 @@ class ProbeController:
         callable that reads it back (the gl path reads it only when there are probes)."""
         if not len(self.probes):
             return
-        model = self.replays.shown
+        model = self.loop.shown
         if model is None:
             return
         rgba = field() if callable(field) else field
