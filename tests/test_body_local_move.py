@@ -83,6 +83,24 @@ def test_compiled_polygon_raster_equals_the_reference(shape):
     assert ref.box_q.any()
 
 
+@pytest.mark.parametrize("pose", [(40.999999999, 30.5), (41.000000001, 30.5), (6.1, 31.3), (30.4, 6.3)])
+def test_window_links_equal_the_whole_grid_links(pose):
+    """The links a move builds on the force window (numpy and compiled) are those of the whole
+    grid's mask and cut fractions, node for node, across a cell edge and beside the walls."""
+    cfg = FlowConfig(nx=NX, ny=NY)
+    shape = Cylinder(12.0, x=pose[0], y=pose[1])
+    whole = build_links(rasterise(shape, NX, NY, 0).q, rasterise(shape, NX, NY, 0).solid, 0, 0, (shape.x, shape.y),
+                        (0.03, -0.01), 0.002)
+    for builders in ({}, dict(links=body_compiled.build_links, rasteriser=body_compiled.raster)):
+        body = make_body_state(shape, (0.03, -0.01), 0.002, cfg, 2, **builders)
+        L, (x0, y0) = body.links, body.window[:2]
+        assert len(L) == len(whole) > 0
+        for name in ("i", "q", "uw", "a", "b", "c", "d"):
+            assert np.array_equal(getattr(L, name), getattr(whole, name)), name
+        assert np.array_equal(L.iy + y0, whole.iy) and np.array_equal(L.ix + x0, whole.ix)
+        assert np.array_equal(L.fy + y0, whole.fy) and np.array_equal(L.fx + x0, whole.fx)
+
+
 def test_compiled_links_across_a_periodic_seam():
     """A window that spans the periodic x direction whole takes second nodes across the seam."""
     cfg = FlowConfig(nx=16, ny=32, x_boundary="periodic", y_boundary="periodic")
