@@ -169,7 +169,7 @@ class ExerciseController(QObject):
         if self.sim is None or self.replays.refuse("exercises run in the live tunnel"):
             return False
         if self.worker is not None:
-            QMessageBox.information(w, "Scoring is running", "Wait for the score or cancel it first.")
+            QMessageBox.information(self.window, "Scoring is running", "Wait for the score or cancel it first.")
             return False
         try:
             exercise = load_exercise(path)
