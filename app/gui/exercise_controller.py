@@ -175,13 +175,7 @@ class ExerciseController(QObject):
             exercise = load_exercise(path)
             start = load_shape(exercise.start)
             s = exercise.scene
-            scene = scene_from_dict({
-                "grid": {"nx": s.nx, "ny": s.ny},
-                "flow": {"nu": s.nu, "inflow_speed": s.inflow_speed, "walls": s.walls, "dtype": "float32",
-                         "inflow_ramp_steps": 0, "initial_velocity": [s.inflow_speed, 0.0],
-                         "sponge_cells": s.sponge_cells, "sponge_absorb": 0.1},
-                "body": {"kind": "cylinder", "diameter": s.reference_length, "x": s.body_x, "y": s.body_y},
-                "run": {"steps": s.steps}}, exercise.source)
+            scene = scene_from_dict(s.live_scene(), exercise.source)   # the scored flow, in float32
             self.make_current()
             self.sim.load_scene(scene)
         except (UserError, ShapeError, ValueError) as exc:
