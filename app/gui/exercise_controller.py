@@ -19,7 +19,7 @@ from PySide6.QtWidgets import QDockWidget, QFileDialog, QMessageBox
 from feelflow import EXERCISE_DIR
 from feelflow.app.errors import UserError
 from feelflow.app.exercises import scoring
-from feelflow.app.exercises.uncertainty import better_by, fmt, tied
+from feelflow.app.exercises.uncertainty import fmt, standing
 from feelflow.app.gui.exercise_panel import PARAMETERS, PANEL_WIDTH, ExercisePanel, ScrollingPanel
 from feelflow.app.model import readouts
 from feelflow.app.model.readouts import EXERCISE_LENGTH, ReferenceLength
@@ -169,7 +169,7 @@ class ExerciseController(QObject):
         if self.sim is None or self.replays.refuse("exercises run in the live tunnel"):
             return False
         if self.worker is not None:
-            QMessageBox.information(w, "Scoring is running", "Wait for the score or cancel it first.")
+            QMessageBox.information(self.window, "Scoring is running", "Wait for the score or cancel it first.")
             return False
         try:
             exercise = load_exercise(path)
@@ -410,12 +410,7 @@ class ExerciseController(QObject):
             if result.hit is not None:
                 lines.append("A hit: within the tolerance." if result.hit else "Not a hit yet: outside the tolerance.")
             for ref in ex.references:
-                if u is not None and tied(result.score, ref.score, u):
-                    word = "tied (within the grid uncertainty) with"
-                elif u is None and round(result.score, 4) == round(ref.score, 4):
-                    word = "the same as"
-                else:
-                    word = "better than" if better_by(result.score, ref.score, o.better, None) else "behind"
+                word = standing(result.score, ref.score, o.better, u)
                 lines.append(f"{word} the reference \u201c{ref.label}\u201d ({fmt(ref.score, u)})")
             lines.append(f"<small>{result.averaging}</small>")
             self.panel.result.setText("<br>".join(lines))

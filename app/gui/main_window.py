@@ -234,7 +234,7 @@ class MainWindow(QMainWindow):
 
     def remember(self):
         """What the next start comes back to (app/gui/window/settings.py)."""
-        self.store.save(self.params_now(), self.sim.polygon if self.sim is not None else None,
+        self.store.remember(self.params_now(), self.sim.polygon if self.sim is not None else None,
                         self.loop.display_mode, self.saveGeometry())
 
     def closeEvent(self, ev):

@@ -72,7 +72,7 @@ class WindowSettings:
         else:
             window.resize(1280, 820)
 
-    def save(self, params: Params, polygon, display_mode: str, geometry) -> None:
+    def remember(self, params: Params, polygon, display_mode: str, geometry) -> None:
         """The panel's parameters, the custom polygon (body frame; None keeps the remembered
         one), the display mode and the window's geometry (QMainWindow.saveGeometry)."""
         s = self.qsettings
