@@ -195,6 +195,10 @@ class Solver(ABC):
         check_schemes(refill, impulse)
         self.body_refill, self.body_impulse = refill, impulse
 
+    #: build a moved body's raster and links compiled (solver/body_compiled.py, the same numbers);
+    #: the numpy backend, the reference, builds them with its own readable code
+    compiled_moves: bool = False
+
     def _body_state(self, shape, velocity, omega, raster=None):
         """The rasterised, speed-capped body state for `set_body` (None without a body), with a
         force window wide enough for every enabled model (solver/body.py)."""
@@ -202,8 +206,13 @@ class Solver(ABC):
             return None
         from feelflow.solver.body import make_body_state, window_margin
 
+        builders = {}
+        if self.compiled_moves:
+            from feelflow.solver import body_compiled
+
+            builders = dict(links=body_compiled.build_links, rasteriser=body_compiled.compiled_raster(shape))
         return make_body_state(shape, velocity, omega, self.config,
-                               window_margin(self._models.values()), raster)
+                               window_margin(self._models.values()), raster, **builders)
 
     # --- stepping -------------------------------------------------------------
     @abstractmethod

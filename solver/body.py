@@ -282,7 +282,7 @@ def make_body_state(shape, velocity, omega, config, margin: int, raster=None, li
     """Rasterise `shape` (unless `raster` is given: a BodyRaster of this shape with any
     window margin), cap its motion and build its links on raster.window + margin. `links`:
     `build_links` or an equal; `rasteriser(shape, nx, ny)`: one for this shape equal to
-    `rasterise(shape, nx, ny, 0)`, or None (the compiled ones: solver/cpu_body.py)."""
+    `rasterise(shape, nx, ny, 0)`, or None (the compiled ones: solver/body_compiled.py)."""
     from feelflow.shapes.raster import rasterise
 
     nx, ny = config.nx, config.ny

@@ -10,18 +10,19 @@ goes, collides again exactly the nodes that own such a population (a list of nod
 masks, rebuilt when the body's links change) and resets the solid nodes. Every operator is
 compiled: BGK, TRT, recursive-regularised BGK and entropic KBC (the last two with or without the
 Smagorinsky viscosity).
-The moving body's cover/uncover bookkeeping and refill, the force models other than the
-momentum exchanges and the fields are the numpy backend's (this class is a NumpySolver whose
-step is compiled), so both compute the same numbers to float32 rounding
-(tests/test_cpu_vs_numpy.py). docs/science/cpu-backend.md says why this layout.
+A move's raster, links, node list and (float32 storage, equilibrium scheme) cover/uncover refill
+are compiled equals of the numpy backend's code (solver/body_compiled.py); the force models other
+than the momentum exchanges and the fields are the numpy backend's (this class is a NumpySolver
+whose step is compiled), so both compute the same numbers to float32 rounding
+(tests/test_cpu_vs_numpy.py, tests/test_body_local_move.py). docs/science/cpu-backend.md says why
+this layout.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from feelflow.solver import cpu_body
+from feelflow.solver import body_compiled
 from feelflow.solver.backend import SolverDiverged
-from feelflow.solver.body import make_body_state, window_margin
 from feelflow.solver.forces.momentum_exchange import ClassicMomentumExchange, GalileanMomentumExchange
 from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS
 from feelflow.solver.numpy_backend import NumpySolver, absorb_keep, relaxation_rates
@@ -49,6 +50,7 @@ class CpuSolver(NumpySolver):
     """D2Q9 solver compiled for the CPU with numba: NumpySolver's algorithm, fused kernels."""
 
     name = "cpu"
+    compiled_moves = True
 
     def __init__(self, config):
         from feelflow.solver.cpu_kernels import CHUNK, WALLS, make_kernel
@@ -113,7 +115,7 @@ class CpuSolver(NumpySolver):
     def _redo_nodes(self):
         """(iy, ix, bits) of every node a boundary rule or a body link writes a population of,
         and the links as flat arrays in grid coordinates; rebuilt when the body's links change,
-        from the links and the body window alone (compiled: solver/cpu_body.py). A link node on
+        from the links and the body window alone (compiled: solver/body_compiled.py). A link node on
         the domain's edge comes twice, the second time (the links' part, later in the list) with
         every bit, so it wins."""
         b = self.body
@@ -121,25 +123,20 @@ class CpuSolver(NumpySolver):
         if self._redo is not None and links is self._mask_links:
             return self._redo, self._link_arrays
         if links is not None and len(links):
-            self._redo, self._link_arrays = cpu_body.redo_nodes(self._edge_nodes, self._edge_grid, links, b.window)
+            self._redo, self._link_arrays = body_compiled.redo_nodes(self._edge_nodes, self._edge_grid, links, b.window)
         else:
             self._redo, self._link_arrays = self._edge_nodes, (_EMPTY_I,) * 5 + (_EMPTY_F,) * 8
         self._mask_links = links
         return self._redo, self._link_arrays
 
-    def _body_state(self, shape, velocity, omega, raster=None):
-        """As Solver._body_state, with the compiled raster (a cylinder or a polygonal shape) and
-        the compiled links (solver/cpu_body.py: the same numbers, a fraction of the time per move)."""
-        if shape is None:
-            return None
-        return make_body_state(shape, velocity, omega, self.config, window_margin(self._models.values()), raster,
-                               links=cpu_body.build_links, rasteriser=cpu_body.compiled_raster(shape))
-
     def _move_body(self, old, new) -> tuple[float, float]:
-        """NumpySolver._move_body, compiled for the equilibrium refill (solver/cpu_body.py)."""
-        if self.body_refill != "equilibrium":
+        """NumpySolver._move_body, compiled for the equilibrium refill of float32 storage, the
+        window's (solver/body_compiled.py); float64 storage (scoring, validation: bodies placed
+        once or seldom) and Caiazzo's refill run the numpy code, which spares a second compiled
+        variant (tens of seconds on a fresh machine)."""
+        if self.body_refill != "equilibrium" or self.dtype != np.float32:
             return super()._move_body(old, new)
-        return cpu_body.move_body(old, new, self.config, self.g, self.body_impulse)
+        return body_compiled.move_body(old, new, self.config, self.g, self.body_impulse)
 
     # --- stepping -------------------------------------------------------------
     def step(self, n: int = 1) -> None:

@@ -71,6 +71,7 @@ class GLSolver(Solver):
     """The lattice Boltzmann step on the GPU (fragment shaders), float32; see the module docstring."""
 
     name = "gl"
+    compiled_moves = True   # the moved body's raster and links (solver/body_compiled.py)
 
     def __init__(self, config, ctx=None):
         super().__init__(config)

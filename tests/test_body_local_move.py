@@ -1,5 +1,5 @@
 """A body move works on the body's box only, and the compiled move of the cpu backend
-(solver/cpu_body.py) equals the numpy reference (solver/body.py, solver/bouzidi.py,
+(solver/body_compiled.py) equals the numpy reference (solver/body.py, solver/bouzidi.py,
 shapes/raster.py).
 
 - the compiled raster (cylinders, plates, wedges, airfoils, polygons) and links equal the
@@ -21,7 +21,7 @@ from feelflow.shapes import Cylinder, FlatPlate, Polygon
 from feelflow.shapes.naca import NacaAirfoil
 from feelflow.shapes.polygon import HalfAirfoil, Wedge
 from feelflow.shapes.raster import rasterise
-from feelflow.solver import cpu_body
+from feelflow.solver import body_compiled
 from feelflow.solver.body import expand_box, make_body_state, move_body, refill, shifted, unshifted
 from feelflow.solver.bouzidi import build_links, periodic_wrap
 from feelflow.solver.config import FlowConfig
@@ -44,14 +44,14 @@ def _random_poses(n=20, seed=7):
 def test_compiled_cylinder_raster_and_links_equal_the_reference(pose):
     x, y, d = pose
     shape = Cylinder(d, x=x, y=y)
-    ref, fast = rasterise(shape, NX, NY, 0), cpu_body.raster(shape, NX, NY)
+    ref, fast = rasterise(shape, NX, NY, 0), body_compiled.raster(shape, NX, NY)
     assert (fast.box, fast.window) == (ref.box, ref.window)
     assert np.array_equal(fast.box_solid, ref.box_solid) and np.array_equal(fast.box_q, ref.box_q)
     window = expand_box(ref.window, 2, NX, NY)
     solid, q = ref.crop(window)
     for wrap in ((False, False), (True, True)):
         a = build_links(q, solid, window[0], window[1], (x, y), (-0.04, 0.01), 0.003, wrap)
-        b = cpu_body.build_links(q, solid, window[0], window[1], (x, y), (-0.04, 0.01), 0.003, wrap)
+        b = body_compiled.build_links(q, solid, window[0], window[1], (x, y), (-0.04, 0.01), 0.003, wrap)
         assert len(a) > 0
         for name in LINK_FIELDS:
             assert np.array_equal(getattr(a, name), getattr(b, name)), name
@@ -77,10 +77,28 @@ def _polygonal_shapes():
 
 @pytest.mark.parametrize("shape", _polygonal_shapes(), ids=lambda s: s.kind)
 def test_compiled_polygon_raster_equals_the_reference(shape):
-    ref, fast = rasterise(shape, NX, NY, 0), cpu_body.raster(shape, NX, NY)
+    ref, fast = rasterise(shape, NX, NY, 0), body_compiled.raster(shape, NX, NY)
     assert (fast.box, fast.window) == (ref.box, ref.window)
     assert np.array_equal(fast.box_solid, ref.box_solid) and np.array_equal(fast.box_q, ref.box_q)
     assert ref.box_q.any()
+
+
+@pytest.mark.parametrize("pose", [(40.999999999, 30.5), (41.000000001, 30.5), (6.1, 31.3), (30.4, 6.3)])
+def test_window_links_equal_the_whole_grid_links(pose):
+    """The links a move builds on the force window (numpy and compiled) are those of the whole
+    grid's mask and cut fractions, node for node, across a cell edge and beside the walls."""
+    cfg = FlowConfig(nx=NX, ny=NY)
+    shape = Cylinder(12.0, x=pose[0], y=pose[1])
+    whole = build_links(rasterise(shape, NX, NY, 0).q, rasterise(shape, NX, NY, 0).solid, 0, 0, (shape.x, shape.y),
+                        (0.03, -0.01), 0.002)
+    for builders in ({}, dict(links=body_compiled.build_links, rasteriser=body_compiled.raster)):
+        body = make_body_state(shape, (0.03, -0.01), 0.002, cfg, 2, **builders)
+        L, (x0, y0) = body.links, body.window[:2]
+        assert len(L) == len(whole) > 0
+        for name in ("i", "q", "uw", "a", "b", "c", "d"):
+            assert np.array_equal(getattr(L, name), getattr(whole, name)), name
+        assert np.array_equal(L.iy + y0, whole.iy) and np.array_equal(L.ix + x0, whole.ix)
+        assert np.array_equal(L.fy + y0, whole.fy) and np.array_equal(L.fx + x0, whole.fx)
 
 
 def test_compiled_links_across_a_periodic_seam():
@@ -88,7 +106,7 @@ def test_compiled_links_across_a_periodic_seam():
     cfg = FlowConfig(nx=16, ny=32, x_boundary="periodic", y_boundary="periodic")
     ref = make_body_state(Cylinder(14.0, x=7.6, y=16.4), (0.02, 0.0), 0.0, cfg, 2)
     fast = make_body_state(Cylinder(14.0, x=7.6, y=16.4), (0.02, 0.0), 0.0, cfg, 2,
-                           links=cpu_body.build_links, rasteriser=cpu_body.raster)
+                           links=body_compiled.build_links, rasteriser=body_compiled.raster)
     assert periodic_wrap(cfg, ref.window)[0]
     assert (ref.links.fx != ref.links.ix + C[ref.links.i, 0]).any()   # some second node wraps
     for name in LINK_FIELDS:
@@ -134,7 +152,7 @@ def test_a_local_move_equals_a_whole_grid_refill(old_pose, new_pose, omega, impu
 
     j_local = move_body(old, new, cfg, read_window, write_nodes, impulse=impulse)
     g = shifted(f0).astype(np.float32)
-    j_fast = cpu_body.move_body(old, new, cfg, g, impulse)
+    j_fast = body_compiled.move_body(old, new, cfg, g, impulse)
 
     assert np.abs(whole - f0).max() > 1e-3    # the move wrote something
     np.testing.assert_allclose(local, whole, rtol=0, atol=1e-14)
@@ -152,7 +170,7 @@ def test_compiled_node_list_holds_the_link_nodes_and_their_bits():
     edge_grid[0, :] = 0b1100100   # the lower wall's bits (2, 5, 6), under some link nodes
     ey, ex = np.nonzero(edge_grid)
     edge = (ey, ex, edge_grid[ey, ex])
-    (ry, rx, rbits), arrays = cpu_body.redo_nodes(edge, edge_grid, L, body.window)
+    (ry, rx, rbits), arrays = body_compiled.redo_nodes(edge, edge_grid, L, body.window)
     assert np.array_equal(ry[:ey.size], ey) and np.array_equal(rbits[:ey.size], edge[2])
     want = {}
     for i, iy, ix in zip(L.i, L.iy + y0, L.ix + x0):

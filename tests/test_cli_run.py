@@ -113,7 +113,8 @@ def test_run_writes_the_documented_csv(tmp_path):
     assert result.returncode == 0, result.stderr
     rows = list(csv.reader(out.open()))
     assert rows[0] == ["step", "x", "y", "vx", "vy", "fx_momentum_exchange", "fy_momentum_exchange",
-                       "fx_momentum_exchange_classic", "fy_momentum_exchange_classic"]
+                       "fx_momentum_exchange_classic", "fy_momentum_exchange_classic",
+                       "torque_momentum_exchange", "torque_momentum_exchange_classic"]
     data = [[float(v) for v in r] for r in rows[1:]]
     assert [r[0] for r in data] == [20, 40, 60]  # one row per interval, the last one shorter
     # the body rests for 30 steps, then moves at (0.02, 0.01): after 60 steps it moved 30 steps

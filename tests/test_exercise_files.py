@@ -308,3 +308,18 @@ def test_class_folder_problems_are_one_line(exercise, capsys, tmp_path):
     empty.mkdir()
     code, _, err = run(capsys, "exercise", "score", exercise, empty)
     one_line_refusal(code, err, "no shape files")
+
+
+def test_the_window_shows_the_scored_flow_in_float32():
+    """ScoringScene.live_scene: the window's tunnel for an exercise is the flow it is scored in
+    (grid, viscosity, wind, walls, outlet sponge), in float32."""
+    from feelflow import EXERCISE_DIR
+    from feelflow.app.exercises.format import load_exercise
+    from feelflow.app.model.scene import scene_from_dict
+
+    exercise = load_exercise(EXERCISE_DIR / "most_lift.toml")
+    s = exercise.scene
+    live, scored = scene_from_dict(s.live_scene(), exercise.source).config, s.flow_config()
+    for key in ("nx", "ny", "nu", "inflow_speed", "y_boundary", "sponge_cells", "initial_velocity"):
+        assert getattr(live, key) == getattr(scored, key), key
+    assert live.dtype == "float32" and scored.dtype == "float64"

@@ -147,3 +147,15 @@ def test_the_cpu_backend_scores_numpys_digits():
     b = scoring.score_shape(ex, shape, backend="cpu")
     assert a.ok and b.ok
     assert b.score == pytest.approx(a.score, rel=1e-12) and round(a.score, 4) == round(b.score, 4)
+
+
+def test_standing_against_a_reference():
+    """The exercise panel's words for a score against a reference's (uncertainty.standing)."""
+    from feelflow.app.exercises.uncertainty import standing
+
+    assert standing(1.00, 1.02, "lower", 0.05) == "tied (within the grid uncertainty) with"
+    assert standing(1.00, 1.20, "lower", 0.05) == "better than"
+    assert standing(1.20, 1.00, "lower", 0.05) == "behind"
+    assert standing(1.20, 1.00, "higher", 0.05) == "better than"
+    assert standing(1.00002, 1.00001, "lower", None) == "the same as"
+    assert standing(1.001, 1.002, "lower", None) == "better than"

@@ -94,3 +94,20 @@ def test_first_start_without_an_exercise_still_offers_the_lessons(qtbot, tmp_pat
         w.loop.timer.stop()
         w.loop.slow_timer.stop()
         w.close()
+
+
+def test_another_exercise_waits_for_a_running_score(qtbot, tmp_path, monkeypatch):
+    """While a score runs, opening an exercise says so in one dialog and changes nothing."""
+    from PySide6.QtWidgets import QMessageBox
+
+    w = _window(qtbot, tmp_path, None)
+    try:
+        said = []
+        monkeypatch.setattr(QMessageBox, "information", lambda *a, **k: said.append(a[1]))
+        exercise = w.exercises.exercise
+        w.exercises.worker = object()   # a score running
+        assert not w.exercises.open(MOST_LIFT)
+        assert said == ["Scoring is running"] and w.exercises.exercise is exercise
+    finally:
+        w.exercises.worker = None
+        w.loop.timer.stop()

@@ -275,7 +275,7 @@ def test_settings_are_remembered(qtbot, tmp_path):
     w.panel.shape.setCurrentIndex(w.panel.shape.findData("polygon"))
     edited = [(x * 1.3, y) for x, y in w.sim.polygon]
     assert w.bodies.edit_polygon(edited)
-    w.store.save(w)
+    w.remember()
     w2 = MainWindow(backend="numpy", settings=QSettings(path, QSettings.IniFormat))
     qtbot.addWidget(w2)
     assert w2.params.wind == pytest.approx(0.07) and w2.loop.display_mode == "vorticity"

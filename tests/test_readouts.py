@@ -95,3 +95,33 @@ def test_the_torque_arc_follows_the_torque_and_is_capped():
     assert torque_arc(-0.5 * reference, 16.0, 0.1) == pytest.approx(-0.5 * TORQUE_ARC_DEG)   # clockwise
     assert torque_arc(100 * reference, 16.0, 0.1) == TORQUE_ARC_CAP_DEG
     assert torque_arc(float("nan"), 16.0, 0.1) is None and torque_arc(None, 16.0, 0.1) is None
+
+
+def test_forces_table_joins_the_probes_on_the_step():
+    """The window's forces CSV (readouts.forces_table): the lattice table as it is without
+    probes or SI units; a probe's columns on the rows of the steps it sampled, blank elsewhere
+    (the SI columns: tests/test_gui_units.py)."""
+    from feelflow.app.model.display_units import DisplayUnits
+    from feelflow.app.model.probes import Probes
+
+    h, length = history(n=4), ReferenceLength(20.0)
+    plain = readouts.forces_csv(h, ["momentum_exchange"], length)
+    assert readouts.forces_table(h, ["momentum_exchange"], length, Probes(), DisplayUnits()) == plain
+    probes = Probes()
+    probes.add(2.0, 2.0, 8, 8)
+    field = np.zeros((8, 8, 4))
+    field[..., 0], field[..., 1] = 1.0, 0.03
+    probes.sample(10, field, 1.0)   # the second sample's step only
+    rows = list(csv.DictReader(io.StringIO(readouts.forces_table(h, ["momentum_exchange"], length, probes))))
+    assert [row["probe1_ux"] for row in rows] == ["", "0.03", "", ""]
+    assert rows[1]["momentum_exchange_cd"] == list(csv.DictReader(io.StringIO(plain)))[1]["momentum_exchange_cd"]
+
+
+def test_settled_drag_keeps_only_the_samples_held_long_enough():
+    """History.settled_drag: the drag-against-speed view fits settled samples only."""
+    h = History()
+    for k in range(30):
+        h.add(100 * k, (0.0, 0.0), (0.05, 0.0), {"momentum_exchange": (0.02, 0.0)})
+    speed, drag = h.settled_drag("momentum_exchange")
+    assert len(speed) == sum(h.settled) > 0 and len(speed) < len(h)
+    assert np.allclose(speed, 0.05) and np.allclose(drag, 0.02)

@@ -50,7 +50,7 @@ def test_info_replay_export(recorded, tmp_path):
     with open(exported, newline="") as fh:
         header = next(csv.reader(fh))
     assert header == ["step", "x", "y", "vx", "vy", "fx_momentum_exchange", "fy_momentum_exchange",
-                      "fx_pressure", "fy_pressure"]
+                      "fx_pressure", "fy_pressure", "torque_momentum_exchange", "torque_pressure"]
     assert json.loads(manifest.read_text())["counts"]["inputs"] == 25
 
 

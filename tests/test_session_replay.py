@@ -100,11 +100,13 @@ def test_recorded_playback_and_csv_export(tmp_path):
     export_csv(s, out)
     with open(out, newline="") as fh:
         rows = list(csv.reader(fh))
-    assert rows[0] == ["step", "x", "y", "vx", "vy", "fx_momentum_exchange", "fy_momentum_exchange"]
+    assert rows[0] == ["step", "x", "y", "vx", "vy", "fx_momentum_exchange", "fy_momentum_exchange",
+                       "torque_momentum_exchange"]
     assert rows[0] == force_columns(s.models)
     assert len(rows) == 1 + len(frames)
     # the decimals round-trip exactly
-    assert [float(v) for v in rows[-1][5:]] == list(s.forces["values"][-1])
+    assert [float(v) for v in rows[-1][5:7]] == list(s.forces["values"][-1])
+    assert float(rows[-1][7]) == s.forces["torques"][-1, 0]
     assert int(rows[-1][0]) == s.steps and math.isclose(float(rows[-1][1]), frames[-1][1][0])
 
 

@@ -107,9 +107,21 @@ class ScoringScene:
                        average_steps=self.average_steps * s, sample_interval=self.sample_interval * s,
                        sponge_cells=self.sponge_cells * s, scale=self.scale * s)
 
+    def live_scene(self) -> dict:
+        """The scene, in a scene file's form (app/model/scene.py `scene_from_dict`), that the
+        window's live tunnel shows while the exercise is open: the same flow in float32, with a
+        cylinder of the reference length where the body goes until the student's shape is put
+        in."""
+        return {"grid": {"nx": self.nx, "ny": self.ny},
+                "flow": {"nu": self.nu, "inflow_speed": self.inflow_speed, "walls": self.walls, "dtype": "float32",
+                         "inflow_ramp_steps": 0, "initial_velocity": [self.inflow_speed, 0.0],
+                         "sponge_cells": self.sponge_cells, "sponge_absorb": 0.1},
+                "body": {"kind": "cylinder", "diameter": self.reference_length, "x": self.body_x, "y": self.body_y},
+                "run": {"steps": self.steps}}
+
     def flow_config(self) -> FlowConfig:
         """numpy float64, TRT, the wind blowing from the first step with an absorbing outlet
-        sponge (the window's base configuration, app/model/simulation.py)."""
+        sponge (the window's base configuration, app/model/flow_choice.py)."""
         return FlowConfig(nx=self.nx, ny=self.ny, nu=self.nu, collision="trt", dtype="float64",
                           x_boundary="tunnel", y_boundary=self.walls, inflow_speed=self.inflow_speed,
                           inflow_ramp_steps=0, initial_velocity=(self.inflow_speed, 0.0),

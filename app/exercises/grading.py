@@ -123,6 +123,29 @@ def _share_cores(threads: int) -> None:
     numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
 
 
+def _warm_up(exercise_path: str, path: str, scale: int) -> None:
+    """One step of a cpu-backend scoring run of `path` (without a body if it is not a valid shape
+    file): compiles, or loads from numba's disk cache, what the grading processes then load."""
+    from feelflow.app.exercises.constraints import posed
+    from feelflow.app.shape_files import load_shape
+    from feelflow.shapes.base import ShapeError
+    from feelflow.solver.backend import create_solver
+
+    exercise = _exercise(exercise_path)
+    try:
+        body = posed(exercise, load_shape(path), scale)
+    except (ShapeError, UserError):
+        body = None
+    solver = create_solver("cpu", exercise.scene.scaled(scale).flow_config())
+    try:
+        solver.enable_force_models([scoring.FORCE_MODEL])
+        if body is not None:
+            solver.set_body(body)
+        solver.step(1)
+    finally:
+        solver.close()
+
+
 def default_workers() -> int:
     return os.cpu_count() or 1
 
@@ -133,13 +156,35 @@ AUTO = "auto"
 CHOICE_KEY = "float64 scoring"
 
 
-def _timed_choice(config, store_path: str) -> tuple[str, str]:
+def _timed_choice(config, store_path: str, body=None) -> tuple[str, str]:
+    """choose_backend on `config`, with `body` (a posed shape) placed as the scoring run places
+    it, so that the trial also compiles what scoring it needs (the body's raster of its kind)
+    once, before the graders start; None: the default trial's cylinder."""
     from feelflow.app.model.backend_choice import JsonFileStore, choose_backend
     from feelflow.solver.backend import create_solver
 
+    def setup(solver):
+        solver.enable_force_models([scoring.FORCE_MODEL])
+        solver.set_body(body)
+
+    kwargs = {} if body is None else {"setup": setup}
     choice = choose_backend(config, lambda name, cfg: create_solver(name, cfg), JsonFileStore(store_path),
-                            renderer=CHOICE_KEY, candidates=scoring.BACKENDS)
+                            renderer=CHOICE_KEY, candidates=scoring.BACKENDS, **kwargs)
     return choice.backend, choice.describe(config.nx, config.ny)
+
+
+def _trial_body(exercise, scale: int):
+    """The exercise's first reference shape, posed as scoring poses it, or None."""
+    from feelflow.app.exercises.constraints import posed
+    from feelflow.app.shape_files import load_shape
+    from feelflow.shapes.base import ShapeError
+
+    if not exercise.references:
+        return None
+    try:
+        return posed(exercise, load_shape(exercise.references[0].path), scale)
+    except (ShapeError, UserError):
+        return None
 
 
 def resolve_backend(backend: str, exercise, scale: int = 1, store_path=None) -> tuple[str, str | None]:
@@ -159,7 +204,7 @@ def resolve_backend(backend: str, exercise, scale: int = 1, store_path=None) -> 
         return known, f"scoring backend {known} (remembered for {config.nx} x {config.ny})"
     try:
         with ProcessPoolExecutor(max_workers=1) as pool:
-            name, line = pool.submit(_timed_choice, config, path).result()
+            name, line = pool.submit(_timed_choice, config, path, _trial_body(exercise, scale)).result()
     except RuntimeError as exc:   # neither can run (choose_backend says why)
         raise UserError(f"--backend auto: {exc}") from None
     return name, f"scoring {line}"
@@ -185,6 +230,13 @@ def grade(exercise, paths, workers: int | None = None, scales=(1,), progress=Non
         initializer, initargs = None, ()
         if backend == "cpu":
             initializer, initargs = _share_cores, (max(1, default_workers() // workers),)
+            # the kernels compile once here, in a process of its own, not in every grading
+            # process at once (a first run, or the first after an update of the kernels)
+            with ProcessPoolExecutor(max_workers=1) as warm:
+                try:
+                    warm.submit(_warm_up, *jobs[0][:3]).result()
+                except Exception:  # noqa: BLE001 - the graders' own runs report what is wrong
+                    pass
         with ProcessPoolExecutor(max_workers=workers, initializer=initializer, initargs=initargs) as pool:
             futures = {pool.submit(_worker, job): i for i, job in enumerate(jobs)}
             for n, fut in enumerate(as_completed(futures), 1):

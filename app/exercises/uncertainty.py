@@ -67,6 +67,17 @@ def tied(a: float, b: float, uncertainty: float | None) -> bool:
     return uncertainty is not None and abs(a - b) <= uncertainty
 
 
+def standing(score: float, reference: float, better: str, uncertainty: float | None) -> str:
+    """How `score` stands against a reference's, in the words the exercise panel puts before
+    the reference: tied within the uncertainty, the same to four decimals (no uncertainty
+    given), better, or behind."""
+    if uncertainty is not None and tied(score, reference, uncertainty):
+        return "tied (within the grid uncertainty) with"
+    if uncertainty is None and round(score, 4) == round(reference, 4):
+        return "the same as"
+    return "better than" if better_by(score, reference, better, None) else "behind"
+
+
 def tied_ranks(scores: list[float], better: str, uncertainty: float | None) -> list[int]:
     """Each score's rank: 1 + the number of scores better than it by more than the uncertainty."""
     return [1 + sum(better_by(other, s, better, uncertainty) for other in scores) for s in scores]

@@ -19,15 +19,27 @@ from PySide6.QtWidgets import QDockWidget, QFileDialog, QMessageBox
 from feelflow import EXERCISE_DIR
 from feelflow.app.errors import UserError
 from feelflow.app.exercises import scoring
-from feelflow.app.exercises.uncertainty import better_by, fmt, tied
+from feelflow.app.exercises.uncertainty import fmt, standing
 from feelflow.app.gui.exercise_panel import PARAMETERS, PANEL_WIDTH, ExercisePanel, ScrollingPanel
 from feelflow.app.model import readouts
 from feelflow.app.model.readouts import EXERCISE_LENGTH, ReferenceLength
 from feelflow.shapes.base import ShapeError
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from PySide6.QtCore import QSettings
+    from PySide6.QtGui import QUndoStack
+    from PySide6.QtWidgets import QMainWindow, QStatusBar
+
+    from feelflow.app.gui.force_plot import ForcePlot
+    from feelflow.app.gui.side_panel import SidePanel
     from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.gui.window.bodies import BodyController
+    from feelflow.app.gui.window.events import WindowEvents
+    from feelflow.app.gui.window.flow import FlowController
     from feelflow.app.gui.window.frame_loop import FrameLoop
+    from feelflow.app.gui.window.replay_controller import ReplayController
     from feelflow.app.model.simulation import Simulation
 
 BROKEN_EDGE = QColor(230, 40, 40)
@@ -67,12 +79,19 @@ class ExerciseController(QObject):
 
     attemptAdded = Signal(object)   # attempts.Attempt
 
-    def __init__(self, window, viewport: "Viewport", loop: "FrameLoop"):
+    def __init__(self, events: "WindowEvents", viewport: "Viewport", loop: "FrameLoop", side_panel: "SidePanel",
+                 plot: "ForcePlot", undo: "QUndoStack", replays: "ReplayController", flow: "FlowController",
+                 bodies: "BodyController", settings: "QSettings", status: "QStatusBar",
+                 make_current: "Callable[[], None]", window: "QMainWindow"):
+        """`window`: the main window, as the holder of the exercise's dock (beside the side
+        panel's) and the dialogs' parent."""
         super().__init__(window)
         self.window = window
-        self.viewport, self.loop = viewport, loop
+        self.viewport, self.loop, self.side_panel, self.plot, self.undo = viewport, loop, side_panel, plot, undo
+        self.replays, self.flow, self.bodies, self.settings = replays, flow, bodies, settings
+        self.status, self.make_current = status, make_current
         self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
-        window.events.liveCreated.connect(self._live_created)
+        events.liveCreated.connect(self._live_created)
         self.exercise = None
         self.attempts = None
         self.panel = None
@@ -121,11 +140,11 @@ class ExerciseController(QObject):
     @property
     def work_folder(self) -> Path:
         default = Path.home() / "FeelFlow" / "exercises"
-        return Path(self.window.settings.value("exercises/work_folder", str(default)))
+        return Path(self.settings.value("exercises/work_folder", str(default)))
 
     @work_folder.setter
     def work_folder(self, folder):
-        self.window.settings.setValue("exercises/work_folder", str(folder))
+        self.settings.setValue("exercises/work_folder", str(folder))
 
     def work_folder_dialog(self, _=False):
         folder = QFileDialog.getExistingDirectory(self.window, "Work folder for attempts", str(self.work_folder))
@@ -147,33 +166,26 @@ class ExerciseController(QObject):
         from feelflow.app.model.scene import scene_from_dict
         from feelflow.app.shape_files import load_shape
 
-        w = self.window
-        if self.sim is None or w.replays.refuse("exercises run in the live tunnel"):
+        if self.sim is None or self.replays.refuse("exercises run in the live tunnel"):
             return False
         if self.worker is not None:
-            QMessageBox.information(w, "Scoring is running", "Wait for the score or cancel it first.")
+            QMessageBox.information(self.window, "Scoring is running", "Wait for the score or cancel it first.")
             return False
         try:
             exercise = load_exercise(path)
             start = load_shape(exercise.start)
             s = exercise.scene
-            scene = scene_from_dict({
-                "grid": {"nx": s.nx, "ny": s.ny},
-                "flow": {"nu": s.nu, "inflow_speed": s.inflow_speed, "walls": s.walls, "dtype": "float32",
-                         "inflow_ramp_steps": 0, "initial_velocity": [s.inflow_speed, 0.0],
-                         "sponge_cells": s.sponge_cells, "sponge_absorb": 0.1},
-                "body": {"kind": "cylinder", "diameter": s.reference_length, "x": s.body_x, "y": s.body_y},
-                "run": {"steps": s.steps}}, exercise.source)
-            w.make_current()
+            scene = scene_from_dict(s.live_scene(), exercise.source)   # the scored flow, in float32
+            self.make_current()
             self.sim.load_scene(scene)
         except (UserError, ShapeError, ValueError) as exc:
-            w.flow.refuse_dialog("This exercise cannot be opened", exc)
+            self.flow.refuse_dialog("This exercise cannot be opened", exc)
             return False
         self.exercise = exercise
         # the live readouts use the length the score uses (app/model/readouts.py)
         self.sim.reference_override = ReferenceLength(s.reference_length, EXERCISE_LENGTH)
-        w.undo.clear()
-        w.bodies.set_hold_still(True)
+        self.undo.clear()
+        self.bodies.set_hold_still(True)
         self._ensure_panel()
         self.panel.show_exercise(exercise)
         self.dock.show()
@@ -181,12 +193,12 @@ class ExerciseController(QObject):
         self.install_shape(start)
         self._load_attempts()
         self.close_action.setEnabled(True)
-        w.panel.show_params(self.sim.params, self.loop.display_mode)
-        w.flow.after_rebuild()
+        self.side_panel.show_params(self.sim.params, self.loop.display_mode)
+        self.flow.after_rebuild()
         self.loop.set_paused(False)
         self.timer.start()
         self.refresh_constraints()
-        w.statusBar().showMessage(f"Exercise: {exercise.title}", 10000)
+        self.status.showMessage(f"Exercise: {exercise.title}", 10000)
         QTimer.singleShot(0, self.fit_tunnel)   # once the docks have their new sizes
         return True
 
@@ -194,7 +206,7 @@ class ExerciseController(QObject):
         """Give the viewport the exercise tunnel's shape: the forces plot below takes the height
         a wide, low tunnel leaves empty, so the tunnel fills the viewport's width and height."""
         w = self.window
-        vp, plot_dock = self.viewport, w.plot.parentWidget()
+        vp, plot_dock = self.viewport, self.plot.parentWidget()
         if self.exercise is None or self.sim is None or not isinstance(plot_dock, QDockWidget):
             return
         self.dock.raise_()
@@ -215,8 +227,8 @@ class ExerciseController(QObject):
         self.panel.attemptChosen.connect(self.load_attempt)
         self.panel.parametersChanged.connect(self._parameters_changed)
         w = self.window
-        self.panel.editToggled.connect(w.bodies.set_editing)
-        w.panel.edit.toggled.connect(self._show_editing)
+        self.panel.editToggled.connect(self.bodies.set_editing)
+        self.side_panel.edit.toggled.connect(self._show_editing)
         self.dock = QDockWidget("Exercise", w)
         self.dock.setObjectName("exercise_dock")
         self.dock.setWidget(ScrollingPanel(self.panel))
@@ -225,7 +237,7 @@ class ExerciseController(QObject):
         # the column full height (the forces plot below grows when the tunnel is wide and low)
         w.setCorner(Qt.BottomRightCorner, Qt.RightDockWidgetArea)
         w.setCorner(Qt.TopRightCorner, Qt.RightDockWidgetArea)
-        controls = w.panel.parentWidget()
+        controls = self.side_panel.parentWidget()
         if isinstance(controls, QDockWidget) and w.dockWidgetArea(controls) != Qt.NoDockWidgetArea:
             w.tabifyDockWidget(controls, self.dock)
         else:
@@ -279,15 +291,14 @@ class ExerciseController(QObject):
 
     def install_shape(self, shape):
         """Put a shape (a start shape, a loaded attempt) into the editor and the tunnel."""
-        w = self.window
         if shape.kind in PARAMETERS:
             self.panel.set_parameters(shape)
             return self._parameters_changed()
-        w.make_current()
+        self.make_current()
         self.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in shape.vertices],
                         angle_deg=math.degrees(shape.angle))
         self.param_shape = None
-        w.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.side_panel.show_params(self.sim.params, self.loop.display_mode)
         self.viewport.update()
         self.refresh_constraints()
         return True
@@ -297,7 +308,6 @@ class ExerciseController(QObject):
         the body's exact vertices, or a cylinder)."""
         from feelflow.shapes.io import from_dict
 
-        w = self.window
         try:
             shape = from_dict(self.panel.parameters())
         except ShapeError as exc:
@@ -306,7 +316,7 @@ class ExerciseController(QObject):
             return False
         self.param_shape = shape
         try:
-            w.make_current()
+            self.make_current()
             if shape.kind == "cylinder":
                 self.sim.set_shape(kind="cylinder", size=shape.diameter, angle_deg=math.degrees(shape.angle))
             else:
@@ -314,7 +324,7 @@ class ExerciseController(QObject):
                                 angle_deg=math.degrees(shape.angle))
         except (ShapeError, ValueError):
             pass    # too big for the tunnel: the constraints say so
-        w.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.side_panel.show_params(self.sim.params, self.loop.display_mode)
         self.viewport.update()
         self.refresh_constraints()
         return True
@@ -394,12 +404,7 @@ class ExerciseController(QObject):
             if result.hit is not None:
                 lines.append("A hit: within the tolerance." if result.hit else "Not a hit yet: outside the tolerance.")
             for ref in ex.references:
-                if u is not None and tied(result.score, ref.score, u):
-                    word = "tied (within the grid uncertainty) with"
-                elif u is None and round(result.score, 4) == round(ref.score, 4):
-                    word = "the same as"
-                else:
-                    word = "better than" if better_by(result.score, ref.score, o.better, None) else "behind"
+                word = standing(result.score, ref.score, o.better, u)
                 lines.append(f"{word} the reference \u201c{ref.label}\u201d ({fmt(ref.score, u)})")
             lines.append(f"<small>{result.averaging}</small>")
             self.panel.result.setText("<br>".join(lines))

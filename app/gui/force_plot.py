@@ -16,7 +16,7 @@ from feelflow.app.files import atomic_path, write_text_atomic
 from feelflow.app.gui.polar_views import VIEWS as LIFT_VIEWS, LiftViews
 from feelflow.app.model.power_law import fit_power_law
 from feelflow.app.model import published, readouts
-from feelflow.app.model.display_units import DisplayUnits, si_columns
+from feelflow.app.model.display_units import DisplayUnits
 from feelflow.app.model.readouts import start_pulse_steps
 from feelflow.app.model.force_history import History
 from feelflow.app.model.simulation import FORCE_MODELS
@@ -311,14 +311,8 @@ class ForcePlot(QWidget):
         return f"{what}" if not self.sim.params.compare_all else f"{what}, {FORCE_MODELS[model].split(' (')[0].lower()}"
 
     def speed_drag(self):
-        """(relative wind speed, drag) of the settled samples only (History.settled): drag
-        while the wind or the body's speed is changing carries the acceleration's force and is
-        not the steady drag the law describes."""
-        sim = self.sim
-        _, drag, _ = sim.history.drag_lift(sim.params.force_model)
-        w = np.asarray(sim.history.wind, float).reshape(-1, 2)
-        settled = np.asarray(sim.history.settled, bool)
-        return np.hypot(w[settled, 0], w[settled, 1]), drag[settled]
+        """(relative wind speed, drag) of the settled samples (History.settled_drag)."""
+        return self.sim.history.settled_drag(self.sim.params.force_model)
 
     def _draw_speed_view(self):
         us, fs, n = fit_power_law(*self.speed_drag())
@@ -365,26 +359,10 @@ class ForcePlot(QWidget):
 
     # --- export ---------------------------------------------------------------------------
     def csv_text(self) -> str:
-        """The forces CSV (app/model/readouts.py `forces_csv`), with the probes' columns
-        (app/model/probes.py) joined on the step when there are probes."""
+        """The forces CSV (app/model/readouts.py `forces_table`: the probes' columns joined on
+        the step, SI columns where the units shown are SI)."""
         sim = self.sim
-        text = readouts.forces_csv(sim.history, FORCE_MODELS, sim.reference_length())
-        probes = self.probes if self.probes is not None and len(self.probes) else None
-        if probes is None and not self.units.is_si:
-            return text
-        import csv
-        import io
-
-        rows = list(csv.reader(io.StringIO(text)))
-        out = io.StringIO()
-        w = csv.writer(out)
-        head = rows[0] + (probes.columns() if probes else [])
-        body = [row + (probes.values_at(int(float(row[0]))) if probes else []) for row in rows[1:]]
-        if self.units.is_si:   # SI columns beside the lattice ones (app/model/display_units.py)
-            head, body = si_columns(head, body, self.units)
-        w.writerow(head)
-        w.writerows(body)
-        return out.getvalue()
+        return readouts.forces_table(sim.history, FORCE_MODELS, sim.reference_length(), self.probes, self.units)
 
     def export_csv(self, path):
         write_text_atomic(path, self.csv_text())

@@ -97,7 +97,11 @@ class MainWindow(QMainWindow):
         vp, events, panel, plot, status = self.viewport, self.events, self.panel, self.plot, self.statusBar()
         self.loop = loop = FrameLoop(events, vp, panel, plot, status, self.status, self.make_current, self.params_now,
                                      self)
-        self.replays = replays = ReplayController(self, vp, loop)
+        self.probes = ProbeController(events, vp, plot, loop, status, self)
+        self.plot.probes = self.probes.probes   # the forces CSV carries the probes' columns
+        self.units = UnitsController(events, self.settings, panel, plot, self.probes, loop, status, self)
+        self.replays = replays = ReplayController(events, vp, loop, panel, self.probes, self.units, status,
+                                                  self.make_current, lambda: self.backend, self)
         self.flow = FlowController(events, vp, loop, panel, plot, replays, status, self.make_current, self)
         self.bodies = BodyController(events, vp, loop, panel, self.undo, replays, self.flow, status,
                                      self.make_current, self)
@@ -105,12 +109,11 @@ class MainWindow(QMainWindow):
         self.exports = ExportController(events, vp, plot, replays, self.bodies, self)
         self.lessons = LessonController(events, vp, loop, panel, plot, self.undo, replays, self.flow, self.bodies,
                                         status, self.make_current)
-        self.video = VideoController(self, vp, loop)
-        self.probes = ProbeController(self, vp)
-        self.plot.probes = self.probes.probes   # the forces CSV carries the probes' columns
-        self.units = UnitsController(events, self.settings, panel, plot, self.probes, replays, status, self)
+        self.video = VideoController(events, vp, loop, status, self)
         self.backends = BackendController(self.settings, vp, status, backend)   # "auto": measured once the context exists
-        self.exercises = ExerciseController(self, vp, loop)   # the Exercises menu and panel
+        self.exercises = ExerciseController(events, vp, loop, panel, plot, self.undo, replays, self.flow,
+                                            self.bodies, self.settings, status, self.make_current,
+                                            self)   # the Exercises menu and panel
         self.actions = build_menus(self)
 
         self.params = params or self.store.params()
@@ -229,8 +232,13 @@ class MainWindow(QMainWindow):
             return True
         return super().event(ev)
 
+    def remember(self):
+        """What the next start comes back to (app/gui/window/settings.py)."""
+        self.store.remember(self.params_now(), self.sim.polygon if self.sim is not None else None,
+                        self.loop.display_mode, self.saveGeometry())
+
     def closeEvent(self, ev):
-        self.store.save(self)
+        self.remember()
         self.loop.stop()
         self.exercises.shutdown()
         self.video.close()

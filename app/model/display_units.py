@@ -122,6 +122,8 @@ def _column_unit(name: str, units: DisplayUnits):
         return f"{name}_Pa", units.pressure
     if name in ("x", "y"):
         return f"{name}_m", lambda v: v * units.physical.dx
+    if name.startswith("torque_"):
+        return f"{name}_N_m", units.torque
     return None
 
 

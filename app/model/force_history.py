@@ -82,6 +82,15 @@ class History:
         drag, lift = readouts.drag_lift(f, np.asarray(self.wind, float).reshape(n, 2))
         return np.asarray(self.time, float), drag, lift
 
+    def settled_drag(self, model: str):
+        """(relative wind speed, drag) arrays of the settled samples only (`settled`): drag
+        while the wind or the body's speed is changing carries the acceleration's force and is
+        not the steady drag the drag-against-speed law describes (app/model/power_law.py)."""
+        _, drag, _ = self.drag_lift(model)
+        wind = np.asarray(self.wind, float).reshape(-1, 2)
+        settled = np.asarray(self.settled, bool)
+        return np.hypot(wind[settled, 0], wind[settled, 1]), drag[settled]
+
     def torque(self, model: str):
         """(t, torque) arrays: the model's torque about the body's centre, counter-clockwise
         positive (NaN where absent)."""

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from feelflow.app.model.display_units import si_columns
 from feelflow.solver import units
 from feelflow.solver.lattice import CS2
 
@@ -214,4 +215,25 @@ def forces_csv(history, force_models, length: ReferenceLength) -> str:
         for c in cols:
             row += [f"{v:.8g}" for v in c[i]]
         w.writerow(row)
+    return out.getvalue()
+
+
+def forces_table(history, force_models, length: ReferenceLength, probes=None, units=None) -> str:
+    """The forces CSV the window exports: `forces_csv`, with the probes' columns
+    (app/model/probes.py `Probes`) joined on the step where there are probes, and SI columns
+    beside the lattice ones where `units` (app/model/display_units.py `DisplayUnits`) is SI."""
+    text = forces_csv(history, force_models, length)
+    probes = probes if probes is not None and len(probes) else None
+    si = units is not None and units.is_si
+    if probes is None and not si:
+        return text
+    rows = list(csv.reader(io.StringIO(text)))
+    head = rows[0] + (probes.columns() if probes else [])
+    body = [row + (probes.values_at(int(float(row[0]))) if probes else []) for row in rows[1:]]
+    if si:   # SI columns beside the lattice ones
+        head, body = si_columns(head, body, units)
+    out = io.StringIO()
+    w = csv.writer(out)
+    w.writerow(head)
+    w.writerows(body)
     return out.getvalue()

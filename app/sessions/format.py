@@ -142,11 +142,12 @@ def shape_from_dict(d, where: str, config: FlowConfig):
 
 
 def force_columns(models) -> list[str]:
-    """The CSV columns of `feelflow run`: step, x, y, vx, vy, fx_<m>, fy_<m> per model."""
+    """The CSV columns of `feelflow run`: step, x, y, vx, vy, fx_<m>, fy_<m> per model, then
+    torque_<m> per model (about the body's centre, counter-clockwise positive)."""
     cols = ["step", "x", "y", "vx", "vy"]
     for m in models:
         cols += [f"fx_{m}", f"fy_{m}"]
-    return cols
+    return cols + [f"torque_{m}" for m in models]
 
 
 # --- a session in memory ----------------------------------------------------------------------
@@ -213,12 +214,14 @@ class Session:
         t = self.forces["torques"][row]
         return {m: float(t[j]) for j, m in enumerate(self.models) if not math.isnan(t[j])}
 
-    def csv_rows(self, values=None):
+    def csv_rows(self, values=None, torques=None):
         """Rows for `force_columns(self.models)` (shortest round-trip decimals; NaN as 'nan')."""
         f = self.forces
         values = f["values"] if values is None else values
+        torques = f["torques"] if torques is None else torques
         for k in range(len(f["step"])):
-            yield [str(int(f["step"][k]))] + [_fmt(v) for v in f["body"][k]] + [_fmt(v) for v in values[k]]
+            yield ([str(int(f["step"][k]))] + [_fmt(v) for v in f["body"][k]] + [_fmt(v) for v in values[k]]
+                   + [_fmt(v) for v in torques[k]])
 
 
 def _fmt(v) -> str:
@@ -639,11 +642,12 @@ def _validate_parameters(parameters, config: FlowConfig) -> list:
     return out
 
 
-def export_csv(session: Session, path, values=None, rows: int | None = None) -> Path:
-    """Write the force series as CSV (`force_columns`), atomically; `values` replaces the
-    recorded forces (e.g. a replay's); `rows` keeps only the first rows (a diverged replay's)."""
+def export_csv(session: Session, path, values=None, rows: int | None = None, torques=None) -> Path:
+    """Write the force series as CSV (`force_columns`), atomically; `values` and `torques`
+    replace the recorded forces and torques (e.g. a replay's); `rows` keeps only the first rows
+    (a diverged replay's)."""
     lines = [",".join(force_columns(session.models))]
-    lines += [",".join(row) for row in session.csv_rows(values)][:rows]
+    lines += [",".join(row) for row in session.csv_rows(values, torques)][:rows]
     return atomic_write_bytes(path, ("\n".join(lines) + "\n").encode(), "CSV file")
 
 

@@ -267,6 +267,11 @@ class SessionPlayer:
             if m in replayed.models:
                 i = replayed.models.index(m)
                 values[:len(replayed.forces["values"]), 2 * j:2 * j + 2] = replayed.forces["values"][:, 2 * i:2 * i + 2]
+        torques = np.full_like(session.forces["torques"], np.nan)
+        for j, m in enumerate(session.models):
+            if m in replayed.models:
+                i = replayed.models.index(m)
+                torques[:len(replayed.forces["torques"]), j] = replayed.forces["torques"][:, i]
         recorded = session.forces["values"]
         both_nan = np.isnan(values) & np.isnan(recorded)
         diff = np.where(both_nan, 0.0, np.abs(values - recorded))
@@ -274,7 +279,7 @@ class SessionPlayer:
         max_dev = float(diff.max()) if diff.size else 0.0
         finite = recorded[np.isfinite(recorded)]
         max_force = float(np.abs(finite).max()) if finite.size else 0.0
-        return ReplayResult(replayed, values, max_dev, max_force, self.diverged_at)
+        return ReplayResult(replayed, values, max_dev, max_force, self.diverged_at, torques)
 
     def close(self) -> None:
         """Free the backend (idempotent)."""
@@ -298,6 +303,7 @@ class ReplayResult:
     max_deviation: float      # largest |replayed - recorded| (inf where one is missing)
     max_force: float          # largest |recorded force| (the scale of the deviation)
     diverged_at: int | None   # session step where the replay diverged, if it did
+    torques: np.ndarray | None = None   # (m, len(models)) replayed torques in the recorded column order
 
     @property
     def relative_deviation(self) -> float:

@@ -200,9 +200,9 @@ def run_scene(scene, solver, steps: int):
     diverged_error = getattr(backends, "SolverDiverged", ())
     solver.enable_force_models(scene.force_models)
     runner = MotionRunner(solver, scene.body, scene.motion)
-    header = ["step", "x", "y", "vx", "vy"]
-    for m in scene.force_models:
-        header += [f"fx_{m}", f"fy_{m}"]
+    from feelflow.app.sessions.format import force_columns
+
+    header = force_columns(scene.force_models)   # ... fx_m, fy_m per model, then torque_m per model
     rows = []
     warned = False
     start = time.perf_counter()
@@ -218,6 +218,7 @@ def run_scene(scene, solver, steps: int):
         values = [v for m in scene.force_models for v in forces[m]]
         if not all(math.isfinite(v) for v in values) or not math.isfinite(solver.total_mass()):
             return header, rows, time.perf_counter() - start, (t0, t0 + n, "NaN")
+        values += [runner.last_torques.get(m, math.nan) for m in scene.force_models]
         if not warned:
             warned = warn_outside_local_region(scene, solver, runner.t)
         x, y = runner.position

@@ -131,7 +131,7 @@ def replay(args) -> int:
     if result.diverged_at is not None:   # rows after the last physical one are dropped
         rows = int(np.count_nonzero(s.forces["step"] < result.diverged_at))
     if args.out:
-        _write(export_csv, s, args.out, result.values, rows)
+        _write(export_csv, s, args.out, result.values, rows, result.torques)
     same = "same backend" if backend == s.backend else f"recorded on {s.backend}"
     print(f"{args.file}: replayed {s.steps} steps on {backend} ({same}); largest force deviation "
           f"{result.max_deviation:.3g} ({result.relative_deviation:.3g} of the largest recorded force "
@@ -160,7 +160,7 @@ def export(args) -> int:
     s = _load(args.file)
     if args.csv:
         _write(export_csv, s, args.csv)
-        print(f"{args.csv}: {len(s.forces['step'])} rows, columns step,x,y,vx,vy + fx/fy for {', '.join(s.models) or 'no model'}")
+        print(f"{args.csv}: {len(s.forces['step'])} rows, columns step,x,y,vx,vy + fx/fy, then torque, for {', '.join(s.models) or 'no model'}")
     if args.manifest:
         _write(export_manifest, s, args.manifest)
         print(f"{args.manifest}: manifest")

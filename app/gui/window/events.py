@@ -18,6 +18,11 @@ controller calls another's methods to keep it in step.
 | `replayTick` | FrameLoop, at each replay frame | inputs (a device moved during the replay is told it does not move the body) |
 | `replayProgressed` | FrameLoop, after a replay frame or its pause | the replay controller (its progress label and banner) |
 | `replayFailed(message)` | FrameLoop, when the session asks for something impossible | the replay controller (stops it, one-line dialog) |
+| `videoRecording(on)` | VideoController, when the window's recording starts or stops | the Record video action's check mark (menus.py) |
+| `probesPlacing(on)` | ProbeController, when clicks start or stop placing probes | the Place probes action's check mark (menus.py) |
+| `recordShown(on)`, `recordLabel(text)` | ReplayController, as a recording starts, fills up or stops | the Record session action's check mark and text (menus.py) |
+| `replayShown(on)` | ReplayController, once a replay shows or the live tunnel is back | the replay's toolbar, Stop replay, Undo and Redo (menus.py) |
+| `replayRefused` | ReplayController.refuse, a request refused during a replay | inputs (the selector back at what drives the body) |
 | `shownChanged(model)` | ReplayController, MainWindow once the live tunnel exists | the frame loop: the viewport and the plot show `model` (a TunnelModel) |
 """
 from __future__ import annotations
@@ -42,3 +47,9 @@ class WindowEvents(QObject):
     replayTick = Signal()            # a replay frame begins
     replayProgressed = Signal()      # a replay frame or pause: its progress changed
     replayFailed = Signal(str)       # the replayed session asked for something impossible
+    videoRecording = Signal(bool)    # the window is being recorded to a video
+    probesPlacing = Signal(bool)     # clicks in the view place probes
+    recordShown = Signal(bool)       # a session is being recorded
+    recordLabel = Signal(str)        # the Record session entry's words
+    replayShown = Signal(bool)       # a replay shows (True) or the live tunnel again
+    replayRefused = Signal()         # a request was refused during a replay: the controls go back

@@ -45,6 +45,7 @@ class InputController:
         events.liveFrame.connect(self.after_frame)
         events.livePaused.connect(self.pause)
         events.replayTick.connect(self.watch_during_replay)
+        events.replayRefused.connect(self.show_selected)
         self.device: DeviceInput | None = None
         self._device_seen = None     # the device's target when the replay began
 

@@ -60,6 +60,8 @@ def build_menus(w: "MainWindow") -> Actions:
     add_action(w, f, "Save screenshot\u2026", w.exports.screenshot_dialog)
     f.addSeparator()
     record = add_action(w, f, "Record session", w.replays.toggle_recording, checkable=True)
+    w.events.recordShown.connect(record.setChecked)
+    w.events.recordLabel.connect(record.setText)
     replay = add_action(w, f, "Replay session\u2026", w.replays.open_dialog)
     stop_replay = add_action(w, f, "Stop replay", w.replays.stop)
     stop_replay.setToolTip("Stop the replay and return to the live tunnel (Esc)")
@@ -67,6 +69,7 @@ def build_menus(w: "MainWindow") -> Actions:
     f.addSeparator()
     add_action(w, f, "Export video of a session\u2026", w.video.export_session_dialog)
     record_video = add_action(w, f, "Record video of the window", w.video.toggle_live, checkable=True)
+    w.events.videoRecording.connect(record_video.setChecked)
     f.addSeparator()
     add_action(w, f, "Quit", w.close, "Ctrl+Q")
     e = bar.addMenu("&Edit")
@@ -85,6 +88,7 @@ def build_menus(w: "MainWindow") -> Actions:
     w.backends.build_menu(r)   # Solver backend: Automatic / cpu / gl / numpy
     v = bar.addMenu("&View")
     place_probes = add_action(w, v, "Place probes (click in the flow)", w.probes.set_placing, "P", checkable=True)
+    w.events.probesPlacing.connect(place_probes.setChecked)
     add_action(w, v, "Remove all probes", w.probes.clear)
     add_action(w, v, "Units\u2026", w.units.dialog)
     v.addSeparator()
@@ -102,5 +106,21 @@ def build_menus(w: "MainWindow") -> Actions:
     toolbar.addAction(stop_replay)
     w.addToolBar(Qt.TopToolBarArea, toolbar)
     toolbar.hide()
+
+    def replay_shown(on: bool):
+        """A replay shows (its toolbar, Stop replay; undo and redo off) or the live tunnel again."""
+        if on:
+            undo.setEnabled(False)
+            redo.setEnabled(False)
+            pause.setChecked(False)
+            stop_replay.setEnabled(True)
+            toolbar.show()
+        else:
+            toolbar.hide()
+            stop_replay.setEnabled(False)
+            undo.setEnabled(w.undo.canUndo())
+            redo.setEnabled(w.undo.canRedo())
+
+    w.events.replayShown.connect(replay_shown)
     return Actions(record=record, replay=replay, stop_replay=stop_replay, pause=pause, undo=undo, redo=redo,
                    replay_toolbar=toolbar, record_video=record_video, place_probes=place_probes)

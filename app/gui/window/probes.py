@@ -14,36 +14,43 @@ from feelflow.app.model import readouts
 from feelflow.app.model.probes import Probes
 
 if TYPE_CHECKING:
-    from feelflow.app.gui.main_window import MainWindow
+    from PySide6.QtWidgets import QMainWindow, QStatusBar
+
+    from feelflow.app.gui.force_plot import ForcePlot
     from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.gui.window.events import WindowEvents
+    from feelflow.app.gui.window.frame_loop import FrameLoop
 
 PLOT_REFRESH_MS = 250
 PLACING_HINT = "Click in the flow to place a probe (up to 4); right-click one to remove it. View > Place probes ends this."
 
 
 class ProbeController:
-    def __init__(self, window: "MainWindow", viewport: "Viewport"):
-        self.w = window
-        self.viewport = viewport
+    def __init__(self, events: "WindowEvents", viewport: "Viewport", forces_plot: "ForcePlot",
+                 loop: "FrameLoop", status: "QStatusBar", docks: "QMainWindow"):
+        """`forces_plot`: the force plot the probes' dock goes beside; `docks`: the main window
+        that holds the docks (and the timer)."""
+        self.events, self.viewport, self.forces_plot, self.loop = events, viewport, forces_plot, loop
+        self.status, self.docks = status, docks
         self.probes = Probes()
         self.plot = ProbePlot()
         self.plot.probes = self.probes
         self.dock = None
-        self.timer = QTimer(window)
+        self.timer = QTimer(docks)
         self.timer.setInterval(PLOT_REFRESH_MS)
         self.timer.timeout.connect(self.plot.refresh)
-        window.events.shownChanged.connect(self.model_changed)
-        window.events.fieldShown.connect(self.sample_frame)
+        events.shownChanged.connect(self.model_changed)
+        events.fieldShown.connect(self.sample_frame)
 
     def _ensure_dock(self):
         if self.dock is not None:
             return
-        w = self.w
+        w = self.docks
         self.dock = QDockWidget("Probes", w)
         self.dock.setObjectName("probe_dock")
         self.dock.setWidget(self.plot)
         self.dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetClosable)
-        forces = w.plot.parentWidget()
+        forces = self.forces_plot.parentWidget()
         if isinstance(forces, QDockWidget):
             w.splitDockWidget(forces, self.dock, Qt.Horizontal)   # beside the forces, same height
         else:
@@ -51,20 +58,18 @@ class ProbeController:
 
     # --- placing ------------------------------------------------------------------------------
     def set_placing(self, on: bool):
-        w = self.w
         self.viewport.probing = bool(on)
-        w.actions.place_probes.setChecked(bool(on))
+        self.events.probesPlacing.emit(bool(on))
         if on:
             self._ensure_dock()
             self.dock.show()
-            w.statusBar().showMessage(PLACING_HINT, 20000)
-        elif w.statusBar().currentMessage() == PLACING_HINT:
-            w.statusBar().clearMessage()
+            self.status.showMessage(PLACING_HINT, 20000)
+        elif self.status.currentMessage() == PLACING_HINT:
+            self.status.clearMessage()
         self.viewport.setCursor(Qt.CrossCursor if on else Qt.ArrowCursor)
 
     def clicked(self, x: float, y: float, remove: bool):
-        w = self.w
-        model = w.shown
+        model = self.loop.shown
         if model is None:
             return
         if remove:
@@ -73,7 +78,7 @@ class ProbeController:
             try:
                 self.probes.add(x, y, model.config.nx, model.config.ny)
             except ValueError as exc:
-                w.statusBar().showMessage(str(exc), 6000)
+                self.status.showMessage(str(exc), 6000)
                 return
         self._ensure_dock()
         self.dock.show()
@@ -100,7 +105,7 @@ class ProbeController:
         callable that reads it back (the gl path reads it only when there are probes)."""
         if not len(self.probes):
             return
-        model = self.w.shown
+        model = self.loop.shown
         if model is None:
             return
         rgba = field() if callable(field) else field

@@ -16,9 +16,16 @@ from feelflow.app.gui.window.dialogs import attempt
 from feelflow.app.model.display_units import choice_to_dict
 
 if TYPE_CHECKING:
-    from feelflow.app.gui.main_window import MainWindow
+    from collections.abc import Callable
+
+    from PySide6.QtWidgets import QStatusBar, QWidget
+
+    from feelflow.app.gui.side_panel import SidePanel
     from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.gui.window.events import WindowEvents
     from feelflow.app.gui.window.frame_loop import FrameLoop
+    from feelflow.app.gui.window.probes import ProbeController
+    from feelflow.app.gui.window.units import UnitsController
     from feelflow.app.model.replay_simulation import ReplaySimulation
     from feelflow.app.model.simulation import Simulation
     from feelflow.app.model.tunnel import TunnelModel
@@ -27,18 +34,22 @@ if TYPE_CHECKING:
 class ReplayController:
     """Owns the replay (None while the live tunnel shows) and its status-bar label."""
 
-    def __init__(self, window: "MainWindow", viewport: "Viewport", loop: "FrameLoop"):
-        self.w = window
-        self.viewport = viewport
-        self.loop = loop
+    def __init__(self, events: "WindowEvents", viewport: "Viewport", loop: "FrameLoop", panel: "SidePanel",
+                 probes: "ProbeController", units: "UnitsController", status: "QStatusBar",
+                 make_current: "Callable[[], None]", backend: "Callable[[], str]", parent: "QWidget"):
+        """`probes`, `units`: what a saved session carries besides the flow; `backend`: the
+        window's solver backend now (a replay runs on it); `parent`: the dialogs' parent."""
+        self.events, self.viewport, self.loop, self.panel = events, viewport, loop, panel
+        self.probes, self.units, self.status, self.make_current = probes, units, status, make_current
+        self.backend, self.parent = backend, parent
         self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
-        window.events.liveCreated.connect(self._live_created)
-        window.events.liveFrame.connect(lambda _forces: self.watch_recording())
-        window.events.replayProgressed.connect(self.show_progress)
-        window.events.replayFailed.connect(self._failed)
+        events.liveCreated.connect(self._live_created)
+        events.liveFrame.connect(lambda _forces: self.watch_recording())
+        events.replayProgressed.connect(self.show_progress)
+        events.replayFailed.connect(self._failed)
         self.replay: ReplaySimulation | None = None
         self.label = QLabel()   # "Replaying <name>: step N / M" (hidden by passing messages)
-        window.statusBar().addWidget(self.label, 1)
+        status.addWidget(self.label, 1)
         self.label.hide()
         self._full_said = False   # the recording's stop at the session bound has been shown
 
@@ -52,27 +63,26 @@ class ReplayController:
 
     # --- recording ----------------------------------------------------------------------------
     def toggle_recording(self, _=None):
-        w = self.w
         if self.sim is None:
             return
         solver = self.sim.solver
         if self.refuse("recording is for the live tunnel"):
-            w.actions.record.setChecked(solver.recorder is not None)
+            self.events.recordShown.emit(solver.recorder is not None)
             return
         if solver.recorder is None:
             solver.start_recording(renderer=self.viewport.renderer())
             self._full_said = False
-            w.actions.record.setChecked(True)
-            w.statusBar().showMessage("Recording a session: inputs, parameter changes and forces.", 5000)
+            self.events.recordShown.emit(True)
+            self.status.showMessage("Recording a session: inputs, parameter changes and forces.", 5000)
             return
-        w.actions.record.setChecked(False)
-        w.actions.record.setText("Record session")
+        self.events.recordShown.emit(False)
+        self.events.recordLabel.emit("Record session")
         recorder = solver.stop_recording()
-        path, _ = QFileDialog.getSaveFileName(w, "Save session", "lesson.ffsession", "Sessions (*.ffsession)")
+        path, _ = QFileDialog.getSaveFileName(self.parent, "Save session", "lesson.ffsession", "Sessions (*.ffsession)")
         if path:
-            recorder.probes = w.probes.session_arrays()   # the probes placed while it recorded, if any
-            recorder.units = choice_to_dict(w.units.choice)   # the units shown (View > Units)
-            attempt(w, lambda: recorder.save(path), "Could not save the session")
+            recorder.probes = self.probes.session_arrays()   # the probes placed while it recorded, if any
+            recorder.units = choice_to_dict(self.units.choice)   # the units shown (View > Units)
+            attempt(self.parent, lambda: recorder.save(path), "Could not save the session")
 
     def watch_recording(self):
         """After each live frame: once the recording stopped at the most a session file may hold
@@ -82,41 +92,36 @@ class ReplayController:
         if rec is None or rec.full is None or self._full_said:
             return
         self._full_said = True
-        self.w.actions.record.setText("Record session (full: choose to stop and save)")
-        self.w.statusBar().showMessage(f"Session: {rec.full}. Choose File > Record session to save it.")
+        self.events.recordLabel.emit("Record session (full: choose to stop and save)")
+        self.status.showMessage(f"Session: {rec.full}. Choose File > Record session to save it.")
 
     # --- replaying ----------------------------------------------------------------------------
     def open_dialog(self, _=None):
         if self.sim is None:
             return
-        path, _ = QFileDialog.getOpenFileName(self.w, "Replay session", "", "Sessions (*.ffsession)")
+        path, _ = QFileDialog.getOpenFileName(self.parent, "Replay session", "", "Sessions (*.ffsession)")
         if path:
             self.start(path)
 
     def start(self, path) -> bool:
         """Replay the session file at `path` in the window; a bad file is a one-line dialog and
         changes nothing. The live tunnel waits, untouched, until `stop`."""
-        w = self.w
         if self.sim is None:
             return False
         if self.sim.solver.recorder is not None:
-            QMessageBox.warning(w, "Could not replay the session",
+            QMessageBox.warning(self.parent, "Could not replay the session",
                                 "A session is being recorded: stop the recording (File > Record session) first.")
             return False
-        replay = attempt(w, lambda: self._open(path), "Could not replay the session")
+        replay = attempt(self.parent, lambda: self._open(path), "Could not replay the session")
         if replay is None:
             return False
         if self.replay is not None:
             self.stop()
-        w.events.replayStarted.emit()   # before the replay takes over: editing ends, the body is let go
+        self.events.replayStarted.emit()   # before the replay takes over: editing ends, the body is let go
         self.replay = replay
-        w.actions.undo.setEnabled(False)
-        w.actions.redo.setEnabled(False)
-        w.events.shownChanged.emit(replay)
-        w.actions.pause.setChecked(False)
-        w.actions.stop_replay.setEnabled(True)
-        w.actions.replay_toolbar.show()
-        w.statusBar().clearMessage()   # a passing message (the mouse hint) would be drawn over the label
+        self.events.shownChanged.emit(replay)
+        self.events.replayShown.emit(True)   # the replay's toolbar; undo and redo off
+        self.status.clearMessage()   # a passing message (the mouse hint) would be drawn over the label
         self.label.show()
         self.show_progress()
         return True
@@ -129,37 +134,32 @@ class ReplayController:
 
         session = load_session(path)
         check_replay_memory(session, path)   # before any grid is allocated
-        w = self.w
-        w.make_current()
-        return ReplaySimulation(session, w.backend, ctx=self.viewport.ctx)
+        self.make_current()
+        return ReplaySimulation(session, self.backend(), ctx=self.viewport.ctx)
 
     def stop(self, _=None):
         """Back to the live tunnel exactly as it was when the replay began."""
         replay, self.replay = self.replay, None
         if replay is None:
             return
-        w = self.w
-        w.make_current()
-        w.events.shownChanged.emit(self.sim)
+        self.make_current()
+        self.events.shownChanged.emit(self.sim)
         replay.close()
         self.viewport.banner = None
         self.label.hide()
-        w.actions.replay_toolbar.hide()
-        w.actions.stop_replay.setEnabled(False)
-        w.actions.undo.setEnabled(w.undo.canUndo())
-        w.actions.redo.setEnabled(w.undo.canRedo())
-        w.events.replayStopped.emit(self.loop.paused)
-        w.statusBar().showMessage("Replay stopped: back to the live tunnel.", 4000)
+        self.events.replayShown.emit(False)
+        self.events.replayStopped.emit(self.loop.paused)
+        self.status.showMessage("Replay stopped: back to the live tunnel.", 4000)
 
     def _failed(self, message: str):
         """The session asked for something impossible: back to the live tunnel, one line."""
         self.stop()
-        QMessageBox.warning(self.w, "Could not replay the session", message)
+        QMessageBox.warning(self.parent, "Could not replay the session", message)
 
     def close(self):
         """The window closes: the replay's solver goes with it."""
         if self.replay is not None:
-            self.w.make_current()
+            self.make_current()
             self.replay.close()
 
     def show_progress(self):
@@ -183,15 +183,14 @@ class ReplayController:
         r = self.replay
         if r is None:
             return False
-        w = self.w
-        w.statusBar().showMessage(f"Replaying {r.name}: {why}. Stop replay (Esc) to return to the live tunnel.",
+        self.status.showMessage(f"Replaying {r.name}: {why}. Stop replay (Esc) to return to the live tunnel.",
                                   6000)
-        p = w.panel
+        p = self.panel
         if self.sim is not None:
             p.show_params(self.sim.params, self.loop.display_mode)
             for box, on in ((p.hold_still, self.sim.hold_still), (p.edit, self.viewport.editing)):
                 box.blockSignals(True)
                 box.setChecked(on)
                 box.blockSignals(False)
-        w.inputs.show_selected()
+        self.events.replayRefused.emit()   # the input selector back at what drives the body
         return True

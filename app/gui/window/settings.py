@@ -15,7 +15,7 @@ from feelflow.app.model.simulation import Params
 from feelflow.shapes.polygon import MAX_VERTICES
 
 if TYPE_CHECKING:
-    from feelflow.app.gui.main_window import MainWindow
+    from PySide6.QtWidgets import QMainWindow
 
 PARAM_KEYS = ("shape", "size", "angle_deg", "wind", "nu", "wall", "force_model")
 
@@ -65,22 +65,23 @@ class WindowSettings:
         mode = self.qsettings.value("display_mode", "speed")
         return mode if mode in modes else "speed"
 
-    def restore_geometry(self, window: "MainWindow"):
+    def restore_geometry(self, window: "QMainWindow"):
         geometry = self.qsettings.value("geometry")
         if geometry is not None:
             window.restoreGeometry(geometry)
         else:
             window.resize(1280, 820)
 
-    def save(self, window: "MainWindow"):
-        """Everything above, as the window shows it now."""
-        s, p = self.qsettings, window.params_now()
-        s.setValue("grid", f"{p.grid[0]}x{p.grid[1]}")
+    def remember(self, params: Params, polygon, display_mode: str, geometry) -> None:
+        """The panel's parameters, the custom polygon (body frame; None keeps the remembered
+        one), the display mode and the window's geometry (QMainWindow.saveGeometry)."""
+        s = self.qsettings
+        s.setValue("grid", f"{params.grid[0]}x{params.grid[1]}")
         for key in PARAM_KEYS:
-            s.setValue(key, getattr(p, key))
-        s.setValue("compare_all", "true" if p.compare_all else "false")
-        if window.sim is not None and window.sim.polygon is not None:
-            s.setValue("polygon", json.dumps([list(v) for v in window.sim.polygon]))
-        s.setValue("display_mode", window.loop.display_mode)
-        s.setValue("geometry", window.saveGeometry())
+            s.setValue(key, getattr(params, key))
+        s.setValue("compare_all", "true" if params.compare_all else "false")
+        if polygon is not None:
+            s.setValue("polygon", json.dumps([list(v) for v in polygon]))
+        s.setValue("display_mode", display_mode)
+        s.setValue("geometry", geometry)
         s.sync()

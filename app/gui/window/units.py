@@ -25,8 +25,8 @@ if TYPE_CHECKING:
     from feelflow.app.gui.force_plot import ForcePlot
     from feelflow.app.gui.side_panel import SidePanel
     from feelflow.app.gui.window.events import WindowEvents
+    from feelflow.app.gui.window.frame_loop import FrameLoop
     from feelflow.app.gui.window.probes import ProbeController
-    from feelflow.app.gui.window.replay_controller import ReplayController
     from feelflow.app.model.simulation import Simulation
 
 REFRESH_MS = 500
@@ -78,9 +78,9 @@ class UnitsDialog(QDialog):
 
 class UnitsController:
     def __init__(self, events: "WindowEvents", settings: "QSettings", panel: "SidePanel", plot: "ForcePlot",
-                 probes: "ProbeController", replays: "ReplayController", status: "QStatusBar", parent: "QWidget"):
+                 probes: "ProbeController", loop: "FrameLoop", status: "QStatusBar", parent: "QWidget"):
         """`parent`: the dialog's and the timer's parent."""
-        self.settings, self.panel, self.plot, self.probes, self.replays = settings, panel, plot, probes, replays
+        self.settings, self.panel, self.plot, self.probes, self.loop = settings, panel, plot, probes, loop
         self.status, self.parent = status, parent
         self.sim: "Simulation | None" = None   # the live tunnel, once it exists (events.liveCreated)
         events.liveCreated.connect(self._live_created)
@@ -143,7 +143,7 @@ class UnitsController:
 
     def refresh(self):
         """The units for the flow shown now, to every widget that shows numbers."""
-        units = for_model(self.choice, self.replays.shown)
+        units = for_model(self.choice, self.loop.shown)
         self.units = units
         self.plot.set_units(units)
         self.panel.show_units(units)

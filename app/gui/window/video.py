@@ -16,8 +16,10 @@ from PySide6.QtWidgets import QFileDialog, QLabel, QMessageBox, QProgressDialog
 from feelflow.app.gui.window.dialogs import attempt
 
 if TYPE_CHECKING:
-    from feelflow.app.gui.main_window import MainWindow
+    from PySide6.QtWidgets import QStatusBar, QWidget
+
     from feelflow.app.gui.viewport import Viewport
+    from feelflow.app.gui.window.events import WindowEvents
     from feelflow.app.gui.window.frame_loop import FrameLoop
 
 LIVE_FPS = 25
@@ -32,27 +34,29 @@ class VideoController:
     """The File menu's video entries; `job` is the session export running (or None), `live` the
     window's recording (or None)."""
 
-    def __init__(self, window: "MainWindow", viewport: "Viewport", loop: "FrameLoop"):
-        self.w = window
+    def __init__(self, events: "WindowEvents", viewport: "Viewport", loop: "FrameLoop", status: "QStatusBar",
+                 parent: "QWidget"):
+        """`parent`: the dialogs', the export job's and the timer's parent."""
+        self.events, self.status, self.parent = events, status, parent
         self.viewport = viewport
         self.loop = loop
         self.job = None
         self.progress: QProgressDialog | None = None
         self.live = None
         self.last_message = ""
-        self.timer = QTimer(window)
+        self.timer = QTimer(parent)
         self.timer.setInterval(int(1000 / LIVE_FPS))
         self.timer.timeout.connect(self._grab)
         self.label = QLabel()
-        window.statusBar().addWidget(self.label)
+        status.addWidget(self.label)
         self.label.hide()
 
     # --- a session to a video -----------------------------------------------------------------
     def export_session_dialog(self, _=None):
-        session, _ = QFileDialog.getOpenFileName(self.w, "Session to render as a video", "", "Sessions (*.ffsession)")
+        session, _ = QFileDialog.getOpenFileName(self.parent, "Session to render as a video", "", "Sessions (*.ffsession)")
         if not session:
             return
-        out, _ = QFileDialog.getSaveFileName(self.w, "Save the video", "replay.mp4", VIDEO_FILTER)
+        out, _ = QFileDialog.getSaveFileName(self.parent, "Save the video", "replay.mp4", VIDEO_FILTER)
         if out:
             self.export_session(session, out, force=True)   # the dialog asked before replacing a file
 
@@ -61,14 +65,14 @@ class VideoController:
         """Start rendering the session file into `out` (.mp4 or .gif) with a progress dialog;
         a bad file or name is a one-line dialog. True when it started."""
         if self.job is not None:
-            QMessageBox.information(self.w, "A video is being written", "Wait for it or cancel it first.")
+            QMessageBox.information(self.parent, "A video is being written", "Wait for it or cancel it first.")
             return False
-        job = attempt(self.w, lambda: self._make_job(session_path, out, steps_per_frame, force, width),
+        job = attempt(self.parent, lambda: self._make_job(session_path, out, steps_per_frame, force, width),
                       "Could not render the video")
         if job is None:
             return False
         self.job = job
-        dialog = QProgressDialog(f"Rendering {out}\u2026", "Cancel", 0, 1000, self.w)
+        dialog = QProgressDialog(f"Rendering {out}\u2026", "Cancel", 0, 1000, self.parent)
         dialog.setObjectName("video-progress")
         dialog.setWindowTitle("Video")
         dialog.setWindowModality(Qt.WindowModal)
@@ -95,7 +99,7 @@ class VideoController:
         backend = session.backend if session.backend in RENDER_BACKENDS else "numpy"
         mode = self.loop.display_mode if self.loop.display_mode in ("speed", "vorticity", "pressure") else "speed"
         render = SessionRender(session, out, backend=backend, steps_per_frame=steps_per_frame, width=width, mode=mode)
-        return VideoExportJob(render, self.w)
+        return VideoExportJob(render, self.parent)
 
     def cancel(self):
         if self.job is not None:
@@ -108,19 +112,19 @@ class VideoController:
             self.progress.close()
             self.progress = None
         self.job = None
-        self.w.statusBar().showMessage(message, 10000)
+        self.status.showMessage(message, 10000)
         if path is None and "cancelled" not in message:
-            QMessageBox.warning(self.w, "Could not render the video", message)
+            QMessageBox.warning(self.parent, "Could not render the video", message)
 
     # --- the live window ----------------------------------------------------------------------
     def toggle_live(self, _=None):
         if self.live is None:
-            out, _ = QFileDialog.getSaveFileName(self.w, "Record the window to a video", "feelflow.mp4", VIDEO_FILTER)
+            out, _ = QFileDialog.getSaveFileName(self.parent, "Record the window to a video", "feelflow.mp4", VIDEO_FILTER)
             if out:
                 self.start_live(out, force=True)
         else:
             self.stop_live()
-        self.w.actions.record_video.setChecked(self.live is not None)
+        self.events.videoRecording.emit(self.live is not None)
 
     def start_live(self, out, force: bool = False) -> bool:
         from feelflow.app.files import check_output
@@ -129,7 +133,7 @@ class VideoController:
         def make():
             check_output(out, "video", force=force, hint="choose another name")
             return LiveRecorder(self.viewport, out, LIVE_FPS)
-        live = attempt(self.w, make, "Could not record a video")
+        live = attempt(self.parent, make, "Could not record a video")
         if live is None:
             return False
         self.live = live
@@ -149,7 +153,7 @@ class VideoController:
             self.live = None
             live.cancel()
             self.label.hide()
-            QMessageBox.warning(self.w, "The video recording stopped", str(exc).splitlines()[0])
+            QMessageBox.warning(self.parent, "The video recording stopped", str(exc).splitlines()[0])
             return
         self.label.setText(f"\u25cf Recording video: {live.seconds:.1f} s, {live.frames} frames "
                            f"(File > Record video of the window stops it)")
@@ -161,10 +165,10 @@ class VideoController:
         self.label.hide()
         if live is None:
             return None
-        path = attempt(self.w, live.stop, "Could not write the video")
+        path = attempt(self.parent, live.stop, "Could not write the video")
         if path is not None:
             self.last_message = f"Wrote {path}: {live.frames} frames, {live.seconds:.1f} s."
-            self.w.statusBar().showMessage(self.last_message, 10000)
+            self.status.showMessage(self.last_message, 10000)
         return path
 
     def close(self):

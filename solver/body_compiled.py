@@ -1,14 +1,17 @@
-"""The cpu backend's body move, compiled (numba): a cylinder's raster, the Bouzidi links with the
-moving-wall term, and the node list of the step's boundary pass, each over the body's box.
+"""A body move, compiled (numba), over the body's box: the raster of a cylinder or a polygonal
+shape and the Bouzidi links with the moving-wall term (the cpu and gl backends), the equilibrium
+refill and the node list of the step's boundary pass (the cpu backend).
 
 The same arithmetic, in the same order, as the numpy reference it stands for, so the results are
-equal bit for bit (tests/test_body_move_cost.py): shapes/raster.py `rasterise` with
+equal bit for bit (tests/test_body_local_move.py): shapes/raster.py `rasterise` with
 shapes/cylinder.py's `contains` and `segment_hit` (a circle's exact cut fractions, Bouzidi,
-Firdaouss & Lallemand, Phys. Fluids 13 (2001) 3452), solver/bouzidi.py `build_links` (the moving
-wall term of Lallemand & Luo, J. Comput. Phys. 184 (2003) 406). Compiled without fastmath (no
-contraction into fused multiply-adds), so each operation rounds as numpy's does. A towed body is
-placed before every step, so what numpy spends on calls over a few hundred nodes would cost more
-than the compiled step itself (docs/science/force-models.md, 'What moving costs').
+Firdaouss & Lallemand, Phys. Fluids 13 (2001) 3452) or shapes/polygon.py's edge tests,
+solver/bouzidi.py `build_links` (the moving-wall term of Lallemand & Luo, J. Comput. Phys. 184
+(2003) 406); solver/body.py `refill` (equilibrium scheme) to the storage's rounding. Compiled
+without fastmath (no contraction into fused multiply-adds), so each operation rounds as numpy's
+does. A towed body is placed before every step, so what numpy spends on calls over a few hundred
+nodes would cost more than the compiled step itself (docs/science/force-models.md, 'What moving
+costs'). The numpy backend, the reference, keeps its own readable code.
 """
 from __future__ import annotations
 
