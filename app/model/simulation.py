@@ -206,6 +206,11 @@ class Simulation:
         """C_p along the surface for the plot's C_p view (app/model/live_polar.py), or None."""
         return self.pressure.surface_watch
 
+    def surface_pressure(self):
+        """C_p along the surface now, for the plot's C_p view (PressureWatches.surface_pressure),
+        or None."""
+        return self.pressure.surface_pressure(self)
+
     def watch_surface_pressure(self, on: bool = True):
         """Switch the pressure model's wall sampling on for C_p along the surface (the C_p view)."""
         self.pressure.watch_surface(on)
