@@ -1,5 +1,6 @@
-"""`feelflow bench operators [--quick] [--rounds N] [--json PATH]`: what each collision operator
-costs per step, on the numpy, the compiled cpu and the gl backend, in the window's tunnel.
+"""`feelflow bench operators [--quick] [--rounds N] [--backend B] [--json PATH]`: what each
+collision operator costs per step, on the numpy, the compiled cpu and the gl backend (or only
+those named with --backend), in the window's tunnel.
 
 The tunnel scene of `feelflow bench solver` (app/bench/solver_speed.py: inlet, pressure outlet with
 its sponge, a cylinder moved every 10 steps, the reference force every step) at the window's
@@ -49,6 +50,9 @@ def main(args) -> int:
     quick = bool(getattr(args, "quick", False))
     rounds = getattr(args, "rounds", None) or (1 if quick else 3)
     steps = {"numpy": 60 if quick else 300, "cpu": 300 if quick else 1500, "gl": 200 if quick else 1000}
+    only = getattr(args, "backend", None)
+    if only:   # --backend: only these backends (each with its own TRT for the ratios)
+        steps = {b: n for b, n in steps.items() if b in only}
     from feelflow.solver.backend import COMPARISON_COLLISIONS
 
     def runs_on(backend, op):

@@ -34,7 +34,7 @@ def add_arguments(parser):
     parser.add_argument("--quick", action="store_true", help="solver, accuracy: fewer steps or points (smoke test)")
     parser.add_argument("--backend", action="append", choices=("numpy", "cpu", "gl"),
                         help="accuracy: only this backend (repeatable; default: numpy float64, numpy float32, gl); "
-                             "motion: default all three")
+                             "motion: default all three; operators: only these (default all three)")
     parser.add_argument("--axis", action="append", choices=AXES,
                         help="accuracy: only this axis (repeatable; default: all three)")
     parser.add_argument("--profile", action="store_true",
