@@ -422,6 +422,12 @@ class Simulation:
         self.guard_changed = True
         return True
 
+    def take_guard_change(self) -> bool:
+        """Whether the local guard changed the flow since the last call (the window then says
+        `guard_note`)."""
+        changed, self.guard_changed = self.guard_changed, False
+        return changed
+
     # --- what the window shows -----------------------------------------------------------
     def reference_length(self) -> readouts.ReferenceLength:
         """The length the force coefficients use (app/model/readouts.py): the body's size, or
