@@ -42,7 +42,7 @@ def drag_handle(window, degrees: float, moves: int = 12, modifiers=None):
     r = math.hypot(knob.x() - centre.x(), knob.y() - centre.y())
     a0 = math.atan2(centre.y() - knob.y(), knob.x() - centre.x())   # widget y is down
     send_mouse(vp, "press", knob)
-    assert vp._turn is not None, "the press did not take the handle"
+    assert vp.turn is not None, "the press did not take the handle"
     at = knob
     for k in range(1, moves + 1):
         a = a0 + math.radians(degrees) * k / moves
@@ -118,7 +118,7 @@ def test_the_handle_is_refused_while_a_replay_shows(window, qtbot, tmp_path, mon
     quarter = QPointF(centre.x() - (knob.y() - centre.y()), centre.y() + (knob.x() - centre.x()))
     send_mouse(vp, "move", quarter)
     send_mouse(vp, "release", knob)
-    assert vp._turn is None
+    assert vp.turn is None
     assert "the mouse does not move the body" in window.statusBar().currentMessage()
     assert not window.bodies.turn_body(45.0)
     assert live.angle_target == angle and window.undo.count() == steps
@@ -136,7 +136,7 @@ def test_the_handle_is_refused_while_a_script_or_a_device_drives_the_body(window
     _, knob = knob_after_hover(window)
     send_mouse(vp, "press", knob)
     send_mouse(vp, "release", knob)
-    assert vp._turn is None and sim.angle_target == angle
+    assert vp.turn is None and sim.angle_target == angle
     assert "A motion script drives the body" in window.statusBar().currentMessage()
 
     window.flow.reset()                                            # the script ends: the mouse turns it again
@@ -146,14 +146,14 @@ def test_the_handle_is_refused_while_a_script_or_a_device_drives_the_body(window
     _, knob = knob_after_hover(window)
     send_mouse(vp, "press", knob)
     send_mouse(vp, "release", knob)
-    assert vp._turn is None and sim.angle_target == angle
+    assert vp.turn is None and sim.angle_target == angle
     assert "The haptic device drives the body" in window.statusBar().currentMessage()
 
     panel.input.setCurrentIndex(panel.input.findData("mouse"))
     assert window.inputs.device is None and vp.turn_blocker() is None
     _, knob = knob_after_hover(window)
     send_mouse(vp, "press", knob)
-    assert vp._turn is not None
+    assert vp.turn is not None
     send_mouse(vp, "release", knob)
 
 

@@ -200,16 +200,10 @@ class ForcePlot(QWidget):
             self._draw_time_view()
 
     def surface_pressure(self):
-        """C_p along the surface now (app/model/live_polar.py): the polar's angle being held, else
-        the C_p view's own sampling; None where there is none (a replay, nothing sampled yet)."""
-        sim = self.sim
-        polar = getattr(sim, "polar", None)
-        if polar is not None and not polar.done:
-            return polar.live_cp(sim)
-        if polar is not None and polar.cp:
-            return polar.cp[-1][1]
-        watch = getattr(sim, "surface_watch", None)
-        return watch.take(sim) if watch is not None else None
+        """C_p along the surface now (Simulation.surface_pressure); None where there is none (a
+        replay, nothing sampled yet)."""
+        take = getattr(self.sim, "surface_pressure", None)
+        return take() if take is not None else None
 
     def readout(self, model=None) -> readouts.Readout:
         """The mean drag, lift and coefficients of the last samples, with the reference they use

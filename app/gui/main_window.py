@@ -44,7 +44,8 @@ from feelflow.app.gui.exercise_controller import ExerciseController  # noqa: E40
 from feelflow.app.gui.force_plot import ForcePlot  # noqa: E402
 from feelflow.app.gui.side_panel import SidePanel  # noqa: E402
 from feelflow.app.gui.display_modes import DISPLAY_MODES  # noqa: E402
-from feelflow.app.gui.viewport import MOUSE_HINT, Viewport  # noqa: E402
+from feelflow.app.gui.view_mouse import MOUSE_HINT  # noqa: E402
+from feelflow.app.gui.viewport import Viewport  # noqa: E402
 from feelflow.app.gui.window.backend_controller import BackendController  # noqa: E402
 from feelflow.app.gui.window.bodies import BodyController  # noqa: E402
 from feelflow.app.gui.window.exports import ExportController  # noqa: E402

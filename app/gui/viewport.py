@@ -1,30 +1,27 @@
 """The wind tunnel view: a plain (raster) widget that draws the flow field coloured on the GPU
 (app/gui/field_colours.py: an OpenGL context of its own on an offscreen surface, the picture
 read back) with QPainter, the overlay (app/gui/overlay.py: body, force arrows, tracers, colour
-bar, notes, the polygon editor's handles and the rotation handle) painted on top; and the
-mouse: dragging the body, the polygon editor, the rotation handle (app/gui/turn_handle.py) and
-the wheel, each a signal to the window. The gl solver runs on the same context (`makeCurrent`).
+bar, notes, the polygon editor's handles and the rotation handle) painted on top, and the
+lattice's place in the widget. The mouse (dragging the body, the polygon editor, the rotation
+handle, the wheel) is app/gui/view_mouse.py's; its requests leave as this widget's signals. The
+gl solver runs on the same context (`makeCurrent`).
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
-from PySide6.QtCore import QEvent, QPointF, QRectF, Qt, Signal
+from PySide6.QtCore import QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QImage, QPainter, QPolygonF
-from PySide6.QtWidgets import QToolTip, QWidget
+from PySide6.QtWidgets import QWidget
 
-from feelflow.app.gui import turn_handle
 from feelflow.app.gui.cpu_field import BACKGROUND
 from feelflow.app.gui.display_modes import COLOUR_BAR_MARGIN, DISPLAY_MODES
 from feelflow.app.gui.field_colours import FieldColours
 from feelflow.app.gui.overlay import Overlay
+from feelflow.app.gui.view_mouse import ViewMouse
 from feelflow.app.model.tunnel import TunnelModel
 from feelflow.solver import units
-WHEEL_DEG_PER_NOTCH = 2.0  # one notch of the mouse wheel (120 eighths of a degree) turns the body this far
-MOUSE_HINT = ("Drag the body to move it; drag its round handle or turn the mouse wheel to rotate it "
-              "(hold Shift for 15\u00b0 steps).")
-HANDLE_HINT = "Drag to rotate the body about its reference point (Shift: 15\u00b0 steps); the mouse wheel rotates it too."
 
 
 class Viewport(QWidget):
@@ -61,12 +58,8 @@ class Viewport(QWidget):
         self.rho_ref = 1.0             # free-stream density for the pressure view (set by the window)
         self.locked = False            # True while a replay shows: the mouse does not move the body
         self.banner = None             # a line painted over the field (the replay's progress)
-        self._grab = None              # offset from body centre to the pressed point
-        self._edit_vertex = None       # index of the vertex being dragged
-        self._edit_preview = None
         self.driver = None             # what else drives the body ("The haptic device"), set by the window
-        self._turn = None              # the handle's drag in progress (turn_handle.Turn)
-        self._hover = None             # "handle", "body" or "near" (the handle shows), or None
+        self.mouse = ViewMouse(self)   # dragging, the polygon editor, the turn handle, the wheel
         self.overlay = Overlay(self)
         self._gl_tried = False
         self._outline_cache = None     # (shape, lattice rectangle, QPolygonF) of body_outline_points
@@ -105,21 +98,6 @@ class Viewport(QWidget):
     def field_texture(self):
         """The texture drawn: the numpy path's upload or the gl solver's own, or None."""
         return self.colours.field_texture
-
-    @property
-    def edit_preview(self):
-        """The polygon's vertices (body frame) while the editor drags one, else None."""
-        return self._edit_preview
-
-    @property
-    def turn(self):
-        """The handle's drag in progress (turn_handle.Turn), or None."""
-        return self._turn
-
-    @property
-    def hover(self):
-        """What the pointer is over: "handle", "body" or "near", or None."""
-        return self._hover
 
     def makeCurrent(self):
         """The viewport's GL context current (the gl solver draws with it too)."""
@@ -235,85 +213,6 @@ class Viewport(QWidget):
             return None
         return self.to_widget(cfg.nx - cfg.sponge_cells - 0.5, 0.0).x()
 
-    # --- rotation handle ------------------------------------------------------------------------
-    def turn_blocker(self):
-        """What drives the body instead of the mouse (a haptic device, a motion script), or None."""
-        if self.driver:
-            return self.driver
-        if getattr(self.sim, "runner", None) is not None:
-            return "A motion script"
-        return None
-
-    def handle_geometry(self):
-        """(reference point, knob centre, stalk length) in widget pixels, or None without a body."""
-        sim = self.sim
-        if sim is None or sim.shape is None:
-            return None
-        centre = self.to_widget(*sim.pos)
-        reach = turn_handle.handle_reach(centre, self.body_outline_points())
-        return centre, turn_handle.knob_position(centre, reach, sim.angle), reach
-
-    def handle_shown(self) -> bool:
-        """The handle shows while the pointer is near the body or turns it; never during a replay,
-        a drag of the body or while the polygon editor drags a vertex."""
-        if self.locked or self.sim is None or self.sim.shape is None:
-            return False
-        if self._grab is not None or self._edit_vertex is not None:
-            return False
-        return self._turn is not None or self._hover is not None
-
-    def _hover_at(self, pos: QPointF):
-        """What the pointer is over: the knob, the body, near the body (within the handle's reach)."""
-        geometry = self.handle_geometry() if not self.locked else None
-        if geometry is None:
-            return None
-        centre, knob, reach = geometry
-        if math.hypot(pos.x() - knob.x(), pos.y() - knob.y()) <= turn_handle.KNOB_REACH:
-            return "handle"
-        if self.sim.hit(*self.to_lattice(pos)):
-            return "body"
-        if math.hypot(pos.x() - centre.x(), pos.y() - centre.y()) <= reach + turn_handle.NEAR:
-            return "near"
-        return None
-
-    def _set_hover(self, hover):
-        if hover != self._hover:
-            self._hover = hover
-            self.update()
-        if self._turn is not None:
-            self.setCursor(turn_handle.rotate_cursor())
-        elif self._grab is not None:
-            self.setCursor(Qt.ClosedHandCursor)
-        elif hover == "handle":
-            self.setCursor(Qt.ForbiddenCursor if self.turn_blocker() else turn_handle.rotate_cursor())
-        elif hover == "body" and not self.editing:
-            self.setCursor(Qt.OpenHandCursor)
-        else:
-            self.unsetCursor()
-
-    def _pointer_degrees(self, pos: QPointF) -> float:
-        return turn_handle.pointer_degrees(self.sim.pos, self.to_lattice(pos))
-
-    def leaveEvent(self, ev):
-        if self._turn is None:
-            self._set_hover(None)
-        super().leaveEvent(ev)
-
-    def event(self, ev):
-        """Tooltips where they help: over the handle, over the body."""
-        if ev.type() == QEvent.ToolTip and self.sim is not None and not self.locked:
-            hover = self._hover_at(QPointF(ev.pos()))
-            text = {"handle": HANDLE_HINT, "body": MOUSE_HINT}.get(hover)
-            blocker = self.turn_blocker() if hover == "handle" else None
-            if blocker:
-                text = f"{blocker} drives the body: the handle cannot rotate it now."
-            if text:
-                QToolTip.showText(ev.globalPos(), text, self)
-            else:
-                QToolTip.hideText()
-            return True
-        return super().event(ev)
-
     # --- editor geometry ------------------------------------------------------------------------
     def body_to_world(self, verts):
         sim = self.sim
@@ -327,115 +226,56 @@ class Viewport(QWidget):
         dx, dy = x - sim.pos[0], y - sim.pos[1]
         return (c * dx + s * dy, -s * dx + c * dy)
 
-    def _vertex_at(self, pos: QPointF):
-        if self.sim.polygon is None:
-            return None
-        for i, (x, y) in enumerate(self.body_to_world(self.sim.polygon)):
-            c = self.to_widget(x, y)
-            if abs(c.x() - pos.x()) <= 8 and abs(c.y() - pos.y()) <= 8:
-                return i
-        return None
+    # --- the mouse (app/gui/view_mouse.py) -------------------------------------------------------
+    @property
+    def edit_preview(self):
+        """The polygon's vertices (body frame) while the editor drags one, else None."""
+        return self.mouse.edit_preview
 
-    # --- mouse --------------------------------------------------------------------------------
+    @property
+    def turn(self):
+        """The handle's drag in progress (turn_handle.Turn), or None."""
+        return self.mouse.turn
+
+    @property
+    def hover(self):
+        """What the pointer is over: "handle", "body" or "near", or None."""
+        return self.mouse.hover
+
+    def turn_blocker(self):
+        """What drives the body instead of the mouse (a haptic device, a motion script), or None."""
+        return self.mouse.turn_blocker()
+
+    def handle_geometry(self):
+        """(reference point, knob centre, stalk length) in widget pixels, or None without a body."""
+        return self.mouse.handle_geometry()
+
+    def handle_shown(self) -> bool:
+        """Whether the turn handle shows (ViewMouse.handle_shown)."""
+        return self.mouse.handle_shown()
+
     def cancel_drag(self):
         """Forget a drag of the body in progress (a replay takes over the view)."""
-        self._grab = None
+        self.mouse.cancel_drag()
+
+    def event(self, ev):
+        return True if self.mouse.tooltip(ev) else super().event(ev)
+
+    def leaveEvent(self, ev):
+        self.mouse.leave()
+        super().leaveEvent(ev)
 
     def mousePressEvent(self, ev):
-        if self.sim is None:
-            return
-        if self.locked:
-            self.inputRefused.emit()
-            return
-        pos = ev.position()
-        x, y = self.to_lattice(pos)
-        if self.probing and ev.button() in (Qt.LeftButton, Qt.RightButton):
-            self.probeClicked.emit(x, y, ev.button() == Qt.RightButton)
-            return
-        if self.editing and self.sim.polygon is not None:
-            i = self._vertex_at(pos)
-            if i is not None and ev.button() == Qt.RightButton:
-                verts = [v for k, v in enumerate(self.sim.polygon) if k != i]
-                self.polygonEdited.emit(verts)
-                return
-            if i is not None and ev.button() == Qt.LeftButton:
-                self._edit_vertex = i
-                self._edit_preview = [tuple(v) for v in self.sim.polygon]
-                return
-        hover = self._hover_at(pos)
-        if ev.button() == Qt.LeftButton and hover == "handle":
-            blocker = self.turn_blocker()
-            if blocker:
-                self.turnRefused.emit(blocker)
-                return
-            self._turn = turn_handle.Turn(self._pointer_degrees(pos), self.sim.target_degrees())
-            self._set_hover(hover)
-            return
-        if ev.button() == Qt.LeftButton and self.sim.hit(x, y):
-            self._grab = (self.sim.pos[0] - x, self.sim.pos[1] - y)
-            self.bodyPulled.emit((x + self._grab[0], y + self._grab[1]))
-            self.bodyGrabbed.emit(True)
-            self._set_hover(hover)
-            self.update()
+        self.mouse.press(ev)
 
     def mouseMoveEvent(self, ev):
-        if self.sim is None:
-            return
-        x, y = self.to_lattice(ev.position())
-        if self._turn is not None:
-            before = self._turn.target
-            target = self._turn.follow(self._pointer_degrees(ev.position()), bool(ev.modifiers() & Qt.ShiftModifier))
-            if target != before:
-                self.turnRequested.emit(target)
-            self.update()
-        elif self._edit_vertex is not None:
-            self._edit_preview[self._edit_vertex] = self.world_to_body(x, y)
-            self.update()
-        elif self._grab is not None:
-            self.bodyPulled.emit((x + self._grab[0], y + self._grab[1]))
-        elif not ev.buttons():
-            self._set_hover(self._hover_at(ev.position()))
+        self.mouse.move(ev)
 
     def mouseReleaseEvent(self, ev):
-        if self._turn is not None:
-            turn, self._turn = self._turn, None
-            if turn.target != turn.before:
-                self.turnFinished.emit(turn.before, turn.target)
-            self._set_hover(self._hover_at(ev.position()) if self.sim is not None else None)
-            self.update()
-        elif self._edit_vertex is not None:
-            verts, self._edit_vertex, self._edit_preview = self._edit_preview, None, None
-            self.polygonEdited.emit(verts)
-        elif self._grab is not None:
-            self._grab = None
-            self.bodyPulled.emit(None)
-            self.bodyGrabbed.emit(False)
-            self._set_hover(self._hover_at(ev.position()))
+        self.mouse.release(ev)
 
     def mouseDoubleClickEvent(self, ev):
-        """Editor: a double click adds a vertex on the nearest edge."""
-        if self.locked:
-            return
-        if not (self.editing and self.sim is not None and self.sim.polygon is not None):
-            return
-        x, y = self.to_lattice(ev.position())
-        bx, by = self.world_to_body(x, y)
-        v = np.asarray(self.sim.polygon, float)
-        a, b = v, np.roll(v, -1, axis=0)
-        ab = b - a
-        t = np.clip(((bx - a[:, 0]) * ab[:, 0] + (by - a[:, 1]) * ab[:, 1]) / np.maximum((ab ** 2).sum(1), 1e-12), 0, 1)
-        d = np.hypot(a[:, 0] + t * ab[:, 0] - bx, a[:, 1] + t * ab[:, 1] - by)
-        k = int(np.argmin(d))
-        verts = [tuple(p) for p in v]
-        verts.insert(k + 1, (bx, by))
-        self.polygonEdited.emit(verts)
+        self.mouse.double_click(ev)
 
     def wheelEvent(self, ev):
-        if self.sim is None:
-            return
-        if self.locked:
-            self.inputRefused.emit()
-            ev.accept()
-            return
-        self.wheelTurned.emit(WHEEL_DEG_PER_NOTCH * ev.angleDelta().y() / 120.0)
-        ev.accept()
+        self.mouse.wheel(ev)

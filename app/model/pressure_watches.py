@@ -36,6 +36,17 @@ class PressureWatches:
     def stop_polar(self):
         self.polar = None
 
+    def surface_pressure(self, sim):
+        """C_p along the surface now: at the polar's angle being held, else its last settled
+        angle's, else the C_p view's own sampling (averaged since the last look); None where
+        nothing is sampled."""
+        polar = self.polar
+        if polar is not None and not polar.done:
+            return polar.live_cp(sim)
+        if polar is not None and polar.cp:
+            return polar.cp[-1][1]
+        return self.surface_watch.take(sim) if self.surface_watch is not None else None
+
     def after_advance(self, sim, forces: dict, n: int):
         """Take the probes' rows out of `forces` (a probe's force is the pressure model's, not a
         model of its own) and feed the polar the last `n` steps."""

@@ -206,6 +206,11 @@ class Simulation:
         """C_p along the surface for the plot's C_p view (app/model/live_polar.py), or None."""
         return self.pressure.surface_watch
 
+    def surface_pressure(self):
+        """C_p along the surface now, for the plot's C_p view (PressureWatches.surface_pressure),
+        or None."""
+        return self.pressure.surface_pressure(self)
+
     def watch_surface_pressure(self, on: bool = True):
         """Switch the pressure model's wall sampling on for C_p along the surface (the C_p view)."""
         self.pressure.watch_surface(on)
@@ -416,6 +421,12 @@ class Simulation:
             self.guard_note = action.verdict.line(label, nu_set=self.params.nu)
         self.guard_changed = True
         return True
+
+    def take_guard_change(self) -> bool:
+        """Whether the local guard changed the flow since the last call (the window then says
+        `guard_note`)."""
+        changed, self.guard_changed = self.guard_changed, False
+        return changed
 
     # --- what the window shows -----------------------------------------------------------
     def reference_length(self) -> readouts.ReferenceLength:

@@ -212,8 +212,7 @@ class FrameLoop:
         if not all(math.isfinite(v) for f in forces.values() for v in f):
             self._on_nan()
             return
-        if getattr(sim, "guard_changed", False):   # the local stability guard raised the viscosity
-            sim.guard_changed = False
+        if sim.take_guard_change():   # the local stability guard raised the viscosity
             self.events.guardActed.emit()
         self.events.liveFrame.emit(forces)
         self._frame_done(now, t0, t1, n, forces, rgba)
