@@ -110,8 +110,12 @@ def test_cylinder_re200_targets_are_the_published_values_within_their_tolerances
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(3600)
 def test_schaefer_turek_2d1_at_40_cells(request):
-    r = case_module("schaefer-turek-2d1").run(factory("numpy", request), resolution=40)
+    """2D-1 at 40 cells per diameter: eight times the node updates of the 20-cell full case, so
+    it runs on the compiled cpu backend (equal to numpy, tests/test_cpu_vs_numpy.py); on numpy it
+    ran past 600 s on a loaded 2-core machine."""
+    r = case_module("schaefer-turek-2d1").run(factory("cpu", request), resolution=40, backend="cpu")
     assert r.passed, r.to_dict()
 
 
