@@ -215,9 +215,14 @@ def test_space_pauses_and_r_resets(window, qtbot):
     from PySide6.QtCore import Qt
     from PySide6.QtTest import QTest
 
-    window.activateWindow()
-    window.viewport.setFocus()
-    qtbot.waitUntil(window.viewport.hasFocus, timeout=5000)
+    def focused():   # ask again while waiting: a window left by an earlier test may take the activation first
+        if not window.viewport.hasFocus():
+            window.raise_()
+            window.activateWindow()
+            window.viewport.setFocus()
+        return window.viewport.hasFocus()
+
+    qtbot.waitUntil(focused, timeout=10000)
     QTest.keyClick(window.viewport, Qt.Key_Space)
     assert window.loop.paused
     t = window.sim.solver.time
