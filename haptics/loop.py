@@ -95,6 +95,7 @@ class ForceLoop:
         self.shaper = ForceInterpolator(cfg.filter_hz)
         self.torque_scale = ForceScale(cfg.expected_peak_torque, cfg.comfort_fraction, caps.max_torque)
         self.torque_shaper = ForceInterpolator(cfg.filter_hz)  # the torque as (torque, 0)
+        self.torque_axis = caps.max_torque > 0   # only then is the torque shaped and sent
         self.torque_sent = 0.0
         self.gate = SafetyGate(cfg.safety)
         self.ticker = Ticker(cfg.rate_hz, cfg.spin_s)
@@ -287,12 +288,12 @@ class ForceLoop:
                 self.gate.set_fault("nan", False)
         if sample is not None:
             self.shaper.add(sample.fx, sample.fy, arrival)
-            self.torque_shaper.add(sample.torque, 0.0, arrival)
+            if self.torque_axis:
+                self.torque_shaper.add(sample.torque, 0.0, arrival)
         due = self.shaper.next_due
         stalled = due is None or now > due + self.config.safety.stall_timeout
         self.gate.set_fault("stall", stalled)
         lx, ly = self.shaper.evaluate(now)
-        lt, _ = self.torque_shaper.evaluate(now)
         # 3. safety gain, scale, map to device axes, clamp
         g = self.gate.update(now)
         k = self.scale.gain * g
@@ -300,7 +301,8 @@ class ForceLoop:
         fx, fy = clamp_force(fx, fy, dev.capabilities.max_force)
         # 4. command
         self.force_sent = dev.write_force(fx, fy)
-        if dev.capabilities.max_torque > 0:   # the same gain g: ramp, pause, stall, NaN zero it too
+        if self.torque_axis:   # the same gain g: ramp, pause, stall, NaN zero it too
+            lt, _ = self.torque_shaper.evaluate(now)
             self.torque_sent = dev.write_torque(self.map.torque_to_device(lt * self.torque_scale.gain * g))
         self._max_cmd = max(self._max_cmd, math.hypot(*self.force_sent))
         if rec is not None:
