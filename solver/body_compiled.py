@@ -440,9 +440,10 @@ def move_body(old, new, config, g, impulse: str) -> tuple[float, float]:
 @numba.njit(**_JIT)
 def _redo_nodes(ey, ex, ebits, edge_grid, li, liy, lix, lfy, lfx, lq, x0, y0, h, w):
     """The boundary pass's node list (solver/cpu_backend.py `_redo_nodes`): the domain-edge nodes
-    (ey, ex, ebits), then each node that owns a body link, row by row, with a bit per link
-    direction and its edge bits, as (3, m) (iy, ix, bits); the links' (iy, ix, fy, fx) in grid
-    coordinates (4, n); and their wall crossings x - q c_i (px, py) (2, n), for the torque."""
+    (ey, ex, ebits) that own no body link, then each node that owns a body link, row by row, with
+    a bit per link direction and its edge bits, as (3, m) (iy, ix, bits), each node once; the
+    links' (iy, ix, fy, fx) in grid coordinates (4, n); and their wall crossings x - q c_i
+    (px, py) (2, n), for the torque."""
     win = np.zeros((h, w), np.int64)
     for k in range(len(li)):
         win[liy[k], lix[k]] |= 1 << li[k]
@@ -450,11 +451,20 @@ def _redo_nodes(ey, ex, ebits, edge_grid, li, liy, lix, lfy, lfx, lq, x0, y0, h,
     for y in range(h):
         for x in range(w):
             m += win[y, x] != 0
-    ne = len(ey)
+    keep = np.ones(len(ey), np.bool_)
+    for k in range(len(ey)):
+        yy, xx = ey[k] - y0, ex[k] - x0
+        if 0 <= yy < h and 0 <= xx < w and win[yy, xx] != 0:
+            keep[k] = False
+    ne = 0
+    for k in range(len(ey)):
+        ne += keep[k]
     nodes = np.empty((3, ne + m), np.int64)
-    for k in range(ne):
-        nodes[0, k], nodes[1, k], nodes[2, k] = ey[k], ex[k], ebits[k]
-    k = ne
+    k = 0
+    for j in range(len(ey)):
+        if keep[j]:
+            nodes[0, k], nodes[1, k], nodes[2, k] = ey[j], ex[j], ebits[j]
+            k += 1
     for y in range(h):
         for x in range(w):
             if win[y, x] != 0:

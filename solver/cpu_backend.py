@@ -23,6 +23,7 @@ import numpy as np
 
 from feelflow.solver import body_compiled
 from feelflow.solver.backend import SolverDiverged
+from feelflow.solver.cpu_kernels import rows_of_nodes
 from feelflow.solver.forces.momentum_exchange import ClassicMomentumExchange, GalileanMomentumExchange
 from feelflow.solver.inflow import INLET_DIRECTIONS, OUTLET_DIRECTIONS
 from feelflow.solver.numpy_backend import NumpySolver, absorb_keep, relaxation_rates
@@ -97,8 +98,9 @@ class CpuSolver(NumpySolver):
 
     def _boundary_nodes(self):
         """((ny, nx) bits, (iy, ix, bits) of the node pass): bit i set where a domain boundary
-        rule (c, d, b) writes population i; the node pass takes those nodes and every node of
-        the first and last column (solver/cpu_kernels.py advance, step 3)."""
+        rule (c, d, b) writes population i; the node pass takes every node of the first and last
+        column (solver/cpu_kernels.py advance, step 3: they pull across the periodic seam and
+        own the inlet's and outlet's populations); the parallel pass takes the walls' (step 2)."""
         cfg = self.config
         bits = np.zeros((cfg.ny, cfg.nx), np.int64)
         if cfg.x_boundary == "tunnel":
@@ -107,7 +109,7 @@ class CpuSolver(NumpySolver):
         if cfg.y_boundary != "periodic":
             bits[0, :] |= _bits((2, 5, 6))
             bits[-1, :] |= _bits((4, 7, 8))
-        listed = bits != 0
+        listed = np.zeros_like(bits, dtype=bool)
         listed[:, 0] = listed[:, -1] = True  # the seam columns are always collided in the node pass
         iy, ix = np.nonzero(listed)
         return bits, (iy.astype(np.int64), ix.astype(np.int64), bits[iy, ix])
@@ -115,9 +117,9 @@ class CpuSolver(NumpySolver):
     def _redo_nodes(self):
         """(iy, ix, bits) of every node a boundary rule or a body link writes a population of,
         and the links as flat arrays in grid coordinates; rebuilt when the body's links change,
-        from the links and the body window alone (compiled: solver/body_compiled.py). A link node on
-        the domain's edge comes twice, the second time (the links' part, later in the list) with
-        every bit, so it wins."""
+        from the links and the body window alone (compiled: solver/body_compiled.py). Each node
+        comes once (the node pass runs in parallel): a link node in a seam column comes only in
+        the links' part, with its edge bits as well."""
         b = self.body
         links = None if b is None else b.links
         if self._redo is not None and links is self._mask_links:
@@ -127,6 +129,7 @@ class CpuSolver(NumpySolver):
         else:
             self._redo, self._link_arrays = self._edge_nodes, (_EMPTY_I,) * 5 + (_EMPTY_F,) * 8
         self._mask_links = links
+        self._rows = rows_of_nodes(*self._redo, self.config.ny)
         return self._redo, self._link_arrays
 
     def _move_body(self, old, new) -> tuple[float, float]:
@@ -192,18 +195,19 @@ class CpuSolver(NumpySolver):
             wall_profile, profile = self._inlet_wall_profile, self._inflow_profile
             if self._quiet:
                 rate = cfg.inlet_nonreflecting
-        (ry, rx, rbits), links = self._redo_nodes()
+        _, links = self._redo_nodes()
+        rp, nxs, nbits = self._rows
         if self._solid_idx is not None:
             sy, sx, solid_g = self._solid_idx[0], self._solid_idx[1], self._solid_g
         else:
             sy, sx, solid_g = _EMPTY_I, _EMPTY_I, self._empty_solid
         dt = self.dtype.type
-        done, finite = self._advance(n, t, cfg.inflow_ramp_steps, self.g, self._gin, self._pre, self._op, self._om,
-                             self._keep, self._target, self._xs, self._fx, self._fy, self._smag, self._scratch,
-                             self._block_sums, self._tunnel, self._walls_kind, self._periodic_x, profile,
-                             wall_profile, dt(rate), dt(CS_OVER_RHO0), self._drho_ref, *links, self._link_force,
-                             ry, rx, rbits, sy, sx, solid_g)
-        if done % 2:
+        done, finite, in_out = self._advance(
+            n, t, cfg.inflow_ramp_steps, self.g, self._gin, self._pre, self._op, self._om, self._keep, self._target,
+            self._xs, self._fx, self._fy, self._smag, self._scratch, self._block_sums, self._tunnel, self._walls_kind,
+            self._periodic_x, profile, wall_profile, dt(rate), dt(CS_OVER_RHO0), self._drho_ref, *links,
+            self._link_force, rp, nxs, nbits, sy, sx, solid_g)
+        if in_out:
             self.g, self._gin = self._gin, self.g
         self.time = t + done
         if not finite:

@@ -53,6 +53,8 @@ _MIRROR_Y = np.array([0, 1, 4, 3, 2, 8, 7, 6, 5], dtype=np.int64)
 WALLS = {"periodic": 0, "no_slip": 1, "free_slip": 2}
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy", fastmath={"contract", "arcp", "nsz", "reassoc"})
+#: the tunnel kernel's one parallel loop per step; numba must not fuse it with anything
+_PARALLEL = {"fusion": False}
 
 
 def constants(dtype) -> tuple:
@@ -417,13 +419,94 @@ def _gather_node(g, b, k, y, ym, yp, x):
 
 
 @numba.njit(inline="always", **_JIT)
-def _velocity(g, y, x):
-    """u = sum c f / sum f at one node, in float64."""
+def _wall_in(b, pre, y, x0, n, lower):
+    """b[i, :n] = pre[i, y, x0 .. x0+n-1] for the populations a wall at y = -1/2 (lower) or
+    ny - 1/2 writes: rule b on a wall row's chunk inside the parallel pass."""
+    x1 = x0 + n
+    if lower:
+        b[2, :n] = pre[2, y, x0:x1]
+        b[5, :n] = pre[5, y, x0:x1]
+        b[6, :n] = pre[6, y, x0:x1]
+    else:
+        b[4, :n] = pre[4, y, x0:x1]
+        b[7, :n] = pre[7, y, x0:x1]
+        b[8, :n] = pre[8, y, x0:x1]
+
+
+#: the lattice velocities as integers, for the layout accessors
+_CXI = C[:, 0].astype(np.int64)
+_CYI = C[:, 1].astype(np.int64)
+#: where the state of a step's input or output lives (the AA pattern, `make_kernel`): NATURAL
+#: f*_i(x) in slot i of node x (the solver's state between calls); STREAMED f*_i(x) in slot i of
+#: node x + c_i (an AA odd step's output: each node's incoming populations in its own slots);
+#: SWAPPED f*_i(x) in slot opp(i) of node x (an AA even step's output)
+NATURAL, STREAMED, SWAPPED = 0, 1, 2
+
+
+@numba.njit(inline="always", **_JIT)
+def _wrap(v, n):
+    """v periodic in 0 .. n-1 for -n <= v < 2n (a branch: an integer modulo costs tens of cycles)."""
+    if v < 0:
+        return v + n
+    if v >= n:
+        return v - n
+    return v
+
+
+@numba.njit(inline="always", **_JIT)
+def _post(g, lay, i, y, x):
+    """f*_i at node (y, x), the post-collision population i, from g in layout `lay`."""
+    if lay == NATURAL:
+        return g[i, y, x]
+    if lay == SWAPPED:
+        return g[_OPP[i], y, x]
+    ny, nx = g.shape[1], g.shape[2]
+    return g[i, _wrap(y + _CYI[i], ny), _wrap(x + _CXI[i], nx)]
+
+
+@numba.njit(inline="always", **_JIT)
+def _put(g, lay, i, y, x, v):
+    """Store f*_i of node (y, x) = v into g in layout `lay`."""
+    if lay == NATURAL:
+        g[i, y, x] = v
+    elif lay == SWAPPED:
+        g[_OPP[i], y, x] = v
+    else:
+        ny, nx = g.shape[1], g.shape[2]
+        g[i, _wrap(y + _CYI[i], ny), _wrap(x + _CXI[i], nx)] = v
+
+
+@numba.njit(inline="always", **_JIT)
+def _gather_own(g, b, y, x0, n):
+    """b[:, :n] = the populations of nodes (y, x0 ..) in their own slots: a STREAMED input."""
+    x1 = x0 + n
+    for i in range(9):
+        b[i, :n] = g[i, y, x0:x1]
+
+
+@numba.njit(inline="always", **_JIT)
+def _store_swapped(g, o, y, x0, n):
+    """g[opp(i), y, x0 ..] = o[i, :n]: a SWAPPED output (an AA even step's writes)."""
+    x1 = x0 + n
+    g[0, y, x0:x1] = o[0, :n]
+    g[3, y, x0:x1] = o[1, :n]
+    g[4, y, x0:x1] = o[2, :n]
+    g[1, y, x0:x1] = o[3, :n]
+    g[2, y, x0:x1] = o[4, :n]
+    g[7, y, x0:x1] = o[5, :n]
+    g[8, y, x0:x1] = o[6, :n]
+    g[5, y, x0:x1] = o[7, :n]
+    g[6, y, x0:x1] = o[8, :n]
+
+
+@numba.njit(inline="always", **_JIT)
+def _velocity(g, lay, y, x):
+    """u = sum c f / sum f at one node, post-collision, in float64."""
     rho = R0
     jx = 0.0
     jy = 0.0
     for i in range(9):
-        v = np.float64(g[i, y, x])
+        v = np.float64(_post(g, lay, i, y, x))
         rho += v
         jx += _CX[i] * v
         jy += _CY[i] * v
@@ -431,41 +514,41 @@ def _velocity(g, y, x):
 
 
 @numba.njit(**_JIT)
-def _outlet(g, pre):
+def _outlet(g, lay, pre):
     """Rule d (solver/inflow.py outlet_incoming), anti-bounce-back at x = nx - 1/2, in float64."""
     ny, nx = g.shape[1], g.shape[2]
     for y in range(ny):
-        ux0, uy0 = _velocity(g, y, nx - 2)
-        ux1, uy1 = _velocity(g, y, nx - 1)
+        ux0, uy0 = _velocity(g, lay, y, nx - 2)
+        ux1, uy1 = _velocity(g, lay, y, nx - 1)
         bx = 1.5 * ux1 - 0.5 * ux0
         by = 1.5 * uy1 - 0.5 * uy0
         usq = bx * bx + by * by
         for i in (3, 6, 7):
             cu = _CX[i] * bx + _CY[i] * by
-            pre[i, y, nx - 1] = -np.float64(g[_OPP[i], y, nx - 1]) + 2.0 * _W[i] * R0 * (4.5 * cu * cu - 1.5 * usq)
+            pre[i, y, nx - 1] = -np.float64(_post(g, lay, _OPP[i], y, nx - 1)) + 2.0 * _W[i] * R0 * (4.5 * cu * cu - 1.5 * usq)
 
 
 @numba.njit(**_JIT)
-def _inlet(g, pre, r, wall_profile, quiet, rate, coefficient, drho_ref):
+def _inlet(g, lay, pre, r, wall_profile, quiet, rate, coefficient, drho_ref):
     """Rule c (moving-wall half-way bounce-back at x = -1/2, each link with its own inflow) and
     the quiet inlet's correction (solver/quiet_inlet.py; drho_ref updated in place)."""
     ny = g.shape[1]
     for y in range(ny):
         corr = 0.0
         if quiet:
-            d = g[0, y, 0]
+            d = _post(g, lay, 0, y, 0)
             for i in range(1, 9):
-                d += g[i, y, 0]
+                d += _post(g, lay, i, y, 0)
             drho_ref[y] += rate * (d - drho_ref[y])
             corr = -coefficient * (d - drho_ref[y])
         for k in range(3):
             i = (1, 5, 8)[k]
             c = 6.0 * _W[i] * R0
-            pre[i, y, 0] = np.float64(g[_OPP[i], y, 0]) + c * r * wall_profile[k, y] + c * corr
+            pre[i, y, 0] = np.float64(_post(g, lay, _OPP[i], y, 0)) + c * r * wall_profile[k, y] + c * corr
 
 
 @numba.njit(**_JIT)
-def _walls(g, pre, walls, periodic_x):
+def _walls(g, lay, pre, walls, periodic_x):
     """Rule b: half-way bounce-back (walls 1) or specular reflection (walls 2) at y = -1/2 and
     ny - 1/2; a free-slip tunnel corner keeps the inlet/outlet rule."""
     ny, nx = g.shape[1], g.shape[2]
@@ -476,27 +559,27 @@ def _walls(g, pre, walls, periodic_x):
             if walls == 1:
                 ib = _OPP[i]
                 for x in range(nx):
-                    pre[i, row, x] = g[ib, row, x]
+                    pre[i, row, x] = _post(g, lay, ib, row, x)
                 continue
             j = _MIRROR_Y[i]
             cx = int(_CX[i])
             if cx == 0:
                 for x in range(nx):
-                    pre[i, row, x] = g[j, row, x]
+                    pre[i, row, x] = _post(g, lay, j, row, x)
             elif cx == 1:
                 for x in range(1, nx):
-                    pre[i, row, x] = g[j, row, x - 1]
+                    pre[i, row, x] = _post(g, lay, j, row, x - 1)
                 if periodic_x:
-                    pre[i, row, 0] = g[j, row, nx - 1]
+                    pre[i, row, 0] = _post(g, lay, j, row, nx - 1)
             else:
                 for x in range(nx - 1):
-                    pre[i, row, x] = g[j, row, x + 1]
+                    pre[i, row, x] = _post(g, lay, j, row, x + 1)
                 if periodic_x:
-                    pre[i, row, nx - 1] = g[j, row, 0]
+                    pre[i, row, nx - 1] = _post(g, lay, j, row, 0)
 
 
 @numba.njit(**_JIT)
-def _links(g, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, lpx, lpy, sums):
+def _links(g, lay, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, lpx, lpy, sums):
     """Rule a (solver/bouzidi.py incoming, float64) on every body link, and the momentum
     exchange on them (solver/forces/momentum_exchange.py, full f = g + w RHO0):
     sums += (Galilean fx, fy, classic fx, fy, Galilean p x F, classic p x F) without the
@@ -506,8 +589,9 @@ def _links(g, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, lpx, lpy, s
         i = li[k]
         ib = _OPP[i]
         y, x = ly[k], lx[k]
-        g_out = np.float64(g[ib, y, x])
-        v = la[k] * g_out + lb[k] * np.float64(g[ib, lfy[k], lfx[k]]) + lc[k] * np.float64(g[i, y, x]) + ld[k]
+        g_out = np.float64(_post(g, lay, ib, y, x))
+        v = (la[k] * g_out + lb[k] * np.float64(_post(g, lay, ib, lfy[k], lfx[k]))
+             + lc[k] * np.float64(_post(g, lay, i, y, x)) + ld[k])
         pre[i, y, x] = v
         wr = _W[i] * R0
         f_out = g_out + wr
@@ -523,6 +607,115 @@ def _links(g, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, lpx, lpy, s
         sums[3] += sy
         sums[4] += lpx[k] * gy - lpy[k] * gx
         sums[5] += lpx[k] * sy - lpy[k] * sx
+
+
+@numba.njit(inline="always", **_JIT)
+def _collide_columns(bb, o, m, c, op, om, keep, tg, Fx, Fy, sm, rr, kbc, trt, incomp, has_keep, has_force, K):
+    """Collide m gathered nodes of columns c, each with its column's rates and absorbing layer."""
+    if rr:
+        return _columns_rr(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force, sm, K)
+    if kbc:
+        return _columns_kbc(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force, sm)
+    return _columns(bb, o, m, c, op, om, keep, tg, trt, incomp, has_keep, Fx, Fy, has_force, K)
+
+
+@numba.njit(inline="always", **_JIT)
+def _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
+         lin, lout, rr, kbc, trt, incomp, has_keep, has_force, K):
+    """One step of row y (`make_kernel`, step 2) from src in layout lin into dst in layout lout;
+    returns the row's sum drho. Columns 1 .. nx-2 in chunks; a wall row takes the populations
+    its wall writes from pre (_wall_in); the row's listed nodes nxs[rp[y] .. rp[y+1]] (sorted by
+    x: column 0 first, column nx-1 last) take population i from pre where bit i of nbits is set
+    before they collide, the seam columns 0 and nx-1 node by node with periodic neighbours."""
+    ny, nx = src.shape[1], src.shape[2]
+    ym = y - 1 if y > 0 else ny - 1
+    yp = y + 1 if y < ny - 1 else 0
+    wall_row = walls != 0 and (y == 0 or y == ny - 1)
+    k0, k1 = rp[y], rp[y + 1]
+    s = 0.0
+    k = k0
+    while k < k1 and nxs[k] == 0:
+        k += 1
+    x0 = 1
+    while x0 < nx - 1:   # chunks end at xs: the sponge starts a chunk
+        m = min(CHUNK, (xs if x0 < xs else nx - 1) - x0)
+        if lin == NATURAL:
+            _gather(src, bb, y, ym, yp, x0, m)
+        elif lin == STREAMED:
+            _gather_own(src, bb, y, x0, m)
+        else:
+            _gather_aa(src, bb, y, ym, yp, x0, m)
+        if wall_row:
+            _wall_in(bb, pre, y, x0, m, y == 0)
+        while k < k1 and nxs[k] < x0 + m:
+            x, bits = nxs[k], nbits[k]
+            for i in range(9):
+                if (bits >> i) & 1:
+                    bb[i, x - x0] = pre[i, y, x]
+            k += 1
+        if x0 < xs:        # the rates of column 1 for the whole chunk
+            if rr:
+                s += _chunk_rr(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm, K)
+            elif kbc:
+                s += _chunk_kbc(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm)
+            else:
+                s += _chunk(bb, o, m, op0, om0, tg, trt, incomp, Fx, Fy, has_force, K)
+        else:              # each column its own rates (the sponge)
+            s += _collide_columns(bb, o, m, cols[x0:x0 + m], op, om, keep, tg, Fx, Fy, sm, rr, kbc, trt, incomp,
+                                  has_keep, has_force, K)
+        if lout == NATURAL:
+            dst[:, y, x0:x0 + m] = o[:, :m]
+        elif lout == STREAMED:
+            _scatter_aa(dst, o, y, ym, yp, x0, m)
+        else:
+            _store_swapped(dst, o, y, x0, m)
+        x0 += m
+    for side in range(2):  # the seam columns
+        x = 0 if side == 0 else nx - 1
+        if side == 1 and nx == 1:
+            break
+        bits = 0
+        for kk in range(k0, k1):
+            if nxs[kk] == x:
+                bits = nbits[kk]
+        for i in range(9):
+            if (bits >> i) & 1:
+                bb[i, 0] = pre[i, y, x]
+            else:
+                bb[i, 0] = _post(src, lin, i, _wrap(y - _CYI[i], ny), _wrap(x - _CXI[i], nx))
+        s += _collide_columns(bb, o, 1, cols[x:x + 1], op, om, keep, tg, Fx, Fy, sm, rr, kbc, trt, incomp,
+                              has_keep, has_force, K)
+        for i in range(9):
+            _put(dst, lout, i, y, x, o[i, 0])
+    return s
+
+
+@numba.njit(**_JIT)
+def rows_of_nodes(ry, rx, rbits, ny):
+    """The kernel's boundary-node list by row: (rp (ny+1,), xs, bits), row y's nodes
+    xs[rp[y] .. rp[y+1]] sorted by x, from nodes (ry, rx, rbits) that each come once."""
+    n = len(ry)
+    rp = np.zeros(ny + 1, np.int64)
+    for k in range(n):
+        rp[ry[k] + 1] += 1
+    for y in range(ny):
+        rp[y + 1] += rp[y]
+    fill = rp[:-1].copy()
+    xs = np.empty(n, np.int64)
+    bits = np.empty(n, np.int64)
+    for k in range(n):
+        j = fill[ry[k]]
+        xs[j], bits[j] = rx[k], rbits[k]
+        fill[ry[k]] += 1
+    for y in range(ny):  # insertion sort: a row holds a handful of nodes
+        for a in range(rp[y] + 1, rp[y + 1]):
+            xa, ba = xs[a], bits[a]
+            b = a - 1
+            while b >= rp[y] and xs[b] > xa:
+                xs[b + 1], bits[b + 1] = xs[b], bits[b]
+                b -= 1
+            xs[b + 1], bits[b + 1] = xa, ba
+    return rp, xs, bits
 
 
 @numba.njit(inline="always", **_JIT)
@@ -551,30 +744,38 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
     kbc = kind == "kbc"
     smag_on = bool(smagorinsky) and (rr or kbc)
 
-    @numba.njit(parallel=True, **_JIT)
+    @numba.njit(parallel=_PARALLEL, **_JIT)
     def advance(n, t0, ramp_steps, g, out, pre, op, om, keep, target, xs, Fx, Fy, smag, scratch, sums,
                 tunnel, walls, periodic_x, profile, wall_profile, quiet_rate, quiet_coefficient, drho_ref,
                 li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, lpx, lpy, force,
-                ry, rx, rbits, sy, sx, solid_g):
-        """n steps from time t0, the state in g (post-collision), ping-ponging with out; returns
-        (steps done, finite): it stops after the first step whose density is not finite (that
-        state is kept). After an odd number of steps done the state is in out. Each step, in
-        the numpy backend's order:
+                rp, nxs, nbits, sy, sx, solid_g):
+        """n steps from time t0 of the post-collision state in g (NATURAL layout); returns
+        (steps done, finite, where): it stops after the first step whose density is not finite
+        (that state is kept, in the layout of that step's output); the state is in g if `where`
+        is 0, in out if 1.
+
+        The streaming pattern is AA (Bailey, Myre, Walsh, Lilja & Saar 2009;
+        docs/science/cpu-backend.md): the first step pulls from g (NATURAL) and writes its
+        output STREAMED into out; the steps between run in place in out, alternately
+        STREAMED -> SWAPPED and SWAPPED -> STREAMED (each node reads and writes the same nine
+        places, which no other node touches); the last writes NATURAL back into g. One step
+        alone reads g and writes out, both NATURAL. Each step, in the numpy backend's order:
         1. rules d (outlet), c (inlet with the ramp r(t) of `ramp_steps`, each link's inflow
            r wall_profile, the quiet inlet's correction once the ramp is over: quiet_rate > 0),
            b (walls: 0 periodic, 1 no-slip, 2 free-slip) and a (the body links li..luwy, in grid
-           coordinates) into pre, from the post-collision state; the momentum exchange summed
-           into force (6,) over the n steps (Galilean fx, fy, classic fx, fy, no impulse, and
-           their moments about the grid origin from the wall crossings lpx, lpy: _links);
-        2. pull-stream + collide of columns 1 .. nx-2, blocks of rows in parallel (scratch (B,
-           2, 9, CHUNK): each block's gather and result buffers, nothing allocated in the
-           parallel loop; sums (B,) each block's sum drho): columns 1 .. xs-1 share the rates
-           op[1], om[1]; xs .. nx-2 (the sponge) take their own column's; target (ny,) the
-           absorbing layer's x-velocity r profile;
-        3. the nodes (ry[k], rx[k]), serially: every node of columns 0 and nx-1 (they pull
-           across the periodic seam) and every node that owns a boundary population, pulled and
-           collided with population i from pre where bit i of rbits[k] is set;
-        4. the solid nodes (sy, sx) reset to solid_g."""
+           coordinates) into pre, from the post-collision state (read through `_post`); the
+           momentum exchange summed into force (6,) over the n steps (Galilean fx, fy, classic
+           fx, fy, no impulse, and their moments about the grid origin from the wall crossings
+           lpx, lpy: _links);
+        2. stream + collide of every node, blocks of rows in parallel (scratch (B, 2, 9, CHUNK):
+           each block's gather and result buffers, nothing allocated in the parallel loop; sums
+           (B,) each block's sum drho; _row): columns 1 .. xs-1 share the rates op[1], om[1];
+           xs .. nx-2 (the sponge) take their own column's; target (ny,) the absorbing layer's
+           x-velocity r profile; a wall row takes the populations its wall writes from pre;
+           the nodes listed by row (rp, nxs, nbits: `rows_of_nodes`) take population i from pre
+           where bit i of their bits is set: every node of columns 0 and nx-1 (they pull across
+           the periodic seam) and every node that owns a body link;
+        3. the solid nodes (sy, sx) reset to solid_g."""
         ny, nx = g.shape[1], g.shape[2]
         nb = scratch.shape[0]
         per = (ny + nb - 1) // nb
@@ -582,79 +783,62 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
         sm = smag if smag_on else 0.0
         cols = np.arange(nx)
         force[:] = 0.0
-        a = g
-        b_ = out
         for step in range(n):
             t = t0 + step
+            in_out = step < n - 1 or n == 1
+            src = g if step == 0 else out
+            dst = out if in_out else g
+            lin = NATURAL if step == 0 else (STREAMED if step % 2 == 1 else SWAPPED)
+            if step == n - 1:
+                lout = NATURAL
+            elif step == 0:
+                lout = STREAMED
+            else:
+                lout = SWAPPED if step % 2 == 1 else STREAMED
             if tunnel:
                 r = _ramp(t, ramp_steps)
                 for y in range(ny):
                     target[y] = r * profile[y]
-                _outlet(a, pre)
+                _outlet(src, lin, pre)
                 quiet = quiet_rate > 0 and r >= 1.0
-                _inlet(a, pre, r, wall_profile, quiet, quiet_rate, quiet_coefficient, drho_ref)
+                _inlet(src, lin, pre, r, wall_profile, quiet, quiet_rate, quiet_coefficient, drho_ref)
             if walls != 0:
-                _walls(a, pre, walls, periodic_x)
-            _links(a, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, lpx, lpy, force)
+                _walls(src, lin, pre, walls, periodic_x)
+            _links(src, lin, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, lpx, lpy, force)
             for blk in prange(nb):
                 bb = scratch[blk, 0]
                 o = scratch[blk, 1]
                 s = 0.0
                 for y in range(blk * per, min(ny, (blk + 1) * per)):
-                    ym = y - 1 if y > 0 else ny - 1
-                    yp = y + 1 if y < ny - 1 else 0
                     tg = target[y]
-                    x0 = 1
-                    while x0 < nx - 1:   # chunks end at xs: the sponge starts a chunk
-                        m = min(CHUNK, (xs if x0 < xs else nx - 1) - x0)
-                        _gather(a, bb, y, ym, yp, x0, m)
-                        if x0 < xs:        # the rates of column 1 for the whole chunk
-                            if rr:
-                                s += _chunk_rr(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm, K)
-                            elif kbc:
-                                s += _chunk_kbc(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm)
-                            else:
-                                s += _chunk(bb, o, m, op0, om0, tg, trt, incomp, Fx, Fy, has_force, K)
-                        else:              # each column its own rates (the sponge)
-                            c = cols[x0:x0 + m]
-                            if rr:
-                                s += _columns_rr(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force,
-                                                 sm, K)
-                            elif kbc:
-                                s += _columns_kbc(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force, sm)
-                            else:
-                                s += _columns(bb, o, m, c, op, om, keep, tg, trt, incomp, has_keep, Fx, Fy,
-                                              has_force, K)
-                        b_[:, y, x0:x0 + m] = o[:, :m]
-                        x0 += m
+                    if lin == NATURAL:   # each layout pair its own inlined copy: no branch per chunk
+                        if lout == NATURAL:
+                            s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
+                                      NATURAL, NATURAL, rr, kbc, trt, incomp, has_keep, has_force, K)
+                        else:
+                            s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
+                                      NATURAL, STREAMED, rr, kbc, trt, incomp, has_keep, has_force, K)
+                    elif lin == STREAMED:
+                        if lout == SWAPPED:
+                            s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
+                                      STREAMED, SWAPPED, rr, kbc, trt, incomp, has_keep, has_force, K)
+                        else:
+                            s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
+                                      STREAMED, NATURAL, rr, kbc, trt, incomp, has_keep, has_force, K)
+                    elif lout == STREAMED:
+                        s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
+                                      SWAPPED, STREAMED, rr, kbc, trt, incomp, has_keep, has_force, K)
+                    else:
+                        s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
+                                      SWAPPED, NATURAL, rr, kbc, trt, incomp, has_keep, has_force, K)
                 sums[blk] = s
             total = sums.sum()
-            bb = scratch[0, 0]
-            o = scratch[0, 1]
-            for k in range(len(ry)):
-                y, x, bits = ry[k], rx[k], rbits[k]
-                _gather_node(a, bb, 0, y, y - 1 if y > 0 else ny - 1, y + 1 if y < ny - 1 else 0, x)
-                for i in range(9):
-                    if (bits >> i) & 1:
-                        bb[i, 0] = pre[i, y, x]
-                c = cols[x:x + 1]
-                if rr:
-                    total += _columns_rr(bb, o, 1, c, op, keep, target[y], incomp, has_keep, Fx, Fy, has_force,
-                                         sm, K)
-                elif kbc:
-                    total += _columns_kbc(bb, o, 1, c, op, keep, target[y], incomp, has_keep, Fx, Fy, has_force, sm)
-                else:
-                    total += _columns(bb, o, 1, c, op, om, keep, target[y], trt, incomp, has_keep, Fx, Fy,
-                                      has_force, K)
-                for i in range(9):
-                    b_[i, y, x] = o[i, 0]
             for k in range(len(sy)):
                 for i in range(9):
-                    b_[i, sy[k], sx[k]] = solid_g[i, k]
-            a, b_ = b_, a
+                    _put(dst, lout, i, sy[k], sx[k], solid_g[i, k])
             if not np.isfinite(total):
-                return step + 1, False
-        return n, True
+                return step + 1, False, 1 if in_out else 0
+        return n, True, 1 if n == 1 else 0
 
     return advance
 
