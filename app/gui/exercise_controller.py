@@ -2,13 +2,16 @@
 constraint checks while the student edits (the body outlined in red while one is broken), Score
 it in a worker thread (progress, Cancel) and the attempts file next to the student's work.
 
-The score is `feelflow.app.exercises.scoring.score_shape` on numpy float64, the function
-`feelflow exercise score` calls, so the window and the command line give the same digits. The
-live flow in the viewport is the window's own (gl or numpy, float32) and only shows the flow.
+The score is `feelflow.app.exercises.scoring.score_shape` in float64 on the solver that
+`feelflow exercise score` picks by default (`grading.resolve_backend`, `--backend auto`: the
+faster of numpy and the compiled cpu backend, which give the same scores), so the window and
+the command line give the same digits. The live flow in the viewport is the window's own (gl,
+cpu or numpy, float32) and only shows the flow.
 """
 from __future__ import annotations
 
 import math
+import multiprocessing
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -18,7 +21,7 @@ from PySide6.QtWidgets import QDockWidget, QFileDialog, QMessageBox
 
 from feelflow import EXERCISE_DIR
 from feelflow.app.errors import UserError
-from feelflow.app.exercises import scoring
+from feelflow.app.exercises import grading, scoring
 from feelflow.app.exercises.uncertainty import fmt, standing
 from feelflow.app.gui.exercise_panel import PARAMETERS, PANEL_WIDTH, ExercisePanel, ScrollingPanel
 from feelflow.app.model import readouts
@@ -47,16 +50,21 @@ CHECK_INTERVAL_MS = 250
 
 
 class ScoreWorker(QThread):
-    """Runs one scoring in a thread; the window keeps drawing (numpy releases the GIL in its
-    array kernels)."""
+    """Runs one scoring in a thread: chooses the solver as `feelflow exercise score` does by
+    default (`grading.resolve_backend` with AUTO: timed once per grid in a child process, then
+    remembered in the same file the command line reads), then scores on it. The window keeps
+    drawing (numpy releases the GIL in its array kernels, the cpu backend's kernels run
+    without it)."""
 
     progressed = Signal(float)
+    chosen = Signal(str, str)      # the backend, the line saying why (empty when named)
     scored = Signal(object)        # scoring.Result
     failed = Signal(str)
 
     def __init__(self, exercise, shape, parent=None):
         super().__init__(parent)
         self.exercise, self.shape = exercise, shape
+        self.backend: str | None = None
         self._cancel = False
 
     def cancel(self):
@@ -64,8 +72,15 @@ class ScoreWorker(QThread):
 
     def run(self):
         try:
+            # a spawned child: this process may already run numba's OpenMP threads (the live
+            # flow on the cpu backend), and a forked child of such a process aborts in them
+            self.backend, why = grading.resolve_backend(grading.AUTO, self.exercise,
+                                                        mp_context=multiprocessing.get_context("spawn"))
+            self.chosen.emit(self.backend, why or "")
+            if self._cancel:
+                raise scoring.Cancelled()
             result = scoring.score_shape(self.exercise, self.shape, progress=self.progressed.emit,
-                                         cancelled=lambda: self._cancel)
+                                         cancelled=lambda: self._cancel, backend=self.backend)
         except scoring.Cancelled:
             self.failed.emit("cancelled")
         except Exception as exc:  # noqa: BLE001 - shown in one line in the panel, not a traceback
@@ -100,6 +115,7 @@ class ExerciseController(QObject):
         self.problems: list[str] = []
         self.param_shape = None      # the built-in body the parameter fields describe
         self.last_result = None
+        self.scored_on = None        # the solver the last score ran on (numpy or cpu)
         self.timer = QTimer(self)
         self.timer.setInterval(CHECK_INTERVAL_MS)
         self.timer.timeout.connect(self.refresh_constraints)
@@ -369,13 +385,24 @@ class ExerciseController(QObject):
         shape = self.current_shape()
         self.worker = ScoreWorker(self.exercise, shape, self)
         self.worker.progressed.connect(self.panel.set_progress)
+        self.worker.chosen.connect(self._backend_chosen)
         self.worker.scored.connect(lambda result, s=shape: self._scored(s, result))
         self.worker.failed.connect(self._failed)
         self.worker.finished.connect(self._worker_done)
         self.panel.set_running(True)
-        self.panel.result.setText("Scoring: the tunnel runs the exercise's scoring simulation (numpy, float64)\u2026")
+        self.panel.result.setText("Scoring: choosing the solver (numpy or the compiled cpu backend, float64: "
+                                  "the same scores; timed once for this grid)\u2026")
         self.worker.start()
         return True
+
+    def _backend_chosen(self, backend, why):
+        self.scored_on = backend
+        text = f"Scoring: the tunnel runs the exercise's scoring simulation ({backend}, float64)\u2026"
+        if backend == "cpu":
+            text += "<br><small>The first run on this machine compiles the solver (20 - 60 s).</small>"
+        self.panel.result.setText(text)
+        if why:
+            self.status.showMessage(f"Exercise: {why}", 10000)
 
     def cancel(self, _=False):
         if self.worker is not None:
@@ -400,7 +427,7 @@ class ExerciseController(QObject):
             lines = [f"<b>Score {fmt(result.score, u, with_uncertainty=True)}</b> ({o.quantity}; "
                      f"C_D {fmt(result.cd, u)}, C_L {fmt(result.cl, u)} "
                      f"with L = {s.reference_length:g} cells ({EXERCISE_LENGTH}), U = {s.inflow_speed:.3f}; "
-                     f"{result.steps} steps, {result.seconds:.1f} s)"]
+                     f"{result.steps} steps, {result.seconds:.1f} s on {self.scored_on})"]
             if result.hit is not None:
                 lines.append("A hit: within the tolerance." if result.hit else "Not a hit yet: outside the tolerance.")
             for ref in ex.references:
