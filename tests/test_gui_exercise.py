@@ -47,7 +47,7 @@ def test_edit_violate_fix_score_and_list_the_attempt(window, qtbot, tmp_path, mo
     warnings = []
     monkeypatch.setattr(QMessageBox, "warning", lambda *a, **k: warnings.append(a[2]))
     ex = window.exercises
-    ex.work_folder = tmp_path / "work"
+    ex.attempts.work_folder = tmp_path / "work"
     assert ex.open(TINY)
     panel = ex.panel
     assert panel.isVisible() and "Tiny test exercise" in panel.title.text()
@@ -72,21 +72,21 @@ def test_edit_violate_fix_score_and_list_the_attempt(window, qtbot, tmp_path, mo
     frames = window.viewport.frames
     qtbot.mouseClick(panel.score_button, Qt.LeftButton)
     assert panel.cancel_button.isEnabled()
-    qtbot.waitUntil(lambda: panel.attempts.count() == 1 and ex.worker is None, timeout=300000)
+    qtbot.waitUntil(lambda: panel.attempts.count() == 1 and not ex.scoring.running, timeout=300000)
     assert window.viewport.frames > frames
-    result = ex.last_result
+    result = ex.scoring.last_result
     assert result.ok and "Score" in panel.result.text()
     assert "\u2605 best" in panel.attempts.item(0).text() and f"{result.score:.4f}" in panel.attempts.item(0).text()
     saved = json.loads((tmp_path / "work" / "tiny.attempts.json").read_text())
     assert saved["attempts"][0]["score"] == result.score
 
     # the command line's path (its default, --backend auto) gives the same digits for the same shape
-    assert asked == [grading.AUTO] and ex.scored_on == "numpy" and "s on numpy)" in panel.result.text()
+    assert asked == [grading.AUTO] and ex.scoring.backend == "numpy" and "s on numpy)" in panel.result.text()
     shape_file = tmp_path / "arrow.json"
-    save_shape(shape_file, ex.attempts.items[0].load_shape())
+    save_shape(shape_file, ex.attempts.record.items[0].load_shape())
     backend, _ = grading.resolve_backend(grading.AUTO, ex.exercise)
     row = grading.score_file(ex.exercise, shape_file, backend=backend)
-    assert backend == ex.scored_on
+    assert backend == ex.scoring.backend
     assert row.score == result.score and row.cd == result.cd and row.cl == result.cl
 
     # edit again, then load the attempt back into the editor
@@ -98,13 +98,13 @@ def test_edit_violate_fix_score_and_list_the_attempt(window, qtbot, tmp_path, mo
     # cancel a second scoring: no attempt is added
     assert ex.score()
     ex.cancel()
-    qtbot.waitUntil(lambda: ex.worker is None, timeout=60000)
+    qtbot.waitUntil(lambda: not ex.scoring.running, timeout=60000)
     assert "cancelled" in panel.result.text() and panel.attempts.count() == 1
 
 
 def test_exercise_on_a_built_in_body_uses_the_parameter_fields(window, qtbot, tmp_path):
     ex = window.exercises
-    ex.work_folder = tmp_path / "work"
+    ex.attempts.work_folder = tmp_path / "work"
     assert ex.open(ROOT / "exercises" / "lift_to_drag.toml")
     panel = ex.panel
     assert panel.shape_box.isVisible()
@@ -140,7 +140,7 @@ def test_plot_overlay_exercise_panel_and_csv_agree_on_one_frame(window, qtbot, t
     from feelflow.app.model import readouts
 
     ex = window.exercises
-    ex.work_folder = tmp_path / "work"
+    ex.attempts.work_folder = tmp_path / "work"
     assert ex.open(TINY)
     length = ex.exercise.scene.reference_length
     sim, plot = window.sim, window.plot
@@ -186,19 +186,19 @@ def test_window_times_the_solvers_and_scores_as_the_command_line(window, qtbot, 
 
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     ex = window.exercises
-    ex.work_folder = tmp_path / "work"
+    ex.attempts.work_folder = tmp_path / "work"
     assert ex.open(TINY)
     assert window.bodies.edit_polygon(ARROW)
     qtbot.waitUntil(lambda: "All constraints met" in ex.panel.constraints.text(), timeout=5000)
     assert ex.score()
-    qtbot.waitUntil(lambda: ex.worker is None, timeout=600000)
-    result = ex.last_result
-    assert result.ok and ex.scored_on in ("numpy", "cpu"), ex.panel.result.text()
+    qtbot.waitUntil(lambda: not ex.scoring.running, timeout=600000)
+    result = ex.scoring.last_result
+    assert result.ok and ex.scoring.backend in ("numpy", "cpu"), ex.panel.result.text()
     assert default_store_path().exists()
     backend, why = grading.resolve_backend(grading.AUTO, ex.exercise)
-    assert backend == ex.scored_on and "remembered" in why
+    assert backend == ex.scoring.backend and "remembered" in why
     shape_file = tmp_path / "arrow.json"
-    save_shape(shape_file, ex.attempts.items[0].load_shape())
+    save_shape(shape_file, ex.attempts.record.items[0].load_shape())
     cli = grading.score_file(ex.exercise, shape_file, backend=backend)
     reference = grading.score_file(ex.exercise, shape_file, backend="numpy")
     for row in (cli, reference):   # C_L of this symmetric body is round-off (1e-16): to 1e-12 of C_D
