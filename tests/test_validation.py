@@ -85,12 +85,14 @@ def test_full_case_meets_its_targets(name, request):
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1800)   # (a few minutes on cpu; numba compiles the regularised operator's kernel first)
 def test_cylinder_at_re200_sheds_at_the_published_strouhal_at_10_cells(request):
     """The high-Reynolds case at its coarsest rung (the whole ladder d = 10, 20, 40 takes hours:
     `feelflow validate --case cylinder-re200`): St within its 3 % target; C_D is measured 7.8 %
     high at 10 cells (docs/science/collision-operators.md), outside its 5 % target there, so only
-    its sign and size are held here."""
-    r = case_module("cylinder-re200").run(factory("numpy", request), resolution=10, backend="numpy")
+    its sign and size are held here. On the compiled cpu backend (equal to numpy; on numpy it
+    took 391 s on a loaded 2-core machine)."""
+    r = case_module("cylinder-re200").run(factory("cpu", request), resolution=10, backend="cpu")
     q = r.quantities
     assert q["converged"] == 1.0 and r.check_results()["strouhal"], r.to_dict()
     assert 0.0 < q["cd_mean"] / 1.34 - 1.0 < 0.10, q
@@ -144,7 +146,7 @@ def test_schaefer_turek_2d1_drag_converges_at_second_order_with_tau_held(request
 
     st = case_module("schaefer-turek-2d1")
     points = TAU_FIXED[:2]  # (20, 0.075), (30, 0.05)
-    errors = [abs(st.run(factory("numpy", request), resolution=d, u_max=u)
+    errors = [abs(st.run(factory("cpu", request), resolution=d, u_max=u, backend="cpu")
                   .quantities["cd_rel_error"]) for d, u in points]
     order = math.log(errors[0] / errors[1]) / math.log(points[1][0] / points[0][0])
     assert order > 1.8, (errors, order)
