@@ -94,7 +94,7 @@ class ForcePlot(QWidget):
         self.plot.getPlotItem().invertY(False)
         reset_legend(self.plot, 1)
         view = self.view.currentData()
-        if self.sim is not None and hasattr(self.sim, "watch_surface_pressure"):
+        if self.sim is not None:
             self.sim.watch_surface_pressure(view == "cp")   # the wall sampling runs only while C_p is shown
         speed_view = view == "speed"
         self.plot.setLogMode(speed_view, speed_view)
@@ -144,15 +144,9 @@ class ForcePlot(QWidget):
         elif view == "drag_polar":
             self.lift_views.draw_drag_polar(sim)
         elif view == "cp":
-            self.lift_views.draw_cp(self.surface_pressure())
+            self.lift_views.draw_cp(sim.surface_pressure())
         else:
             self.time_views.draw(sim, view, self.units)
-
-    def surface_pressure(self):
-        """C_p along the surface now (Simulation.surface_pressure); None where there is none (a
-        replay, nothing sampled yet)."""
-        take = getattr(self.sim, "surface_pressure", None)
-        return take() if take is not None else None
 
     def readout(self, model=None) -> readouts.Readout:
         """The mean drag, lift and coefficients of the last samples, with the reference they use
