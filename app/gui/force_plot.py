@@ -46,7 +46,6 @@ class ForcePlot(QWidget):
         self.csv_button = QPushButton("Export CSV\u2026")
         self.png_button = QPushButton("Export PNG\u2026")
         self.readout_box = CoefficientReadout()
-        self.readout_label, self.reference_label = self.readout_box.value_label, self.readout_box.reference_label
         bar = QHBoxLayout()
         for w in (self.view, self.pause_box, self.clear_button, self.csv_button, self.png_button):
             bar.addWidget(w)
@@ -153,26 +152,6 @@ class ForcePlot(QWidget):
         (app/model/readouts.py)."""
         sim = self.sim
         return readouts.readout(sim.history, model or sim.params.force_model, sim.reference_length())
-
-    # --- what the tests and the window read of the views ---------------------------------------
-    @property
-    def curves(self) -> dict:
-        return self.time_views.curves
-
-    @property
-    def follow_range(self) -> bool:
-        return self.ranges.follow
-
-    @property
-    def scatter(self):
-        return self.speed_view.scatter
-
-    @property
-    def fitted_exponent(self) -> float | None:
-        return self.speed_view.fitted_exponent
-
-    def fit_text(self) -> str:
-        return self.speed_view.fit_text()
 
     # --- exports ---------------------------------------------------------------------------
     def csv_text(self) -> str:
