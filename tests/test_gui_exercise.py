@@ -151,9 +151,9 @@ def test_plot_overlay_exercise_panel_and_csv_agree_on_one_frame(window, qtbot, t
     r = plot.readout()
     assert r.length.cells == length and r.length.name == readouts.EXERCISE_LENGTH
     assert math.isfinite(r.cd) and r.cd > 0
-    assert f"L = {length:g} cells" in plot.reference_label.text()
+    assert f"L = {length:g} cells" in plot.readout_box.reference_label.text()
     shown = readouts.format_coefficient(r.cd)
-    assert f"= {shown}" in plot.readout_label.text() and f"C<sub>D</sub> {shown}," in ex.panel.live.text()
+    assert f"= {shown}" in plot.readout_box.value_label.text() and f"C<sub>D</sub> {shown}," in ex.panel.live.text()
     assert r.reference_text() in ex.panel.live.text()
 
     path = tmp_path / "forces.csv"

@@ -100,7 +100,7 @@ class MainWindow(QMainWindow):
         self.loop = loop = FrameLoop(events, vp, panel, plot, status, self.status, self.make_current, self.params_now,
                                      self)
         self.probes = ProbeController(events, vp, plot, loop, status, self)
-        self.plot.probes = self.probes.probes   # the forces CSV carries the probes' columns
+        self.plot.export.probes = self.probes.probes   # the forces CSV carries the probes' columns
         self.units = UnitsController(events, self.settings, panel, plot, self.probes, loop, status, self)
         self.replays = replays = ReplayController(events, vp, loop, panel, self.probes, self.units, status,
                                                   self.make_current, lambda: self.backend, self)
