@@ -396,3 +396,39 @@ def test_auto_scores_on_the_faster_backend_timed_once_in_a_child_and_remembered(
     assert "float64_scoring" in store.read_text()
     assert grading.resolve_backend("auto", ex, store_path=store) == (
         "numpy", f"scoring backend numpy (remembered for {s.nx} x {s.ny})")
+
+
+# --- what the window shows, Qt-free ------------------------------------------------------------
+def test_shape_problems_of_no_shape_a_broken_one_and_a_valid_one(tiny):
+    """The window's live check (app/gui/exercise_constraints.py) says what check_shape says,
+    "no shape yet" without a shape, and a shape that cannot be measured in one line."""
+    from feelflow.app.exercises.constraints import shape_problems
+
+    assert shape_problems(tiny, None) == ["no shape yet"]
+    assert shape_problems(tiny, Wedge(8, 2 * math.atan(3 / 8))) == []
+    tall = Cylinder(8.0)
+    assert shape_problems(tiny, tall) == check_shape(tiny, tall) != []
+    unmeasurable = Polygon([[-3, -3], [3, 3], [3, -3], [-3, 3]])   # crosses itself
+    problems = shape_problems(tiny, unmeasurable)
+    assert len(problems) == 1 and "\n" not in problems[0]
+
+
+def test_score_text_names_the_score_the_solver_and_the_references(tiny):
+    """The exercise panel's verdict (app/exercises/score_text.py): the score to the digits the
+    grid uncertainty supports, the reference length and speed of C_D and C_L, the solver it ran
+    on, the standing against each reference; a run without a score says why."""
+    from feelflow.app.exercises import score_text
+
+    result = scoring.Result(scoring.SCORED, score=3.1539, cd=3.1539, cl=0.0, steps=1500, seconds=1.6,
+                            averaging="steady: mean over the window")
+    text = score_text.result_html(tiny, result, "cpu")
+    s = tiny.scene
+    assert "Score 3.1539" in text and f"L = {s.reference_length:g} cells" in text and "s on cpu)" in text
+    assert "behind the reference \u201cwedge pointing upstream\u201d (2.8101)" in text
+    assert "steady: mean over the window" in text
+    unsettled = scoring.Result(scoring.NOT_SETTLED, reason="the flow diverged (NaN)")
+    assert "Not settled</b>: the flow diverged (NaN)." in score_text.result_html(tiny, unsettled, "numpy")
+    assert score_text.failed_text(score_text.CANCELLED) == "Scoring cancelled."
+    assert score_text.failed_text("no memory") == "Scoring failed: no memory"
+    assert "(cpu, float64)" in score_text.running_text("cpu") and "compiles" in score_text.running_text("cpu")
+    assert "compiles" not in score_text.running_text("numpy")

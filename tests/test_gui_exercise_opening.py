@@ -105,9 +105,9 @@ def test_another_exercise_waits_for_a_running_score(qtbot, tmp_path, monkeypatch
         said = []
         monkeypatch.setattr(QMessageBox, "information", lambda *a, **k: said.append(a[1]))
         exercise = w.exercises.exercise
-        w.exercises.worker = object()   # a score running
+        w.exercises.scoring.worker = object()   # a score running
         assert not w.exercises.open(MOST_LIFT)
         assert said == ["Scoring is running"] and w.exercises.exercise is exercise
     finally:
-        w.exercises.worker = None
+        w.exercises.scoring.worker = None
         w.loop.timer.stop()

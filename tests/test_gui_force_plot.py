@@ -26,7 +26,7 @@ def test_time_view_force_axis_leaves_out_the_start_pulse(window, qtbot):
     for v in (0.0, np.nanmin(drag[late]), np.nanmax(drag[late]), np.nanmin(lift[late]), np.nanmax(lift[late])):
         assert lo <= v <= hi
     assert hi < np.nanmax(drag[early])                        # the pulse runs off the top...
-    shown = plot.curves[(sim.params.force_model, "drag")].getData()[1]
+    shown = plot.time_views.curves[(sim.params.force_model, "drag")].getData()[1]
     assert np.nanmax(shown) == pytest.approx(np.nanmax(drag))   # ...but its data is all there
 
 
@@ -44,12 +44,12 @@ def test_the_users_zoom_is_kept_until_auto_range(window, qtbot):
                      Qt.NoModifier, Qt.NoScrollPhase, False)
     QApplication.sendEvent(view.viewport(), ev)
     zoomed = view.getViewBox().viewRange()[1]
-    assert not plot.follow_range
+    assert not plot.ranges.follow
     plot.refresh(force=True)
     assert view.getViewBox().viewRange()[1] == pytest.approx(zoomed)
     view.getViewBox().enableAutoRange()                    # what pyqtgraph's "A" button does
     plot.refresh(force=True)
-    assert plot.follow_range
+    assert plot.ranges.follow
 
 
 def test_a_zoom_of_the_force_axis_alone_is_kept(window, qtbot):
@@ -62,9 +62,9 @@ def test_a_zoom_of_the_force_axis_alone_is_kept(window, qtbot):
     box.scaleBy(y=0.5)                                     # what ViewBox.wheelEvent(axis=1) does
     box.sigRangeChangedManually.emit([False, True])
     zoomed = box.viewRange()[1]
-    assert box.autoRangeEnabled()[0] and not plot.follow_range
+    assert box.autoRangeEnabled()[0] and not plot.ranges.follow
     plot.refresh(force=True)
-    assert box.viewRange()[1] == pytest.approx(zoomed) and not plot.follow_range
+    assert box.viewRange()[1] == pytest.approx(zoomed) and not plot.ranges.follow
 
 
 def test_log_log_view_frames_a_single_speed(window, qtbot):
@@ -73,11 +73,11 @@ def test_log_log_view_frames_a_single_speed(window, qtbot):
     plot.view.setCurrentIndex(plot.view.findData("speed"))      # from the time view, as a lesson does
     plot.refresh(force=True)
     if not any(sim.history.settled):                           # nothing steady yet: no points, and says why
-        assert plot.fit_text().startswith("fit: hold a speed")
+        assert plot.speed_view.fit_text().startswith("fit: hold a speed")
     qtbot.waitUntil(lambda: sum(sim.history.settled) > 5, timeout=60000)   # History.SETTLE_STEPS
     plot.refresh(force=True)
-    us, fs = plot.scatter.getData()                            # in log mode: log10 of the data
-    assert len(us) == 1 and plot.fitted_exponent is None       # one wind speed so far: one point
+    us, fs = plot.speed_view.scatter.getData()                            # in log mode: log10 of the data
+    assert len(us) == 1 and plot.speed_view.fitted_exponent is None       # one wind speed so far: one point
     (x0, x1), (y0, y1) = plot.plot.getViewBox().viewRange()   # log10 of the axes' ends
     u, f = us[0], fs[0]
     assert x0 < u < x1 and x1 - x0 < 2                         # a factor < 100 around it, not 1e-300..1e300
@@ -94,12 +94,12 @@ def test_the_window_fits_a_1024_pixel_wide_screen(window, qtbot):
     plot.view.setCurrentIndex(plot.view.findData("speed"))
     qtbot.waitUntil(lambda: len(window.sim.history) > 30, timeout=20000)
     plot.refresh(force=True)
-    assert plot.fit_text().startswith("fit")
+    assert plot.speed_view.fit_text().startswith("fit")
     window.resize(1024, 700)
     qtbot.waitUntil(lambda: window.width() <= 1024, timeout=5000)
     qtbot.wait(100)
-    assert plot.readout_label.width() >= plot.readout_label.sizeHint().width()
-    assert plot.reference_label.width() >= plot.reference_label.sizeHint().width()
+    assert plot.readout_box.value_label.width() >= plot.readout_box.value_label.sizeHint().width()
+    assert plot.readout_box.reference_label.width() >= plot.readout_box.reference_label.sizeHint().width()
 
 
 def test_the_torque_view_shows_the_torque_that_resists_a_turn(window, qtbot):
@@ -114,7 +114,7 @@ def test_the_torque_view_shows_the_torque_that_resists_a_turn(window, qtbot):
     qtbot.waitUntil(lambda: len(sim.history) > n0 + 10, timeout=20000)
     plot.refresh(force=True)
     t, torque = sim.history.torque(sim.params.force_model)
-    shown_t, shown = plot.curves[(sim.params.force_model, "torque")].getData()
+    shown_t, shown = plot.time_views.curves[(sim.params.force_model, "torque")].getData()
     assert np.allclose(shown[-5:], torque[-5:], equal_nan=True)
     turning = torque[n0:n0 + 10]
     assert np.isfinite(turning).all() and np.median(turning) < 0

@@ -80,7 +80,7 @@ def test_cylinder_readout_shows_the_measured_and_published_strouhal_number(windo
         lift = 0.01 * np.sin(2 * np.pi * t * 0.17 * u / d)
         sim.history.add(t, (0.0, 0.0), (u, 0.0), {sim.params.force_model: (0.02, lift)})
     window.plot.refresh(force=True)
-    text = window.plot.reference_label.text()
+    text = window.plot.readout_box.reference_label.text()
     assert "St 0.170" in text
     if 49 <= sim.reynolds() <= 178:
         assert "Williamson 1989" in text

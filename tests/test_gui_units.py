@@ -61,7 +61,7 @@ def test_switch_units_and_convert_the_drag_by_hand(window, qtbot):  # noqa: F811
     shown = float(w.panel.drag.text().split()[0])
     assert math.isclose(shown, drag_n, rel_tol=1e-3), (shown, drag_n)
     # the plot's last drag point and time are the same conversion
-    curve = w.plot.curves[(p.force_model, "drag")]
+    curve = w.plot.time_views.curves[(p.force_model, "drag")]
     t, f = curve.getData()
     t_steps, drag, _ = w.sim.history.drag_lift(p.force_model)
     assert math.isclose(f[-1], drag[-1] * newtons_per_lattice_force, rel_tol=1e-9)

@@ -76,12 +76,12 @@ def test_force_model_selector_drives_plot_and_readouts(window, qtbot):
     assert set(sim.solver.forces()) == {"pressure"}
     _, drag, _ = sim.history.drag_lift("pressure")
     assert np.isfinite(drag[-3:]).all()
-    assert {k[0] for k in plot.curves} == {"pressure"}
+    assert {k[0] for k in plot.time_views.curves} == {"pressure"}
     assert panel.drag.text() != "\u2013"
     panel.compare_all.setChecked(True)
     qtbot.waitUntil(lambda: len(sim.history.forces) == 3 and len(sim.history) > n0 + 10, timeout=10000)
     plot.refresh(force=True)
-    assert {k[0] for k in plot.curves} == {"momentum_exchange", "macroscopic", "pressure"}
+    assert {k[0] for k in plot.time_views.curves} == {"momentum_exchange", "macroscopic", "pressure"}
 
 
 def test_dragging_moves_the_body_and_hold_still_freezes_it(window, qtbot):

@@ -62,35 +62,41 @@ def test_every_case_result_has_the_reported_fields(request):
 
 #: published targets a full case misses, with what it measures (docs/science/validation.md)
 KNOWN_MISSES = {
-    "schaefer-turek-2d2": "at 40 cells per diameter on numpy C_D,max is 3.25056 (target 3.22 .. 3.24) and C_L,max "
+    "schaefer-turek-2d2": "at 40 cells per diameter on cpu C_D,max is 3.25056 (target 3.22 .. 3.24) and C_L,max "
                           "0.986747 (target 0.99 .. 1.01); St 0.300601 is inside 0.295 .. 0.305 (feelflow validate "
-                          "--case schaefer-turek-2d2: 67500 steps, 3160 s on a loaded 2-core machine; 60 cells on gl "
-                          "meet the targets, docs/science/validation.md)",
+                          "--case schaefer-turek-2d2 --backend cpu: 67500 steps, 278 s on a loaded 2-core machine; "
+                          "numpy gives the same six digits in 3160 s; 60 cells on gl meet the targets, "
+                          "docs/science/validation.md)",
 }
 
-#: full cases run by another slow test with more checks: the stability scan (an hour on 2 cores)
+#: full cases run by another slow test with more checks: the stability scan (725 s on cpu, 2 cores)
 #: runs once, in tests/test_stability.py test_full_scan_supports_the_window_limit, which also
 #: holds the window's stability constant against what it measures
 RUN_ELSEWHERE = {"stability"}
 
 
 @pytest.mark.slow
-@pytest.mark.timeout(7200)   # a full case runs for up to an hour on 2 cores (2D-2: 3160 s under load)
+@pytest.mark.timeout(3600)   # a full case runs for minutes on cpu (2D-2: 326 s under load, one numba thread)
 @pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.xfail(strict=True, reason=KNOWN_MISSES[name]))
                                   if name in KNOWN_MISSES else name for name in CASES
                                   if not getattr(case_module(name), "NAMED_ONLY", False) and name not in RUN_ELSEWHERE])
 def test_full_case_meets_its_targets(name, request):
-    r = case_module(name).run(factory("numpy", request), backend="numpy")
+    """Every full case (`feelflow validate --case NAME --backend cpu`) on the compiled cpu backend,
+    which computes the numpy reference's numbers to float32 rounding (tests/test_cpu_vs_numpy.py)
+    in a fraction of its time (2D-2: 326 s; 2683 s on numpy, both on a loaded 2-core machine)."""
+    r = case_module(name).run(factory("cpu", request), backend="cpu")
     assert r.passed, r.to_dict()
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1800)   # (a few minutes on cpu; numba compiles the regularised operator's kernel first)
 def test_cylinder_at_re200_sheds_at_the_published_strouhal_at_10_cells(request):
     """The high-Reynolds case at its coarsest rung (the whole ladder d = 10, 20, 40 takes hours:
     `feelflow validate --case cylinder-re200`): St within its 3 % target; C_D is measured 7.8 %
     high at 10 cells (docs/science/collision-operators.md), outside its 5 % target there, so only
-    its sign and size are held here."""
-    r = case_module("cylinder-re200").run(factory("numpy", request), resolution=10, backend="numpy")
+    its sign and size are held here. On the compiled cpu backend (equal to numpy; on numpy it
+    took 391 s on a loaded 2-core machine)."""
+    r = case_module("cylinder-re200").run(factory("cpu", request), resolution=10, backend="cpu")
     q = r.quantities
     assert q["converged"] == 1.0 and r.check_results()["strouhal"], r.to_dict()
     assert 0.0 < q["cd_mean"] / 1.34 - 1.0 < 0.10, q
@@ -133,6 +139,7 @@ def test_schaefer_turek_2d1_coarse_converges_near_the_benchmark(request):
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1800)   # two full 2D-1 runs (D 20 and 30): 175 s on cpu under a load average of 3.5
 def test_schaefer_turek_2d1_drag_converges_at_second_order_with_tau_held(request):
     """D = 20 -> 30 with U_m D held (tau 0.65, `feelflow bench accuracy --axis tau`): every error
     of a second-order scheme falls like D^-2. C_D's observed order was 1.23 while the inlet's
@@ -144,7 +151,7 @@ def test_schaefer_turek_2d1_drag_converges_at_second_order_with_tau_held(request
 
     st = case_module("schaefer-turek-2d1")
     points = TAU_FIXED[:2]  # (20, 0.075), (30, 0.05)
-    errors = [abs(st.run(factory("numpy", request), resolution=d, u_max=u)
+    errors = [abs(st.run(factory("cpu", request), resolution=d, u_max=u, backend="cpu")
                   .quantities["cd_rel_error"]) for d, u in points]
     order = math.log(errors[0] / errors[1]) / math.log(points[1][0] / points[0][0])
     assert order > 1.8, (errors, order)

@@ -173,3 +173,15 @@ def check_shape(exercise, shape: Shape) -> list[str]:
             problems.append(f"on the lattice the body falls into {pieces} separate pieces: a part of it is "
                             f"thinner than a cell")
     return problems
+
+
+def shape_problems(exercise, shape: Shape | None) -> list[str]:
+    """What keeps the student's shape from being scored now, in words: `check_shape`'s list,
+    "no shape yet" without one, or the first line of the error of a shape that cannot even be
+    measured (empty: it may be scored)."""
+    if shape is None:
+        return ["no shape yet"]
+    try:
+        return check_shape(exercise, shape)
+    except (ShapeError, ValueError) as exc:
+        return [str(exc).splitlines()[0]]

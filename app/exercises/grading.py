@@ -187,12 +187,16 @@ def _trial_body(exercise, scale: int):
         return None
 
 
-def resolve_backend(backend: str, exercise, scale: int = 1, store_path=None) -> tuple[str, str | None]:
+def resolve_backend(backend: str, exercise, scale: int = 1, store_path=None,
+                    mp_context=None) -> tuple[str, str | None]:
     """`backend` as given, or for AUTO the faster of scoring.BACKENDS (both float64, the same
     scores: docs/science/cpu-backend.md) on the exercise's grid at `scale`, timed briefly once
     and remembered per grid (app/model/backend_choice.py, in the user's cache like `feelflow run
-    --backend auto`); returns (backend, the line saying why, or None). The timing runs in a
-    child process: numba's OpenMP threads, once started, would make the forked graders abort."""
+    --backend auto`); returns (backend, the line saying why, or None). The command line and the
+    window's Score it both choose here. The timing runs in a child process: numba's OpenMP
+    threads, once started, would make the forked graders abort. `mp_context`: how that child
+    starts (multiprocessing's default, a fork, unless given; the window, whose process may
+    already run numba's threads, passes a spawn context)."""
     if backend != AUTO:
         return backend, None
     from feelflow.app.model.backend_choice import JsonFileStore, choice_key, default_store_path
@@ -203,7 +207,7 @@ def resolve_backend(backend: str, exercise, scale: int = 1, store_path=None) -> 
     if known in scoring.BACKENDS:
         return known, f"scoring backend {known} (remembered for {config.nx} x {config.ny})"
     try:
-        with ProcessPoolExecutor(max_workers=1) as pool:
+        with ProcessPoolExecutor(max_workers=1, mp_context=mp_context) as pool:
             name, line = pool.submit(_timed_choice, config, path, _trial_body(exercise, scale)).result()
     except RuntimeError as exc:   # neither can run (choose_backend says why)
         raise UserError(f"--backend auto: {exc}") from None

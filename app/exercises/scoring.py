@@ -28,9 +28,10 @@ import numpy as np
 from feelflow.app.model import readouts
 
 FORCE_MODEL = "momentum_exchange"
-#: solvers a score may be computed with, both float64: numpy (the reference, what the window
-#: and `feelflow exercise score` use) and the compiled cpu backend, which gives the same digits
-#: (tests/test_exercises.py) in less CPU time for `feelflow exercise check --backend cpu`
+#: solvers a score may be computed with, both float64: numpy (the reference) and the compiled
+#: cpu backend, which gives the same scores (within 1e-12 relative: tests/test_exercise_uncertainty.py)
+#: in less CPU time; the window and `feelflow exercise score|check` use the faster of the two
+#: (grading.resolve_backend)
 BACKENDS = ("numpy", "cpu")
 SCORED, NOT_SETTLED, BROKEN = "scored", "not settled", "broken"
 

@@ -271,6 +271,16 @@ class ExercisePanel(QWidget):
         self.live.setText(f"In the tunnel now: C<sub>D</sub> {fmt(readout.cd)}, C<sub>L</sub> {fmt(readout.cl)} "
                           f"<small>({readout.reference_text()}; the window's flow, float32)</small>")
 
+    def show_result(self, text: str):
+        """The scoring run's line, or its verdict (app/exercises/score_text.py words it)."""
+        self.result.setText(text)
+
+    def show_editing(self, on: bool):
+        """Edit vertices checked or not, as the Controls panel's button is (no editToggled)."""
+        self.edit.blockSignals(True)
+        self.edit.setChecked(on)
+        self.edit.blockSignals(False)
+
     def set_problems(self, problems: list[str]):
         if problems:
             items = "".join(f"<li>{p}</li>" for p in problems)

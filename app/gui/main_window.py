@@ -17,7 +17,8 @@ through `events.liveCreated`:
     window.probes   probes.py      ProbeController: probes placed in the view, their plot beside the forces
     window.units    units.py       UnitsController: View > Units, lattice or SI for a chosen fluid
     window.backends backend_controller.py  BackendController: which solver backend runs, its menu
-    window.exercises  app/gui/exercise_controller.py  ExerciseController: the Exercises menu and panel
+    window.exercises  app/gui/exercise_controller.py  ExerciseController: opening an exercise; its menu,
+                      panel, shape, constraint checks, scoring and attempts (app/gui/exercise_*.py)
 
 The model behind the view is a `TunnelModel` (app/model/tunnel.py): `window.shown` is the one
 drawn (the live `window.sim`, or a replay), and every body input reaches it as a `BodyInput`
@@ -99,7 +100,7 @@ class MainWindow(QMainWindow):
         self.loop = loop = FrameLoop(events, vp, panel, plot, status, self.status, self.make_current, self.params_now,
                                      self)
         self.probes = ProbeController(events, vp, plot, loop, status, self)
-        self.plot.probes = self.probes.probes   # the forces CSV carries the probes' columns
+        self.plot.export.probes = self.probes.probes   # the forces CSV carries the probes' columns
         self.units = UnitsController(events, self.settings, panel, plot, self.probes, loop, status, self)
         self.replays = replays = ReplayController(events, vp, loop, panel, self.probes, self.units, status,
                                                   self.make_current, lambda: self.backend, self)

@@ -77,7 +77,7 @@ class Overlay:
             p.drawLine(a, b)
             p.setBrush(Qt.NoBrush)
             p.drawEllipse(b, 6, 6)
-        # an exercise marks a body that breaks a constraint (app/gui/exercise_controller.py)
+        # an exercise marks a body that breaks a constraint (app/gui/exercise_constraints.py)
         edge = self.view.body_edge
         p.setPen(QPen(edge or BODY_EDGE, 2.5, Qt.DashLine if edge else Qt.SolidLine))
         p.setBrush(QBrush(BODY_FILL))

@@ -37,7 +37,7 @@ class LiftViews:
 
     # --- the polar --------------------------------------------------------------------------
     def draw_polar(self, sim):
-        polar = getattr(sim, "polar", None)
+        polar = sim.polar
         points = polar.sweep.points if polar is not None else []
         alpha = np.array([p.alpha for p in points])
         cl = np.array([p.cl for p in points])
@@ -68,7 +68,7 @@ class LiftViews:
         return np.full(len(cl), polar.sweep.angle), cl, cd
 
     def draw_drag_polar(self, sim):
-        polar = getattr(sim, "polar", None)
+        polar = sim.polar
         points = polar.sweep.points if polar is not None else []
         self._item("polar", pen=pg.mkPen(LIFT, width=2.5), symbol="o", symbolBrush=LIFT, symbolPen=LIFT,
                    name="C_L against C_D, one point per angle").setData(
@@ -94,7 +94,7 @@ class LiftViews:
         """The published 2D C_D(Re) as drag at the measured speeds' range (cylinders only)."""
         item = self._item("published", pen=pg.mkPen((60, 60, 60), width=2, style=Qt.DotLine),
                           name="2D simulations: " + "; ".join(s.label.split(" (")[0] for s in DRAG))
-        if getattr(sim.shape, "kind", None) != "cylinder" or len(speeds) == 0:
+        if sim.shape is None or sim.shape.kind != "cylinder" or len(speeds) == 0:
             item.setData([], [])
             return
         u = np.geomspace(max(min(speeds) / 1.5, 1e-4), max(speeds) * 1.5, 40)

@@ -46,7 +46,7 @@ def make_screenshots(out_dir, seconds: float = 6.0, out=sys.stdout) -> list[Path
         print(f"{path}: {w.width()} x {w.height()}", file=out, flush=True)
 
     def exercise(w):
-        w.exercises.work_folder = Path(tempfile.mkdtemp(prefix="feelflow-attempts-"))
+        w.exercises.attempts.work_folder = Path(tempfile.mkdtemp(prefix="feelflow-attempts-"))
         w.exercises.open(EXERCISE_DIR / "most_lift.toml")
         QTimer.singleShot(ms, lambda: (shot(w, PICTURES[0]), w.close(), start(window(), probes)))
 

@@ -17,7 +17,7 @@ class History:
     """One sample per frame: step, body velocity, relative wind, force of each model in use, and
     whether the sample is *settled*: the relative wind has stayed within `WIND_TOLERANCE` of its
     value for at least `SETTLE_STEPS` steps. Only settled samples are steady drag; the
-    drag-against-speed view fits those (app/gui/force_plot.py). SETTLE_STEPS was chosen from a probe
+    drag-against-speed view fits those (app/model/plot_series.py). SETTLE_STEPS was chosen from a probe
     of the 'Drag grows with speed' lesson (not a command: indicative only): 750
     steps after a wind change had finished, the drag's 250-step means stayed within 5 % of the
     hold's end value at every wind of the sweep, while the first few hundred steps carry the

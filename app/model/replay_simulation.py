@@ -26,13 +26,14 @@ class ReplaySimulation:
     exactly), with the session step as its time."""
 
     #: what a live tunnel may have and a replay has not: no pull, no editor, no cap, no
-    #: sweep, no motion script (the recording holds their effects)
+    #: sweep, no motion script, no angle-of-attack sweep (the recording holds their effects)
     target = None
     hold_still = False
     polygon = None
     capped = False
     sweep = None
     runner = None
+    polar = None
 
     def __init__(self, session, backend: str | None = None, *, ctx=None, factory=None):
         self.player = SessionPlayer(session, backend, ctx=ctx, factory=factory)
@@ -162,6 +163,13 @@ class ReplaySimulation:
 
     def sweep_stage(self):
         return None
+
+    def surface_pressure(self):
+        """None: a session records forces, not the wall pressure along the surface."""
+        return None
+
+    def watch_surface_pressure(self, on: bool = True) -> None:
+        """Nothing to sample: the replayed flow's wall pressure is not recorded."""
 
     # --- running ------------------------------------------------------------------------
     def advance(self, n: int) -> dict:

@@ -26,6 +26,8 @@ if TYPE_CHECKING:   # simulation.py defines them and implements this interface
     import moderngl
 
     from feelflow.app.model.force_history import History
+    from feelflow.app.model.live_polar import LivePolar
+    from feelflow.solver.forces.surface_pressure import SurfacePressure
     from feelflow.app.model.simulation import Params
 
 
@@ -48,6 +50,7 @@ class TunnelModel(Protocol):
     capped: bool         # the Mach cap limited the body's speed in the last frame
     sweep: WindSweep | None   # a lesson's wind sweep, or None
     runner: MotionRunner | None   # a motion script driving the pose, or None
+    polar: "LivePolar | None"   # an angle-of-attack sweep running in the tunnel (the plot's polar views), or None
 
     def advance(self, n: int) -> dict:
         """Run about n steps; {force model: (Fx, Fy)} averaged over them."""
@@ -97,4 +100,12 @@ class TunnelModel(Protocol):
 
     def sweep_stage(self) -> int | None:
         """Which speed of a wind sweep holds now, or None."""
+        ...
+
+    def surface_pressure(self) -> "SurfacePressure | None":
+        """C_p along the surface now (the plot's C_p view), or None where nothing is sampled."""
+        ...
+
+    def watch_surface_pressure(self, on: bool = True) -> None:
+        """Sample the wall pressure for C_p along the surface while `on` (the C_p view shows)."""
         ...

@@ -1,7 +1,7 @@
 """`feelflow report lessons`: every lesson of the Presets menu run headless as the window runs it
 (app.simulation.Simulation, one force sample per frame of `FRAME` steps), and what a class sees
 of its forces: how steady drag and lift are at the end, and for the wind sweep the drag at each
-speed and the exponent the plot's log-log view fits (app/force_plot.py, settled samples only).
+speed and the exponent the plot's log-log view fits (app/model/plot_series.py, settled samples only).
 
 `compare=True` also runs each lesson *plain*: without the sponge's absorbing layer, with the
 wind blowing everywhere from the first step and the sweep's wind changed at once, the old way of

@@ -50,7 +50,7 @@ def add_arguments(parser):
     p.add_argument("--markdown", action="store_true", help="--convergence: print the table as Markdown")
     p.add_argument("--backend", choices=("auto", "numpy", "cpu"), default="auto",
                    help="float64 solver for the runs: auto (default: the faster here, as for 'score'), "
-                        "numpy (the reference; what the window uses) or the compiled cpu backend (the "
+                        "numpy (the reference) or the compiled cpu backend (the "
                         "same scores, less time)")
     p.add_argument("--workers", default=None, metavar="N", help="processes (default: every core)")
     sub.add_parser("list", help="list the shipped exercises")

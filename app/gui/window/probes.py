@@ -1,7 +1,7 @@
 """Probes in the window: View > Place probes turns clicks in the view into probes (left click
 places one, right click removes the nearest); each frame the probes sample the field the frame
 loop already has (app/model/probes.py), and the probes' plot beside the forces shows their
-series (app/gui/probe_plot.py). The forces CSV carries their columns (app/gui/force_plot.py)."""
+series (app/gui/probe_plot.py). The forces CSV carries their columns (app/gui/force_export.py)."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
