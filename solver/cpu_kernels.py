@@ -53,8 +53,12 @@ _MIRROR_Y = np.array([0, 1, 4, 3, 2, 8, 7, 6, 5], dtype=np.int64)
 WALLS = {"periodic": 0, "no_slip": 1, "free_slip": 2}
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy", fastmath={"contract", "arcp", "nsz", "reassoc"})
-#: the tunnel kernel's one parallel loop per step; numba must not fuse it with anything
-_PARALLEL = {"fusion": False}
+#: the tunnel kernel's parallelism: its prange over blocks of rows and nothing else. numba would
+#: also turn each array expression and slice copy into a parallel loop of its own (dozens in the
+#: kernel, run serially inside the prange anyway) and fuse loops: that tripled the compile time
+#: of a variant and may reorder a step's passes
+_PARALLEL = {"prange": True, "fusion": False, "setitem": False, "numpy": False, "comprehension": False,
+             "reduction": False, "inplace_binop": False, "stencil": False}
 
 
 def constants(dtype) -> tuple:
@@ -477,26 +481,47 @@ def _put(g, lay, i, y, x, v):
 
 
 @numba.njit(inline="always", **_JIT)
-def _gather_own(g, b, y, x0, n):
-    """b[:, :n] = the populations of nodes (y, x0 ..) in their own slots: a STREAMED input."""
-    x1 = x0 + n
-    for i in range(9):
-        b[i, :n] = g[i, y, x0:x1]
+def _copy_in(b, i, src, n):
+    """b[i, :n] = src[:n], an element loop over views (LLVM vectorises it; numba's slice
+    assignment, with its overlap check, costs the kernel's compile far more)."""
+    for k in range(n):
+        b[i, k] = src[k]
 
 
 @numba.njit(inline="always", **_JIT)
-def _store_swapped(g, o, y, x0, n):
-    """g[opp(i), y, x0 ..] = o[i, :n]: a SWAPPED output (an AA even step's writes)."""
-    x1 = x0 + n
-    g[0, y, x0:x1] = o[0, :n]
-    g[3, y, x0:x1] = o[1, :n]
-    g[4, y, x0:x1] = o[2, :n]
-    g[1, y, x0:x1] = o[3, :n]
-    g[2, y, x0:x1] = o[4, :n]
-    g[7, y, x0:x1] = o[5, :n]
-    g[8, y, x0:x1] = o[6, :n]
-    g[5, y, x0:x1] = o[7, :n]
-    g[6, y, x0:x1] = o[8, :n]
+def _copy_out(dst, o, i, n):
+    """dst[:n] = o[i, :n], as _copy_in."""
+    for k in range(n):
+        dst[k] = o[i, k]
+
+
+@numba.njit(inline="always", **_JIT)
+def _gather_from(g, lay, b, y, x0, n):
+    """b[i, :n] = the incoming population i of nodes (y, x0 .. x0+n-1), 1 <= x0, x0 + n < nx,
+    from g in layout `lay`: f*_i of the node at x - c_i (NATURAL: slot i there; SWAPPED: slot
+    opp(i) there; STREAMED: slot i of the node itself)."""
+    ny = g.shape[1]
+    for i in range(9):
+        if lay == STREAMED:
+            _copy_in(b, i, g[i, y, x0:x0 + n], n)
+        else:
+            slot = i if lay == NATURAL else _OPP[i]
+            xx = x0 - _CXI[i]
+            _copy_in(b, i, g[slot, _wrap(y - _CYI[i], ny), xx:xx + n], n)
+
+
+@numba.njit(inline="always", **_JIT)
+def _store_to(g, lay, o, y, x0, n):
+    """Store o[i, :n], f*_i of nodes (y, x0 .. x0+n-1), 1 <= x0, x0 + n < nx, into g in layout
+    `lay` (STREAMED: slot i of the node at x + c_i; SWAPPED: slot opp(i) of the node itself)."""
+    ny = g.shape[1]
+    for i in range(9):
+        if lay == STREAMED:
+            xx = x0 + _CXI[i]
+            _copy_out(g[i, _wrap(y + _CYI[i], ny), xx:xx + n], o, i, n)
+        else:
+            slot = i if lay == NATURAL else _OPP[i]
+            _copy_out(g[slot, y, x0:x0 + n], o, i, n)
 
 
 @numba.njit(inline="always", **_JIT)
@@ -609,87 +634,6 @@ def _links(g, lay, pre, li, ly, lx, lfy, lfx, la, lb, lc, ld, luwx, luwy, lpx, l
         sums[5] += lpx[k] * sy - lpy[k] * sx
 
 
-@numba.njit(inline="always", **_JIT)
-def _collide_columns(bb, o, m, c, op, om, keep, tg, Fx, Fy, sm, rr, kbc, trt, incomp, has_keep, has_force, K):
-    """Collide m gathered nodes of columns c, each with its column's rates and absorbing layer."""
-    if rr:
-        return _columns_rr(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force, sm, K)
-    if kbc:
-        return _columns_kbc(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force, sm)
-    return _columns(bb, o, m, c, op, om, keep, tg, trt, incomp, has_keep, Fx, Fy, has_force, K)
-
-
-@numba.njit(inline="always", **_JIT)
-def _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
-         lin, lout, rr, kbc, trt, incomp, has_keep, has_force, K):
-    """One step of row y (`make_kernel`, step 2) from src in layout lin into dst in layout lout;
-    returns the row's sum drho. Columns 1 .. nx-2 in chunks; a wall row takes the populations
-    its wall writes from pre (_wall_in); the row's listed nodes nxs[rp[y] .. rp[y+1]] (sorted by
-    x: column 0 first, column nx-1 last) take population i from pre where bit i of nbits is set
-    before they collide, the seam columns 0 and nx-1 node by node with periodic neighbours."""
-    ny, nx = src.shape[1], src.shape[2]
-    ym = y - 1 if y > 0 else ny - 1
-    yp = y + 1 if y < ny - 1 else 0
-    wall_row = walls != 0 and (y == 0 or y == ny - 1)
-    k0, k1 = rp[y], rp[y + 1]
-    s = 0.0
-    k = k0
-    while k < k1 and nxs[k] == 0:
-        k += 1
-    x0 = 1
-    while x0 < nx - 1:   # chunks end at xs: the sponge starts a chunk
-        m = min(CHUNK, (xs if x0 < xs else nx - 1) - x0)
-        if lin == NATURAL:
-            _gather(src, bb, y, ym, yp, x0, m)
-        elif lin == STREAMED:
-            _gather_own(src, bb, y, x0, m)
-        else:
-            _gather_aa(src, bb, y, ym, yp, x0, m)
-        if wall_row:
-            _wall_in(bb, pre, y, x0, m, y == 0)
-        while k < k1 and nxs[k] < x0 + m:
-            x, bits = nxs[k], nbits[k]
-            for i in range(9):
-                if (bits >> i) & 1:
-                    bb[i, x - x0] = pre[i, y, x]
-            k += 1
-        if x0 < xs:        # the rates of column 1 for the whole chunk
-            if rr:
-                s += _chunk_rr(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm, K)
-            elif kbc:
-                s += _chunk_kbc(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm)
-            else:
-                s += _chunk(bb, o, m, op0, om0, tg, trt, incomp, Fx, Fy, has_force, K)
-        else:              # each column its own rates (the sponge)
-            s += _collide_columns(bb, o, m, cols[x0:x0 + m], op, om, keep, tg, Fx, Fy, sm, rr, kbc, trt, incomp,
-                                  has_keep, has_force, K)
-        if lout == NATURAL:
-            dst[:, y, x0:x0 + m] = o[:, :m]
-        elif lout == STREAMED:
-            _scatter_aa(dst, o, y, ym, yp, x0, m)
-        else:
-            _store_swapped(dst, o, y, x0, m)
-        x0 += m
-    for side in range(2):  # the seam columns
-        x = 0 if side == 0 else nx - 1
-        if side == 1 and nx == 1:
-            break
-        bits = 0
-        for kk in range(k0, k1):
-            if nxs[kk] == x:
-                bits = nbits[kk]
-        for i in range(9):
-            if (bits >> i) & 1:
-                bb[i, 0] = pre[i, y, x]
-            else:
-                bb[i, 0] = _post(src, lin, i, _wrap(y - _CYI[i], ny), _wrap(x - _CXI[i], nx))
-        s += _collide_columns(bb, o, 1, cols[x:x + 1], op, om, keep, tg, Fx, Fy, sm, rr, kbc, trt, incomp,
-                              has_keep, has_force, K)
-        for i in range(9):
-            _put(dst, lout, i, y, x, o[i, 0])
-    return s
-
-
 @numba.njit(**_JIT)
 def rows_of_nodes(ry, rx, rbits, ny):
     """The kernel's boundary-node list by row: (rp (ny+1,), xs, bits), row y's nodes
@@ -769,12 +713,14 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
            lpx, lpy: _links);
         2. stream + collide of every node, blocks of rows in parallel (scratch (B, 2, 9, CHUNK):
            each block's gather and result buffers, nothing allocated in the parallel loop; sums
-           (B,) each block's sum drho; _row): columns 1 .. xs-1 share the rates op[1], om[1];
+           (B,) each block's sum drho): columns 1 .. xs-1 share the rates op[1], om[1];
            xs .. nx-2 (the sponge) take their own column's; target (ny,) the absorbing layer's
-           x-velocity r profile; a wall row takes the populations its wall writes from pre;
-           the nodes listed by row (rp, nxs, nbits: `rows_of_nodes`) take population i from pre
-           where bit i of their bits is set: every node of columns 0 and nx-1 (they pull across
-           the periodic seam) and every node that owns a body link;
+           x-velocity r profile; a wall row takes the populations its wall writes from pre
+           (_wall_in); the nodes listed by row (rp, nxs, nbits: `rows_of_nodes`; row y's
+           nxs[rp[y] .. rp[y+1]], sorted by x) take population i from pre where bit i of their
+           bits is set before they collide: every node of columns 0 and nx-1 (done node by
+           node after the row's chunks: they pull across the periodic seam) and every node
+           that owns a body link;
         3. the solid nodes (sy, sx) reset to solid_g."""
         ny, nx = g.shape[1], g.shape[2]
         nb = scratch.shape[0]
@@ -811,26 +757,62 @@ def make_kernel(kind: str, incomp: bool, has_keep: bool, has_force: bool, dtype:
                 s = 0.0
                 for y in range(blk * per, min(ny, (blk + 1) * per)):
                     tg = target[y]
-                    if lin == NATURAL:   # each layout pair its own inlined copy: no branch per chunk
-                        if lout == NATURAL:
-                            s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
-                                      NATURAL, NATURAL, rr, kbc, trt, incomp, has_keep, has_force, K)
+                    wall_row = walls != 0 and (y == 0 or y == ny - 1)
+                    k0, k1 = rp[y], rp[y + 1]
+                    k = k0
+                    while k < k1 and nxs[k] == 0:
+                        k += 1
+                    x0 = 1
+                    while x0 < nx - 1:   # chunks end at xs: the sponge starts a chunk
+                        m = min(CHUNK, (xs if x0 < xs else nx - 1) - x0)
+                        _gather_from(src, lin, bb, y, x0, m)
+                        if wall_row:
+                            _wall_in(bb, pre, y, x0, m, y == 0)
+                        while k < k1 and nxs[k] < x0 + m:   # the row's listed nodes in this chunk
+                            x, bits = nxs[k], nbits[k]
+                            for i in range(9):
+                                if (bits >> i) & 1:
+                                    bb[i, x - x0] = pre[i, y, x]
+                            k += 1
+                        if x0 < xs:        # the rates of column 1 for the whole chunk
+                            if rr:
+                                s += _chunk_rr(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm, K)
+                            elif kbc:
+                                s += _chunk_kbc(bb, o, m, op0, tg, incomp, Fx, Fy, has_force, sm)
+                            else:
+                                s += _chunk(bb, o, m, op0, om0, tg, trt, incomp, Fx, Fy, has_force, K)
+                        else:              # each column its own rates (the sponge)
+                            c = cols[x0:x0 + m]
+                            if rr:
+                                s += _columns_rr(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force,
+                                                 sm, K)
+                            elif kbc:
+                                s += _columns_kbc(bb, o, m, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force, sm)
+                            else:
+                                s += _columns(bb, o, m, c, op, om, keep, tg, trt, incomp, has_keep, Fx, Fy,
+                                              has_force, K)
+                        _store_to(dst, lout, o, y, x0, m)
+                        x0 += m
+                    for side in range(2 if nx > 1 else 1):  # the seam columns, periodic neighbours
+                        x = 0 if side == 0 else nx - 1
+                        bits = 0
+                        for kk in range(k0, k1):
+                            if nxs[kk] == x:
+                                bits = nbits[kk]
+                        for i in range(9):
+                            if (bits >> i) & 1:
+                                bb[i, 0] = pre[i, y, x]
+                            else:
+                                bb[i, 0] = _post(src, lin, i, _wrap(y - _CYI[i], ny), _wrap(x - _CXI[i], nx))
+                        c = cols[x:x + 1]
+                        if rr:
+                            s += _columns_rr(bb, o, 1, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force, sm, K)
+                        elif kbc:
+                            s += _columns_kbc(bb, o, 1, c, op, keep, tg, incomp, has_keep, Fx, Fy, has_force, sm)
                         else:
-                            s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
-                                      NATURAL, STREAMED, rr, kbc, trt, incomp, has_keep, has_force, K)
-                    elif lin == STREAMED:
-                        if lout == SWAPPED:
-                            s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
-                                      STREAMED, SWAPPED, rr, kbc, trt, incomp, has_keep, has_force, K)
-                        else:
-                            s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
-                                      STREAMED, NATURAL, rr, kbc, trt, incomp, has_keep, has_force, K)
-                    elif lout == STREAMED:
-                        s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
-                                      SWAPPED, STREAMED, rr, kbc, trt, incomp, has_keep, has_force, K)
-                    else:
-                        s += _row(src, dst, pre, y, xs, cols, op, om, keep, tg, walls, rp, nxs, nbits, bb, o, op0, om0, Fx, Fy, sm,
-                                      SWAPPED, NATURAL, rr, kbc, trt, incomp, has_keep, has_force, K)
+                            s += _columns(bb, o, 1, c, op, om, keep, tg, trt, incomp, has_keep, Fx, Fy, has_force, K)
+                        for i in range(9):
+                            _put(dst, lout, i, y, x, o[i, 0])
                 sums[blk] = s
             total = sums.sum()
             for k in range(len(sy)):
