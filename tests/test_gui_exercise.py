@@ -109,9 +109,9 @@ def test_exercise_on_a_built_in_body_uses_the_parameter_fields(window, qtbot, tm
     panel = ex.panel
     assert panel.shape_box.isVisible()
     qtbot.waitUntil(lambda: "All constraints met" in panel.constraints.text(), timeout=5000)
-    panel.angle.setValue(30.0)        # outside -12..12
+    panel.shape_box.angle.setValue(30.0)        # outside -12..12
     qtbot.waitUntil(lambda: "the angle is 30.0 degrees" in panel.constraints.text(), timeout=5000)
-    panel.angle.setValue(-4.0)
+    panel.shape_box.angle.setValue(-4.0)
     qtbot.waitUntil(lambda: "All constraints met" in panel.constraints.text(), timeout=5000)
     assert ex.current_shape().kind == "half_airfoil"
 

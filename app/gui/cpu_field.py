@@ -102,7 +102,7 @@ class CpuCanvas(QWidget):
         self._timer.start(50)
 
     def paintEvent(self, _ev):
-        paint(self.viewport, getattr(self.viewport, "cpu_rgba", None), self)
+        paint(self.viewport, self.viewport.cpu_rgba, self)
 
     def resizeEvent(self, ev):
         if self.stand_in:

@@ -3,14 +3,16 @@ parts, each in a module of its own:
 
     ExerciseMenu      exercise_menu.py         the Exercises menu and its file dialog
     ExercisePanel     exercise_panel.py        the panel's widgets (goal, parameters, score, attempts)
-    ExerciseDock      exercise_dock.py         where the panel sits; the tunnel fitted to the viewport
+    ShapeFields       exercise_shape_fields.py the panel's built-in body fields (kind, sizes, angle)
+    thumbnail         exercise_thumbnail.py    an attempt's outline as the list's picture
+    ExerciseDock      exercise_dock.py         where the panel sits (scrolling); the tunnel fitted to the viewport
     StudentShape      exercise_shape.py        the student's shape and how it reaches the tunnel
     ConstraintWatch   exercise_constraints.py  what the shape breaks, named, the body outlined
     ScoringRunner     exercise_scoring.py      Score it in a worker thread, on the command line's solver
     ExerciseAttempts  exercise_attempts.py     the work folder and the attempts file
 
 The physics and the words stay Qt-free in app/exercises/ (the file, the constraints, scoring,
-the attempts file, the result's text).
+the attempts file, the panel's words and the result's text, the parameter fields' values).
 """
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """Where the exercise panel sits in the window: a dock tabbed beside the Controls in the right
-column (which takes the window's full height), in front while an exercise opens; and the
+column (which takes the window's full height), in front while an exercise opens, the panel
+scrolling inside it on a short screen (`ScrollingPanel`); and the
 forces plot below the tunnel given the height a wide, low exercise tunnel leaves empty, so the
 tunnel fills the viewport's width and height.
 """
@@ -9,16 +10,34 @@ import math
 from typing import TYPE_CHECKING
 
 from PySide6.QtCore import Qt
-from PySide6.QtWidgets import QDockWidget
+from PySide6.QtWidgets import QDockWidget, QScrollArea
 
 from feelflow.app.gui.display_modes import COLOUR_BAR_MARGIN
-from feelflow.app.gui.exercise_panel import PANEL_WIDTH, ScrollingPanel
 
 if TYPE_CHECKING:
     from PySide6.QtWidgets import QMainWindow, QWidget
 
     from feelflow.app.gui.exercise_panel import ExercisePanel
     from feelflow.app.gui.viewport import Viewport
+
+
+#: the panel's width in the window (logical pixels): the goal, references and attempts lines wrap to it
+PANEL_WIDTH = 340
+#: the narrowest it gets (the window keeps 1280 pixels with the forces' toolbar below the flow)
+PANEL_MIN_WIDTH = 290
+
+
+class ScrollingPanel(QScrollArea):
+    """The exercise panel in a vertical scroll area: on a short screen it scrolls instead of
+    squeezing its wrapped lines over each other."""
+
+    def __init__(self, panel: "ExercisePanel"):
+        super().__init__()
+        self.setObjectName("exercise_scroll")
+        self.setWidget(panel)
+        self.setWidgetResizable(True)
+        self.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
+        self.setMinimumWidth(PANEL_MIN_WIDTH)
 
 
 class ExerciseDock(QDockWidget):

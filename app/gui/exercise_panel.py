@@ -1,95 +1,25 @@
 """The exercise panel beside the flow: goal and instructions, the shape's parameters (for
-exercises on a built-in body), the constraints as they stand, Score it with progress and
-Cancel, the result against the reference solutions, and the attempts with thumbnails.
+exercises on a built-in body: `ShapeFields`, app/gui/exercise_shape_fields.py), the constraints
+as they stand, Score it with progress and Cancel, the result against the reference solutions,
+and the attempts with thumbnails (app/gui/exercise_thumbnail.py).
 
-Widgets only; app/gui/exercise_controller.py connects them to the tunnel and the scoring."""
+Widgets only: the words are app/exercises/panel_text.py's and score_text.py's;
+app/gui/exercise_controller.py connects the panel to the tunnel and the scoring."""
 from __future__ import annotations
 
-import math
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtWidgets import (QHBoxLayout, QLabel, QListWidget, QListWidgetItem, QProgressBar, QPushButton,
+                               QTextBrowser, QVBoxLayout, QWidget)
 
-from PySide6.QtCore import QPointF, QSize, Qt, Signal
-from PySide6.QtGui import QColor, QIcon, QPainter, QPen, QPixmap, QPolygonF
-from PySide6.QtWidgets import (QComboBox, QDoubleSpinBox, QFormLayout, QGroupBox, QHBoxLayout, QLabel, QListWidget,
-                               QListWidgetItem, QProgressBar, QPushButton, QScrollArea, QTextBrowser,
-                               QVBoxLayout, QWidget)
-
-from feelflow.app.exercises.uncertainty import fmt, tied
-from feelflow.app.model import readouts
-
-#: parametric kinds: parameter -> (label, minimum, maximum, step); angles in degrees
-PARAMETERS = {
-    "cylinder": {"diameter": ("Diameter (cells)", 2.0, 60.0, 0.5)},
-    "plate": {"length": ("Length (cells)", 2.0, 60.0, 0.5), "thickness": ("Thickness (cells)", 0.5, 20.0, 0.5)},
-    "wedge": {"length": ("Length (cells)", 2.0, 60.0, 0.5), "apex_angle": ("Apex angle (degrees)", 5.0, 170.0, 1.0)},
-    "half_airfoil": {"chord": ("Chord (cells)", 4.0, 60.0, 0.5), "thickness": ("Thickness (cells)", 0.5, 20.0, 0.25)},
-    "naca": {"chord": ("Chord (cells)", 8.0, 120.0, 1.0), "thickness": ("Thickness (x chord)", 0.04, 0.3, 0.01),
-             "camber": ("Camber (x chord)", 0.0, 0.09, 0.01), "camber_position": ("Camber at (x chord)", 0.1, 0.9, 0.1)},
-}
-THUMB = QSize(72, 44)
-#: the panel's width in the window (logical pixels): the goal, references and attempts lines wrap to it
-PANEL_WIDTH = 340
-#: the narrowest it gets (the window keeps 1280 pixels with the forces' toolbar below the flow)
-PANEL_MIN_WIDTH = 290
-BAD = "#d03030"
-GOOD = "#208040"
-
-
-def thumbnail(outline, best: bool = False) -> QIcon:
-    """A small picture of a body outline ((k, 2) points), framed in gold when it is the best."""
-    pix = QPixmap(THUMB)
-    pix.fill(QColor(41, 43, 48))
-    p = QPainter(pix)
-    p.setRenderHint(QPainter.Antialiasing)
-    xs, ys = [float(x) for x, _ in outline], [float(y) for _, y in outline]
-    span = max(max(xs) - min(xs), max(ys) - min(ys), 1e-9)
-    k = 0.8 * min(THUMB.width(), THUMB.height() * 1.6) / span
-    cx, cy = 0.5 * (max(xs) + min(xs)), 0.5 * (max(ys) + min(ys))
-    poly = QPolygonF([QPointF(THUMB.width() / 2 + (x - cx) * k, THUMB.height() / 2 - (y - cy) * k)
-                      for x, y in zip(xs, ys)])
-    p.setPen(QPen(QColor(20, 20, 20), 1.5))
-    p.setBrush(QColor(225, 225, 225))
-    p.drawPolygon(poly)
-    if best:
-        p.setPen(QPen(QColor(255, 200, 0), 3))
-        p.setBrush(Qt.NoBrush)
-        p.drawRect(1, 1, THUMB.width() - 2, THUMB.height() - 2)
-    p.end()
-    return QIcon(pix)
-
-
-def reflow(text: str) -> str:
-    """An exercise's text as paragraphs: the file's line breaks inside a paragraph become
-    spaces (the panel wraps to its own width), blank lines stay paragraph breaks."""
-    paragraphs = [" ".join(line.strip() for line in block.splitlines() if line.strip())
-                  for block in text.strip().split("\n\n")]
-    return "\n\n".join(p for p in paragraphs if p)
-
-
-def breakable_path(path: str) -> str:
-    """A file path that a word-wrapped label may break after each separator (a zero-width
-    space there), with the home folder written as ~."""
-    from pathlib import Path
-
-    home = str(Path.home())
-    if home not in ("", "/") and path.startswith(home):
-        path = "~" + path[len(home):]
-    return path.replace("/", "/\u200b").replace("\\", "\\\u200b")
-
-
-class ScrollingPanel(QScrollArea):
-    """The exercise panel in a vertical scroll area: on a short screen it scrolls instead of
-    squeezing its wrapped lines over each other."""
-
-    def __init__(self, panel: "ExercisePanel"):
-        super().__init__()
-        self.setObjectName("exercise_scroll")
-        self.setWidget(panel)
-        self.setWidgetResizable(True)
-        self.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
-        self.setMinimumWidth(PANEL_MIN_WIDTH)
+from feelflow.app.exercises import panel_text
+from feelflow.app.gui.exercise_shape_fields import ShapeFields
+from feelflow.app.gui.exercise_thumbnail import THUMB, thumbnail
 
 
 class ExercisePanel(QWidget):
+    """The panel's widgets, top to bottom; it emits what the student asks for and shows what
+    the controller hands it."""
+
     scoreRequested = Signal()
     cancelRequested = Signal()
     attemptChosen = Signal(int)      # index into the attempts list
@@ -121,39 +51,8 @@ class ExercisePanel(QWidget):
         self.edit.toggled.connect(self.editToggled)
         layout.addWidget(self.edit)
 
-        self.shape_box = QGroupBox("Your shape")
-        form = QFormLayout(self.shape_box)
-        self.kind = QComboBox()
-        self.kind.currentIndexChanged.connect(self._kind_changed)
-        form.addRow("Kind", self.kind)
-        self.spins: dict[str, QDoubleSpinBox] = {}
-        self.rows: dict[str, tuple] = {}
-        for kind, params in PARAMETERS.items():
-            for name, (label, lo, hi, step) in params.items():
-                key = f"{kind}.{name}"
-                spin = QDoubleSpinBox()
-                spin.setRange(lo, hi)
-                spin.setSingleStep(step)
-                spin.setDecimals(2)
-                spin.setKeyboardTracking(False)
-                spin.valueChanged.connect(lambda _=0: self.parametersChanged.emit())
-                self.spins[key] = spin
-                lab = QLabel(label)
-                form.addRow(lab, spin)
-                self.rows[key] = (lab, spin)
-        self.pointing = QComboBox()
-        self.pointing.addItem("point upstream <", "upstream")
-        self.pointing.addItem("point downstream >", "downstream")
-        self.pointing.currentIndexChanged.connect(lambda _=0: self.parametersChanged.emit())
-        self.pointing_label = QLabel("Wedge")
-        form.addRow(self.pointing_label, self.pointing)
-        self.angle = QDoubleSpinBox()
-        self.angle.setRange(-90.0, 90.0)
-        self.angle.setDecimals(1)
-        self.angle.setSingleStep(1.0)
-        self.angle.setKeyboardTracking(False)
-        self.angle.valueChanged.connect(lambda _=0: self.parametersChanged.emit())
-        form.addRow("Angle (degrees, + turns nose down)", self.angle)
+        self.shape_box = ShapeFields()
+        self.shape_box.changed.connect(self.parametersChanged)
         layout.addWidget(self.shape_box)
 
         self.constraints = QLabel()
@@ -201,75 +100,17 @@ class ExercisePanel(QWidget):
     # --- filling in ---------------------------------------------------------------------------
     def show_exercise(self, exercise):
         self.title.setText(exercise.title)
-        self.instructions.setPlainText(reflow(exercise.instructions))
-        o = exercise.objective
-        goal = f"Goal: {o.kind.replace('_', ' ')}; score = {o.quantity}, {o.better} is better"
-        if o.target is not None:
-            goal += f" (a hit is within {o.tolerance:g} of {o.target:g})"
-        u = o.uncertainty
-        if u is not None:
-            goal += f". Scores are good to \u00b1{u:g} (the grid uncertainty); closer than that is a tie"
-        self.goal.setText(goal + ".")
-        refs = "; ".join(f"{r.label}: {fmt(r.score, u)}" for r in exercise.references)
-        self.references.setText(f"Reference solution{'s' if len(exercise.references) > 1 else ''}: {refs}.")
+        self.instructions.setPlainText(panel_text.reflow(exercise.instructions))
+        self.goal.setText(panel_text.goal_text(exercise))
+        self.references.setText(panel_text.references_text(exercise))
         self.edit.setVisible("polygon" in exercise.kinds)
-        parametric = [k for k in exercise.kinds if k in PARAMETERS]
-        self.shape_box.setVisible(bool(parametric))
-        self.kind.blockSignals(True)
-        self.kind.clear()
-        for k in parametric:
-            self.kind.addItem(k.replace("_", " "), k)
-        self.kind.blockSignals(False)
-        self._show_rows()
+        self.shape_box.show_kinds(exercise.kinds)
         self.result.clear()
         self.progress.setValue(0)
 
-    def _kind_changed(self, _=0):
-        self._show_rows()
-        self.parametersChanged.emit()
-
-    def _show_rows(self):
-        kind = self.kind.currentData()
-        for key, (lab, spin) in self.rows.items():
-            on = key.split(".")[0] == kind
-            lab.setVisible(on)
-            spin.setVisible(on)
-        self.pointing.setVisible(kind == "wedge")
-        self.pointing_label.setVisible(kind == "wedge")
-
-    def set_parameters(self, shape):
-        """Show a built-in body's parameters (angles in degrees) without emitting a change per field."""
-        d = shape.to_dict()
-        widgets = [self.kind, self.pointing, self.angle, *self.spins.values()]
-        for w in widgets:
-            w.blockSignals(True)
-        self.kind.setCurrentIndex(self.kind.findData(d["kind"]))
-        for name in PARAMETERS.get(d["kind"], {}):
-            value = d[name]
-            self.spins[f"{d['kind']}.{name}"].setValue(math.degrees(value) if name == "apex_angle" else value)
-        if "pointing" in d:
-            self.pointing.setCurrentIndex(self.pointing.findData(d["pointing"]))
-        self.angle.setValue(math.degrees(d["angle"]))
-        for w in widgets:
-            w.blockSignals(False)
-        self._show_rows()
-
-    def parameters(self) -> dict:
-        """The shape dictionary (shapes/io.py: radians) the parameter fields describe, at (0, 0)."""
-        kind = self.kind.currentData()
-        d = {"kind": kind, "x": 0.0, "y": 0.0, "angle": math.radians(self.angle.value())}
-        for name in PARAMETERS[kind]:
-            value = self.spins[f"{kind}.{name}"].value()
-            d[name] = math.radians(value) if name == "apex_angle" else value
-        if kind == "wedge":
-            d["pointing"] = self.pointing.currentData()
-        return d
-
     def show_live(self, readout):
         """The live tunnel's C_D and C_L (an app.model.readouts.Readout) with their reference."""
-        fmt = readouts.format_coefficient
-        self.live.setText(f"In the tunnel now: C<sub>D</sub> {fmt(readout.cd)}, C<sub>L</sub> {fmt(readout.cl)} "
-                          f"<small>({readout.reference_text()}; the window's flow, float32)</small>")
+        self.live.setText(panel_text.live_text(readout))
 
     def show_result(self, text: str):
         """The scoring run's line, or its verdict (app/exercises/score_text.py words it)."""
@@ -282,11 +123,7 @@ class ExercisePanel(QWidget):
         self.edit.blockSignals(False)
 
     def set_problems(self, problems: list[str]):
-        if problems:
-            items = "".join(f"<li>{p}</li>" for p in problems)
-            self.constraints.setText(f"<span style='color:{BAD}'><b>Not ready to score:</b><ul>{items}</ul></span>")
-        else:
-            self.constraints.setText(f"<span style='color:{GOOD}'><b>All constraints met</b>: ready to score.</span>")
+        self.constraints.setText(panel_text.problems_text(problems))
         self.score_button.setEnabled(not problems and not self.cancel_button.isEnabled())
 
     def set_running(self, running: bool, problems_ok: bool = True):
@@ -301,19 +138,14 @@ class ExercisePanel(QWidget):
         self.progress.setValue(int(round(1000 * fraction)))
 
     def set_attempts(self, attempts, best, where: str, uncertainty: float | None = None):
-        self.attempts_label.setText(f"Attempts, the best framed in gold; saved in {breakable_path(where)}")
+        self.attempts_label.setText(panel_text.attempts_heading(where))
         self.attempts_label.setToolTip(where)
         self.attempts.clear()
         for a in attempts:
-            shape = a.load_shape()
-            text = (f"#{a.number}  {fmt(a.score, uncertainty)}" if a.score is not None else f"#{a.number}  {a.status}")
-            text += f"   {a.time.replace('T', ' ')[:19]}, {a.seconds:.1f} s"
-            if best is not None and a.number == best.number:
-                text += "   \u2605 best"
-            elif best is not None and a.score is not None and tied(a.score, best.score, uncertainty):
-                text += "   = ties the best"
-            item = QListWidgetItem(thumbnail(shape.outline(), best is not None and a.number == best.number), text)
-            item.setToolTip(a.reason or f"C_D {a.cd:.4f}, C_L {a.cl:.4f}" if a.cd is not None else a.reason)
+            is_best = best is not None and a.number == best.number
+            item = QListWidgetItem(thumbnail(a.load_shape().outline(), is_best),
+                                   panel_text.attempt_line(a, best, uncertainty))
+            item.setToolTip(panel_text.attempt_tip(a))
             self.attempts.addItem(item)
         if attempts:
             self.attempts.setCurrentRow(len(attempts) - 1)

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, Signal
 
-from feelflow.app.gui.exercise_panel import PARAMETERS
+from feelflow.app.exercises.shape_fields import PARAMETERS
 from feelflow.shapes.base import ShapeError
 
 if TYPE_CHECKING:
@@ -55,7 +55,7 @@ class StudentShape(QObject):
     def install(self, shape) -> bool:
         """Put a shape (a start shape, a loaded attempt) into the editor and the tunnel."""
         if shape.kind in PARAMETERS:
-            self.panel.set_parameters(shape)
+            self.panel.shape_box.set_parameters(shape)
             return self.parameters_changed()
         self.make_current()
         self.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in shape.vertices],
@@ -70,7 +70,7 @@ class StudentShape(QObject):
         from feelflow.shapes.io import from_dict
 
         try:
-            shape = from_dict(self.panel.parameters())
+            shape = from_dict(self.panel.shape_box.parameters())
         except ShapeError as exc:
             self.unbuildable.emit(str(exc).splitlines()[0])
             return False

@@ -112,7 +112,7 @@ def run_on_cpu(window, detail: str) -> None:
     window.gl_missing = detail
     window.backend = "numpy"
     viewport = window.viewport
-    canvas = getattr(viewport, "cpu_canvas", None) or CpuCanvas(viewport)
+    canvas = viewport.cpu_canvas or CpuCanvas(viewport)
     # the window's screenshots read the viewport's framebuffer: the canvas holds the picture now
     viewport.grabFramebuffer = lambda: canvas.grab().toImage()
     box = QMessageBox(QMessageBox.Warning, "FeelFlow runs without OpenGL 3.3", no_gl_text(detail),

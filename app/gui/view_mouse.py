@@ -44,7 +44,8 @@ class ViewMouse:
         """What drives the body instead of the mouse (a haptic device, a motion script), or None."""
         if self.view.driver:
             return self.view.driver
-        if getattr(self.view.sim, "runner", None) is not None:
+        sim = self.view.sim
+        if sim is not None and sim.runner is not None:
             return "A motion script"
         return None
 

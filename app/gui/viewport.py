@@ -59,6 +59,8 @@ class Viewport(QWidget):
         self.locked = False            # True while a replay shows: the mouse does not move the body
         self.banner = None             # a line painted over the field (the replay's progress)
         self.driver = None             # what else drives the body ("The haptic device"), set by the window
+        self.cpu_canvas = None         # without OpenGL 3.3: the cpu_field.CpuCanvas that draws the field
+        self.cpu_rgba = None           # and the field it draws, (ny, nx, 4) float32
         self.mouse = ViewMouse(self)   # dragging, the polygon editor, the turn handle, the wheel
         self.overlay = Overlay(self)
         self._gl_tried = False
@@ -110,7 +112,7 @@ class Viewport(QWidget):
         """numpy path: (ny, nx, 4) float32 (rho, ux, uy, vorticity) to draw."""
         if self.ctx is None:       # no OpenGL 3.3: cpu_field.CpuCanvas colours it on the CPU
             self.cpu_rgba = rgba
-            self.cpu_canvas.update()   # set by first_start.run_on_cpu
+            self.cpu_canvas.update()   # a CpuCanvas (first_start.run_on_cpu)
             return
         self.colours.upload(rgba)
 

@@ -46,7 +46,7 @@ class LivePolar:
         self.cp = []   # (alpha, SurfacePressure) of every settled angle
         shape = sim.shape
         self.zero_lift_alpha = (naca_zero_lift_angle(shape.camber, shape.camber_position)
-                                if getattr(shape, "kind", None) == "naca" else 0.0)
+                                if shape.kind == "naca" else 0.0)
         self._acc = [0.0, 0.0, 0]
 
     @property

@@ -14,6 +14,7 @@ from pathlib import Path
 from feelflow.app.model.body_input import BodyInput
 from feelflow.app.model.readouts import ReferenceLength
 from feelflow.app.sessions import SessionPlayer
+from feelflow.app.sessions.format import Session
 from feelflow.app.model.force_history import History
 from feelflow.app.model.simulation import FORCE_MODELS, Params, shape_hit
 from feelflow.solver import units
@@ -170,6 +171,10 @@ class ReplaySimulation:
 
     def watch_surface_pressure(self, on: bool = True) -> None:
         """Nothing to sample: the replayed flow's wall pressure is not recorded."""
+
+    def replayed_session(self) -> Session:
+        """The session file this replay plays."""
+        return self.player.session
 
     # --- running ------------------------------------------------------------------------
     def advance(self, n: int) -> dict:

@@ -216,6 +216,10 @@ class Simulation:
         self.pressure.watch_surface(on)
         self._enable_models()
 
+    def replayed_session(self) -> None:
+        """None: the live tunnel replays no session file."""
+        return None
+
     def start_polar(self, angles, sample_steps: int = 25, **settling):
         """An angle-of-attack sweep (app/model/live_polar.py): the body held still at each angle
         of `angles` (degrees, nose up positive) until its forces settle, then the next."""

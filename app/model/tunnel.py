@@ -29,6 +29,7 @@ if TYPE_CHECKING:   # simulation.py defines them and implements this interface
     from feelflow.app.model.live_polar import LivePolar
     from feelflow.solver.forces.surface_pressure import SurfacePressure
     from feelflow.app.model.simulation import Params
+    from feelflow.app.sessions.format import Session
 
 
 @runtime_checkable
@@ -108,4 +109,8 @@ class TunnelModel(Protocol):
 
     def watch_surface_pressure(self, on: bool = True) -> None:
         """Sample the wall pressure for C_p along the surface while `on` (the C_p view shows)."""
+        ...
+
+    def replayed_session(self) -> "Session | None":
+        """The session file being replayed (its recorded units and probes), or None in the live tunnel."""
         ...

@@ -150,7 +150,7 @@ class BodyController:
     def _script_refuses_turn(self, how: str) -> bool:
         """A motion script drives the pose (it ignores the angle until it ends, when the body would
         swing to the last asked angle): refuse the turn with a status message."""
-        if getattr(self.sim, "runner", None) is None:
+        if self.sim is None or self.sim.runner is None:
             return False
         self.turn_refused("A motion script", how)
         return True

@@ -315,7 +315,7 @@ class FrameLoop:
             return
         p, panel = model.params, self.panel
         live = model is self.sim
-        wind, nu = panel.flow_shown     # lattice units, whatever units the boxes show
+        wind, nu = panel.flow_units.shown     # lattice units, whatever units the boxes show
         if live and (abs(wind - p.wind) > 5e-4   # a sweep, a lesson or the guard
                      or abs(nu - p.nu) > 5e-5):
             panel.show_params(p, self.display_mode)

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     from feelflow.app.gui.viewport import Viewport
     from feelflow.app.gui.window.events import WindowEvents
     from feelflow.app.gui.window.frame_loop import FrameLoop
+    from feelflow.app.model.tunnel import TunnelModel
 
 PLOT_REFRESH_MS = 250
 PLACING_HINT = "Click in the flow to place a probe (up to 4); right-click one to remove it. View > Place probes ends this."
@@ -118,11 +119,11 @@ class ProbeController:
         """The probes and their series for a session file (None without probes)."""
         return self.probes.to_arrays() if len(self.probes) else None
 
-    def model_changed(self, model):
+    def model_changed(self, model: "TunnelModel"):
         """A replay started or stopped: the series start again at its steps; a session that
         was recorded with probes puts them back where they stood."""
-        session = getattr(getattr(model, "player", None), "session", None)
-        arrays = getattr(session, "probes", None)
+        session = model.replayed_session()
+        arrays = session.probes if session is not None else None
         if arrays is not None:
             restored = Probes.from_arrays(arrays)
             self.probes.items[:] = restored.items

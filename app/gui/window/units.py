@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     from feelflow.app.gui.window.frame_loop import FrameLoop
     from feelflow.app.gui.window.probes import ProbeController
     from feelflow.app.model.simulation import Simulation
+    from feelflow.app.model.tunnel import TunnelModel
 
 REFRESH_MS = 500
 
@@ -126,11 +127,11 @@ class UnitsController:
             self.timer.stop()
         self.status.showMessage(f"Units: {self.units.describe()}", 8000)
 
-    def model_changed(self, model):
+    def model_changed(self, model: "TunnelModel"):
         """A replay started (its session's recorded units, if it has them) or stopped (back to
         the user's choice)."""
-        session = getattr(getattr(model, "player", None), "session", None)
-        recorded = choice_from_dict(getattr(session, "units", None))
+        session = model.replayed_session()
+        recorded = choice_from_dict(session.units if session is not None else None)
         if recorded is not None:
             if self.own_choice is None:
                 self.own_choice = self.choice
