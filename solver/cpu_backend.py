@@ -1,15 +1,16 @@
-"""The compiled CPU backend: the numpy reference's algorithm (docs/science/algorithm.md), each
-step two compiled calls (numba, solver/cpu_kernels.py).
+"""The compiled CPU backend: the numpy reference's algorithm (docs/science/algorithm.md), n
+steps in one compiled call (numba, solver/cpu_kernels.py `make_kernel`).
 
-The first pulls every population from its upwind neighbour (periodic in x and y) and collides,
-blocks of rows in parallel, writing the other of two float32 (or float64) buffers. The second,
-serial, does what the boundaries own in the numpy backend's order (outlet d, inlet c with the
-quiet inlet's correction, walls b, body links a with the moving-wall term) into a third buffer,
-`pre`, from the same post-collision state, sums the momentum exchange on the body links as it
-goes, collides again exactly the nodes that own such a population (a list of nodes and bit
-masks, rebuilt when the body's links change) and resets the solid nodes. Every operator is
-compiled: BGK, TRT, recursive-regularised BGK and entropic KBC (the last two with or without the
-Smagorinsky viscosity).
+Each step first does, serially and in the numpy backend's order, what the boundaries own
+(outlet d, inlet c with the quiet inlet's correction, walls b, body links a with the moving-wall
+term) into a third buffer, `pre`, from the post-collision state, summing the momentum exchange
+on the body links as it goes; then streams and collides every node, blocks of rows in parallel,
+the nodes that own a boundary population taking it from `pre` (a list of nodes and bit masks by
+row, rebuilt when the body's links change); then resets the solid nodes. The steps of one call
+stream with the AA pattern between a first and a last step in the natural layout, so between
+calls the state is the numpy backend's. Every operator is compiled: BGK, TRT,
+recursive-regularised BGK and entropic KBC (the last two with or without the Smagorinsky
+viscosity).
 A move's raster, links, node list and (float32 storage, equilibrium scheme) cover/uncover refill
 are compiled equals of the numpy backend's code (solver/body_compiled.py); the force models other
 than the momentum exchanges and the fields are the numpy backend's (this class is a NumpySolver
@@ -32,7 +33,7 @@ from feelflow.solver.regularised import smagorinsky_factor
 
 _EMPTY_I = np.zeros(0, np.int64)
 _EMPTY_F = np.zeros(0, np.float64)
-#: the momentum-exchange models the boundary pass sums: model class -> slice of its (4,) sums
+#: the momentum-exchange models the kernel's boundary rules sum: model class -> slice of its (4,) sums
 #: each momentum exchange's entries of the compiled step's link sums (cpu_kernels._links): fx, fy, moment
 _LINK_SUMS = {GalileanMomentumExchange: (0, 1, 4), ClassicMomentumExchange: (2, 3, 5)}
 
@@ -97,10 +98,11 @@ class CpuSolver(NumpySolver):
         self._link_arrays = None
 
     def _boundary_nodes(self):
-        """((ny, nx) bits, (iy, ix, bits) of the node pass): bit i set where a domain boundary
-        rule (c, d, b) writes population i; the node pass takes every node of the first and last
-        column (solver/cpu_kernels.py advance, step 3: they pull across the periodic seam and
-        own the inlet's and outlet's populations); the parallel pass takes the walls' (step 2)."""
+        """((ny, nx) bits, (iy, ix, bits) of the listed nodes): bit i set where a domain boundary
+        rule (c, d, b) writes population i; the kernel's list holds every node of the first and
+        last column (they pull across the periodic seam and own the inlet's and outlet's
+        populations); a wall row takes its wall's populations chunk by chunk
+        (solver/cpu_kernels.py advance, step 2)."""
         cfg = self.config
         bits = np.zeros((cfg.ny, cfg.nx), np.int64)
         if cfg.x_boundary == "tunnel":
@@ -110,16 +112,16 @@ class CpuSolver(NumpySolver):
             bits[0, :] |= _bits((2, 5, 6))
             bits[-1, :] |= _bits((4, 7, 8))
         listed = np.zeros_like(bits, dtype=bool)
-        listed[:, 0] = listed[:, -1] = True  # the seam columns are always collided in the node pass
+        listed[:, 0] = listed[:, -1] = True  # the seam columns are always listed
         iy, ix = np.nonzero(listed)
         return bits, (iy.astype(np.int64), ix.astype(np.int64), bits[iy, ix])
 
     def _redo_nodes(self):
         """(iy, ix, bits) of every node a boundary rule or a body link writes a population of,
         and the links as flat arrays in grid coordinates; rebuilt when the body's links change,
-        from the links and the body window alone (compiled: solver/body_compiled.py). Each node
-        comes once (the node pass runs in parallel): a link node in a seam column comes only in
-        the links' part, with its edge bits as well."""
+        from the links and the body window alone (compiled: solver/body_compiled.py), and the
+        same list by row for the kernel (`rows_of_nodes`). Each node comes once: a link node in a
+        seam column comes only in the links' part, with its edge bits as well."""
         b = self.body
         links = None if b is None else b.links
         if self._redo is not None and links is self._mask_links:

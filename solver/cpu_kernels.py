@@ -1,5 +1,6 @@
-"""The cpu backend's compiled loops (numba): a tunnel step is two calls, one fused pull-stream +
-collide pass over the grid (rows in parallel) and one serial pass over what the boundaries own.
+"""The cpu backend's compiled loops (numba): n tunnel steps in one call, each a serial pass over
+what the boundaries own and one fused stream + collide pass over the grid (rows in parallel),
+streaming with the AA pattern between natural ends (`make_kernel`).
 
 docs/science/algorithm.md, steps 1-3, and docs/science/cpu-backend.md. The collision is node by
 node that of solver/collision.py (BGK, Bhatnagar, Gross & Krook 1954; TRT, Ginzburg, Verhaeghe &
@@ -10,8 +11,8 @@ compressible or He & Luo (1997) equilibrium and the outlet sponge's per-column r
 absorbing layer (solver/sponge.py). The boundary pass writes what rules d, c, b and a write in
 the numpy backend (solver/inflow.py's outlet and inlet, solver/quiet_inlet.py, the walls,
 solver/bouzidi.py's links with the moving-wall term), sums the momentum exchange on the links
-(solver/forces/momentum_exchange.py), recollides the nodes that own such a population and resets
-the solid nodes. Populations are shifted, g_i = f_i - w_i RHO0; the collision's arithmetic is in
+(solver/forces/momentum_exchange.py); the grid pass takes those populations at the nodes that own
+them, and the solid nodes are reset. Populations are shifted, g_i = f_i - w_i RHO0; the collision's arithmetic is in
 the storage's precision (float32 as numpy's and gl's, or float64) with its constants in a tuple K
 of that type (`constants`); the boundary rules are evaluated in float64, as numpy's. Lattice order
 as solver/lattice.py (0 rest, 1-4 E N W S, 5-8 NE NW SW SE); the module checks that order on
