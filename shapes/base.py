@@ -42,6 +42,13 @@ class Shape(ABC):
     def outline(self) -> np.ndarray:
         """(k, 2) closed polygon of the boundary in world coordinates, for drawing."""
 
+    def reference_length(self) -> float:
+        """The length a section's coefficients are referred to (the polar's C_L and C_D): the
+        shape's own size where it has one (a cylinder's diameter, a plate's or wedge's length,
+        an airfoil's chord), else the larger side of its bounding box."""
+        x0, y0, x1, y1 = self.bounding_box()
+        return float(max(x1 - x0, y1 - y0))
+
     @abstractmethod
     def frontal_area(self, flow_direction) -> float:
         """Width of the body seen along `flow_direction` (2D: area per unit span)."""

@@ -35,6 +35,9 @@ class Cylinder(Shape):
     def radius(self) -> float:
         return 0.5 * self.diameter
 
+    def reference_length(self) -> float:
+        return float(self.diameter)
+
     def contains(self, px, py):
         px = np.asarray(px, dtype=np.float64)
         py = np.asarray(py, dtype=np.float64)

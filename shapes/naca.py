@@ -94,6 +94,9 @@ class NacaAirfoil(PolygonalShape):
 
     kind = "naca"
 
+    def reference_length(self) -> float:
+        return float(self.chord)
+
     def __init__(self, chord, thickness=0.12, camber=0.0, camber_position=0.4, x=0.0, y=0.0, angle=0.0):
         object.__setattr__(self, "chord", positive_number("naca chord", chord))
         object.__setattr__(self, "thickness", _fraction("naca thickness", thickness, MIN_THICKNESS, MAX_THICKNESS))

@@ -342,6 +342,9 @@ class FlatPlate(PolygonalShape):
 
     kind = "plate"
 
+    def reference_length(self) -> float:
+        return float(self.length)
+
     def __init__(self, length, thickness, x=0.0, y=0.0, angle=0.0):
         object.__setattr__(self, "length", positive_number("plate length", length))
         object.__setattr__(self, "thickness", positive_number("plate thickness", thickness))
@@ -378,6 +381,9 @@ class Wedge(PolygonalShape):
     pointing: str = "upstream"
 
     kind = "wedge"
+
+    def reference_length(self) -> float:
+        return float(self.length)
 
     def __init__(self, length, apex_angle, pointing="upstream", x=0.0, y=0.0, angle=0.0):
         object.__setattr__(self, "length", positive_number("wedge length", length))
@@ -425,6 +431,9 @@ class HalfAirfoil(PolygonalShape):
     thickness: float = 1.0
 
     kind = "half_airfoil"
+
+    def reference_length(self) -> float:
+        return float(self.chord)
 
     def __init__(self, chord, thickness, x=0.0, y=0.0, angle=0.0):
         object.__setattr__(self, "chord", positive_number("half_airfoil chord", chord))

@@ -131,6 +131,11 @@ class FlowSolver(Protocol):
         """sum f over the grid (a run's check that the flow is still finite)."""
         ...
 
+    def finish(self) -> None:
+        """Return once every step asked for has been computed (a GPU backend queues its work):
+        what a timing waits for."""
+        ...
+
     def close(self) -> None:
         """Release what the flow holds; unusable after."""
         ...
@@ -353,6 +358,10 @@ class Solver(ABC):
             raise SolverDiverged(self.time, f"the density reaches {hi if hi - 1.0 >= 1.0 - lo else lo:.3g}, "
                                             f"far from 1 (physical range 1 +- {allowed:g})")
         self._physical_checked_at = self.time
+
+    def finish(self) -> None:
+        """Return once every step asked for has been computed: at once on the CPU backends,
+        whose steps have returned by then; the gl backend waits for its GPU."""
 
     def close(self) -> None:
         """Release resources (GL objects); the solver is unusable after."""

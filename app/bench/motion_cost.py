@@ -44,14 +44,11 @@ def _run(backend: str, towed: bool, grid, steps: int, warmup: int) -> float:
         script = MotionScript([Phase(warmup + steps + 10, (-SPEED, 0.0))] if towed else [])
         runner = MotionRunner(solver, body, script)
         runner.advance(warmup)
-        finish = getattr(solver, "finish", None)
-        if finish:
-            finish()
+        solver.finish()
         t0 = time.perf_counter()
         for _ in range(steps // 10):     # the window's frames: 10 steps each
             runner.advance(10)
-        if finish:
-            finish()
+        solver.finish()
         return (time.perf_counter() - t0) / (steps // 10 * 10)
     finally:
         solver.close()

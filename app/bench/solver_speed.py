@@ -117,9 +117,7 @@ class SceneRun:
             done += chunk
             if self.scene == "tunnel" and self.moves:
                 self._move()
-        finish = getattr(self.solver, "finish", None)
-        if finish is not None:
-            finish()
+        self.solver.finish()
 
 
 def measure(run: SceneRun, seconds: float, warmup: int = 20) -> dict:

@@ -13,7 +13,7 @@ import numpy as np
 
 from feelflow.shapes.base import Shape, ShapeError
 from feelflow.shapes.io import from_dict
-from feelflow.shapes.polygon import PolygonalShape, polygon_area_centroid
+from feelflow.shapes.polygon import Polygon, PolygonalShape, polygon_area_centroid
 
 #: shape-dict keys that are lengths (scaled with the resolution); angles are not
 LENGTH_KEYS = ("diameter", "length", "thickness", "chord", "x", "y")
@@ -145,7 +145,7 @@ def check_shape(exercise, shape: Shape) -> list[str]:
                                  c.frontal_height, " cells", 2))
     if c.length is not None:
         problems.append(_outside("the length (along the stream)", streamwise_length(shape), c.length, " cells"))
-    if c.vertices is not None and hasattr(shape, "vertices"):
+    if c.vertices is not None and isinstance(shape, Polygon):
         n = len(shape.vertices)
         lo, hi = c.vertices
         if n < lo:

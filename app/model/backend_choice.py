@@ -135,7 +135,6 @@ def time_backend(name: str, config, make_solver, seconds: float = SECONDS, setup
         if setup is not None:
             setup(solver)
         body = solver.body
-        finish = getattr(solver, "finish", None)
 
         def advance(n):
             solver.step(n)
@@ -143,13 +142,11 @@ def time_backend(name: str, config, make_solver, seconds: float = SECONDS, setup
                 solver.set_body(body.shape, velocity=body.velocity, omega=body.omega)
 
         advance(WARMUP_STEPS)
-        if finish is not None:
-            finish()
+        solver.finish()
         steps, t0 = 0, time.perf_counter()
         while True:
             advance(MOVE_EVERY)
-            if finish is not None:
-                finish()
+            solver.finish()
             steps += MOVE_EVERY
             elapsed = time.perf_counter() - t0
             if elapsed >= seconds:

@@ -221,13 +221,9 @@ def max_lift_fit(points, half_width: float = 8.0) -> tuple[float, float] | None:
 
 
 def chord_of(shape) -> float:
-    """The length the coefficients are referred to: a section's chord, else the body's extent
-    along its own axis (a cylinder's diameter)."""
-    for name in ("chord", "diameter", "length"):
-        if hasattr(shape, name):
-            return float(getattr(shape, name))
-    x0, y0, x1, y1 = shape.bounding_box()
-    return float(max(x1 - x0, y1 - y0))
+    """The length the coefficients are referred to (shapes' `reference_length`: a section's
+    chord, a cylinder's diameter, a plate's length)."""
+    return shape.reference_length()
 
 
 def run_sweep(solver, shape, sweep: PolarSweep, model: str = "momentum_exchange", probe=None,

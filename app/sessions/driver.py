@@ -320,6 +320,9 @@ class SessionSolver:
             self.recorder.record_parameter("resume")
         self.paused = False
 
+    def finish(self) -> None:
+        self._solver.finish()
+
     def close(self) -> None:
         self._solver.close()
 

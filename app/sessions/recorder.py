@@ -68,10 +68,9 @@ class SessionRecorder:
     @classmethod
     def from_scene(cls, scene, *, scene_toml: str | None = None, backend: str | None = None,
                    renderer: str | None = None) -> "SessionRecorder":
-        """A recorder for an `feelflow.app.model.scene.Scene` (anything with config, body, force_models,
-        backend, source)."""
+        """A recorder for an `feelflow.app.model.scene.Scene`."""
         return cls(scene.config, scene.body, scene.force_models, backend=backend or scene.backend,
-                   renderer=renderer, scene_toml=scene_toml, scene_source=getattr(scene, "source", None))
+                   renderer=renderer, scene_toml=scene_toml, scene_source=scene.source)
 
     def _room(self, key: str, steps: int = 0, json_bytes: int = 0) -> bool:
         """True if one more `key` row (and `steps` more steps) stays within the session bound;
