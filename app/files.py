@@ -221,12 +221,15 @@ def write_or_rescue(path, write, option: str = "output") -> pathlib.Path:
         return pathlib.Path(path)
     except OSError as exc:
         reason = exc.strerror or str(exc)
+        saved = None
         try:
             saved = rescue_path(path)
             write(saved)
             where = f"the work was saved to {saved} instead"
         except OSError as exc2:
             where = f"and the rescue copy failed too ({exc2.strerror or exc2})"
+            if saved is not None:  # no empty rescue file left behind
+                saved.unlink(missing_ok=True)
         raise OutputError(f"{option}: cannot write {shown_path(path)!r} ({reason}); {where}") from None
 
 

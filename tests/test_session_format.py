@@ -195,7 +195,12 @@ def test_bad_manifest_or_parameters(good, tmp_path, edit, words):
 
 
 def test_atomic_write_keeps_the_old_file_when_writing_fails(good, tmp_path, monkeypatch):
+    import tempfile
+
     path, rec = good
+    rescue = tmp_path / "rescue"   # the temp folder the rescue copies go to
+    rescue.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(rescue))
     target = tmp_path / "keep.ffsession"
     target.write_bytes(path.read_bytes())
     before = target.read_bytes()
@@ -204,16 +209,21 @@ def test_atomic_write_keeps_the_old_file_when_writing_fails(good, tmp_path, monk
         raise OSError(28, "No space left on device")
 
     import feelflow.app.files
+    real_fsync = os.fsync
     monkeypatch.setattr(feelflow.app.files.os, "fsync", disk_full)  # the fsync of every atomic write
     with pytest.raises(SessionError, match="No space left on device") as info:
         rec.save(target)
     assert "\n" not in str(info.value)
-    monkeypatch.undo()
+    monkeypatch.setattr(feelflow.app.files.os, "fsync", real_fsync)
     assert target.read_bytes() == before
-    assert sorted(os.listdir(tmp_path)) == ["keep.ffsession"]  # no temp file left behind
+    assert sorted(os.listdir(tmp_path)) == ["keep.ffsession", "rescue"]  # no temp file left behind
+    assert os.listdir(rescue) == []   # nor an empty rescue copy: that write failed too
     load_session(target)
-    with pytest.raises(SessionError, match="cannot write"):
+    with pytest.raises(SessionError, match="cannot write") as info:
         rec.save(tmp_path / "no" / "such" / "dir.ffsession")
+    (saved,) = rescue.iterdir()   # the work went to the rescue copy the line names
+    assert str(saved) in str(info.value)
+    load_session(saved)
 
 
 def test_an_impossible_event_is_refused_at_replay(good, tmp_path):
