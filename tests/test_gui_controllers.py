@@ -19,7 +19,11 @@ def test_the_flow_controller_works_without_the_window(qtbot, tmp_path):
     from feelflow.app.gui.viewport import Viewport
     from feelflow.app.gui.window.events import WindowEvents
     from feelflow.app.gui.window.flow import FlowController
+    from feelflow.app.gui.window.field_display import FieldDisplay
+    from feelflow.app.gui.window.flow_overlays import FlowOverlays
     from feelflow.app.gui.window.frame_loop import FrameLoop
+    from feelflow.app.gui.window.frame_rates import FrameRates
+    from feelflow.app.gui.window.frame_readouts import FrameReadouts
     from feelflow.app.gui.window.probes import ProbeController
     from feelflow.app.gui.window.replay_controller import ReplayController
     from feelflow.app.gui.window.units import UnitsController
@@ -30,7 +34,10 @@ def test_the_flow_controller_works_without_the_window(qtbot, tmp_path):
     events, viewport, panel, plot, status = WindowEvents(host), Viewport(), SidePanel(), ForcePlot(), QStatusBar()
     labels = {k: QLabel() for k in ("steps", "mlups", "fps", "re", "ma", "operator")}
     params = Params(grid=(96, 48), size=8.0)
-    loop = FrameLoop(events, viewport, panel, plot, status, labels, lambda: None, lambda: params, host)
+    display = FieldDisplay(viewport, panel, lambda: params, lambda: None)
+    rates = FrameRates()
+    loop = FrameLoop(events, viewport, plot, display, FlowOverlays(viewport, display),
+                     FrameReadouts(events, panel, plot, labels, display, rates), rates, status, lambda: None, host)
     probes = ProbeController(events, viewport, plot, loop, status, host)
     units = UnitsController(events, QSettings(str(tmp_path / "s.ini"), QSettings.IniFormat), panel, plot, probes,
                             loop, status, host)
@@ -52,5 +59,5 @@ def test_the_flow_controller_works_without_the_window(qtbot, tmp_path):
     flow.apply(wind=0.06)
     assert sim.params.wind == pytest.approx(0.06) and changed == [True]
     sim.advance(4)
-    loop.refresh_readouts()   # the panel, the plot and the status bar's numbers from the model
+    loop.readouts.refresh()   # the panel, the plot and the status bar's numbers from the model
     assert labels["re"].text() == f"Re {sim.reynolds():.0f}" and labels["operator"].text() == sim.operator_line()

@@ -165,7 +165,7 @@ def test_plot_overlay_exercise_panel_and_csv_agree_on_one_frame(window, qtbot, t
     assert rows[-1]["ref_length_cells"] == f"{length:g}"
 
     # the arrows of the last frame: length = |coefficient| x half the reference length
-    window.loop.update_arrows({model: sim.history.forces[model][-1]})
+    window.loop.overlays.update_arrows({model: sim.history.forces[model][-1]})
     arrows = window.viewport.arrow_forces
     ref = sim.reference_length()
     assert readouts.arrow_coefficient(arrows["drag"], ref) == pytest.approx(abs(float(rows[-1][f"{model}_cd"])), rel=1e-4)

@@ -75,7 +75,7 @@ def test_first_start_offers_the_lessons_once(qtbot, tmp_path):
     dialog.start_button.click()
     assert not dialog.isVisible()
     assert w.statusBar().currentMessage().startswith(PRESETS["lift"].title)
-    assert w.loop.display_mode == PRESETS["lift"].display
+    assert w.loop.display.mode == PRESETS["lift"].display
     w.loop.timer.stop()
     w.loop.slow_timer.stop()
     w.close()

@@ -31,7 +31,7 @@ def test_spin_boxes_show_their_units(window):
 def test_force_readouts_are_plain_decimals(window, qtbot):
     panel, sim = window.panel, window.sim
     qtbot.waitUntil(lambda: len(sim.history) > 30, timeout=20000)
-    window.loop.refresh_readouts()
+    window.loop.readouts.refresh()
     for label in (panel.drag, panel.lift):
         number = label.text().split()[0]
         assert "e" not in number.lower(), label.text()

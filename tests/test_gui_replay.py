@@ -103,7 +103,7 @@ def test_replay_in_the_window_and_stop_returns_to_the_live_tunnel(window, qtbot,
     # forces are averaged over the parts: equal up to rounding)
     np.testing.assert_allclose(values, session.forces["values"], rtol=1e-12, atol=1e-15)
     curve = window.plot.time_views.curves[(session.models[0], "drag")]
-    window.loop.refresh_readouts()
+    window.loop.readouts.refresh()
     x, y = curve.getData()
     np.testing.assert_array_equal(x, h.time)                        # the plot shows the replay
     assert np.isfinite(y).all()

@@ -38,7 +38,7 @@ def test_switch_units_and_convert_the_drag_by_hand(window, qtbot):  # noqa: F811
     size_m, span_m = 0.01, 0.1
     w.loop.set_paused(True)       # hold the flow still while the numbers are compared
     w.units.set_choice(UnitsChoice("water", size_m, span_m))
-    w.loop.refresh_readouts()
+    w.loop.readouts.refresh()
     w.plot.refresh(force=True)
     # readouts, plot axes and the probes' plot in SI
     assert w.panel.drag.text().endswith("(N)") and w.panel.lift.text().endswith("(N)")
@@ -78,7 +78,7 @@ def test_switch_units_and_convert_the_drag_by_hand(window, qtbot):  # noqa: F811
 
     # back to lattice units
     w.units.set_choice(UnitsChoice())
-    w.loop.refresh_readouts()
+    w.loop.readouts.refresh()
     assert "lattice units" in w.panel.drag.text() and not w.panel.physical.isVisible()
     assert w.plot.plot.getAxis("left").labelText == "force (lattice units)"
     assert "time_s" not in next(csv.reader(io.StringIO(w.plot.csv_text())))
@@ -112,7 +112,7 @@ def test_wind_box_in_metres_per_second_for_water(window, qtbot):  # noqa: F811
     assert "fixes it" in panel.viscosity.toolTip()
     # the solver is untouched, so Re is unchanged by the switch
     assert (w.sim.params.wind, w.sim.params.nu) == (wind_lattice, nu_lattice)
-    w.loop.refresh_readouts()
+    w.loop.readouts.refresh()
     assert w.sim.reynolds() == re_before and panel.reynolds.text() == f"Re = {re_before:.0f}"
 
     # back to lattice units: the boxes show the lattice values exactly as before

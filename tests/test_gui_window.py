@@ -49,11 +49,11 @@ def test_wind_and_viscosity_change_re_and_ma(window):
     panel, sim = window.panel, window.sim
     panel.wind.setValue(0.08)
     assert sim.params.wind == pytest.approx(0.08)
-    window.loop.refresh_readouts()
+    window.loop.readouts.refresh()
     assert panel.reynolds.text() == f"Re = {0.08 * 12 / sim.params.nu:.0f}"
     assert "Ma = 0.139" in panel.mach.text()
     panel.viscosity.setValue(0.04)
-    window.loop.refresh_readouts()
+    window.loop.readouts.refresh()
     assert sim.config.nu == pytest.approx(0.04)
     assert panel.reynolds.text() == f"Re = {0.08 * 12 / 0.04:.0f}"
 
@@ -72,7 +72,7 @@ def test_force_model_selector_drives_plot_and_readouts(window, qtbot):
     panel.model.setCurrentIndex(panel.model.findData("pressure"))
     n0 = len(sim.history)
     qtbot.waitUntil(lambda: len(sim.history) > n0 + 5, timeout=10000)
-    window.loop.refresh_readouts()
+    window.loop.readouts.refresh()
     assert set(sim.solver.forces()) == {"pressure"}
     _, drag, _ = sim.history.drag_lift("pressure")
     assert np.isfinite(drag[-3:]).all()
@@ -283,7 +283,7 @@ def test_settings_are_remembered(qtbot, tmp_path):
     w.remember()
     w2 = MainWindow(backend="numpy", settings=QSettings(path, QSettings.IniFormat))
     qtbot.addWidget(w2)
-    assert w2.params.wind == pytest.approx(0.07) and w2.loop.display_mode == "vorticity"
+    assert w2.params.wind == pytest.approx(0.07) and w2.loop.display.mode == "vorticity"
     assert w2.panel.wind.value() == pytest.approx(0.07) and w2.params.grid == GRID
     w.loop.timer.stop()
     w2.show()                                   # the custom polygon comes back too
@@ -309,7 +309,7 @@ def test_each_lesson_preset_loads_its_scene_and_runs(window, qtbot, key):
     sim = window.sim
     assert (sim.config.nx, sim.config.ny) == (scene.config.nx, scene.config.ny)
     assert sim.shape.kind == scene.body.kind and sim.config.nu == pytest.approx(scene.config.nu)
-    assert window.loop.display_mode == PRESETS[key].display
+    assert window.loop.display.mode == PRESETS[key].display
     qtbot.waitUntil(lambda: sim.solver.time > 30, timeout=20000)
     if key == "seed_protocol":
         assert sim.runner is not None and sim.script_phase()[2] == "stopped"

@@ -145,7 +145,7 @@ class ExerciseController(QObject):
         self.shape.install(start)
         self.attempts.load(exercise)
         self.menu.set_open(True)
-        self.side_panel.show_params(self.sim.params, self.loop.display_mode)
+        self.side_panel.show_params(self.sim.params, self.loop.display.mode)
         self.flow.after_rebuild()
         self.loop.set_paused(False)
         self.timer.start()

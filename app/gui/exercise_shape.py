@@ -88,6 +88,6 @@ class StudentShape(QObject):
         return True
 
     def _shown(self):
-        self.side_panel.show_params(self.sim.params, self.loop.display_mode)
+        self.side_panel.show_params(self.sim.params, self.loop.display.mode)
         self.viewport.update()
         self.changed.emit()

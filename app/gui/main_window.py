@@ -6,7 +6,10 @@ through `events.liveCreated`:
 
     window.store    settings.py    WindowSettings: remembered parameters, polygon, mode, geometry
     window.actions  menus.py       the menus, shortcuts and replay toolbar (`build_menus`)
-    window.loop     frame_loop.py  FrameLoop: adaptive stepping, pause, display mode, readouts
+    window.loop     frame_loop.py  FrameLoop: the frame timer, adaptive stepping, pause; its parts:
+      .display      field_display.py  FieldDisplay: the display mode, the field into the viewport
+      .overlays     flow_overlays.py  FlowOverlays: tracers, force arrows, torque arc
+      .readouts     frame_readouts.py FrameReadouts: panel numbers, plot, status bar (rates: frame_rates.py)
     window.replays  replay_controller.py  ReplayController: recording, and replaying a session
     window.inputs   input_controller.py   InputController: mouse or haptic device; body input to the model
     window.bodies   bodies.py      BodyController: shape, polygon editor (undo), turning the body
@@ -51,7 +54,11 @@ from feelflow.app.gui.window.backend_controller import BackendController  # noqa
 from feelflow.app.gui.window.bodies import BodyController  # noqa: E402
 from feelflow.app.gui.window.exports import ExportController  # noqa: E402
 from feelflow.app.gui.window.flow import FlowController  # noqa: E402
+from feelflow.app.gui.window.field_display import FieldDisplay  # noqa: E402
+from feelflow.app.gui.window.flow_overlays import FlowOverlays  # noqa: E402
 from feelflow.app.gui.window.frame_loop import FrameLoop  # noqa: E402
+from feelflow.app.gui.window.frame_rates import FrameRates  # noqa: E402
+from feelflow.app.gui.window.frame_readouts import FrameReadouts  # noqa: E402
 from feelflow.app.gui.window.input_controller import InputController  # noqa: E402
 from feelflow.app.gui.window.lessons import LessonController  # noqa: E402
 from feelflow.app.gui.window.events import WindowEvents  # noqa: E402
@@ -97,8 +104,11 @@ class MainWindow(QMainWindow):
         # controllers, and the events they tell each other (window/events.py)
         self.events = WindowEvents(self)
         vp, events, panel, plot, status = self.viewport, self.events, self.panel, self.plot, self.statusBar()
-        self.loop = loop = FrameLoop(events, vp, panel, plot, status, self.status, self.make_current, self.params_now,
-                                     self)
+        display = FieldDisplay(vp, panel, self.params_now, self.make_current)
+        rates = FrameRates()
+        readouts = FrameReadouts(events, panel, plot, self.status, display, rates)
+        self.loop = loop = FrameLoop(events, vp, plot, display, FlowOverlays(vp, display), readouts, rates, status,
+                                     self.make_current, self)
         self.probes = ProbeController(events, vp, plot, loop, status, self)
         self.plot.export.probes = self.probes.probes   # the forces CSV carries the probes' columns
         self.units = UnitsController(events, self.settings, panel, plot, self.probes, loop, status, self)
@@ -119,8 +129,8 @@ class MainWindow(QMainWindow):
         self.actions = build_menus(self)
 
         self.params = params or self.store.params()
-        self.loop.display_mode = self.store.display_mode(DISPLAY_MODES)
-        self.panel.show_params(self.params, self.loop.display_mode)
+        self.loop.display.mode = self.store.display_mode(DISPLAY_MODES)
+        self.panel.show_params(self.params, self.loop.display.mode)
         self._connect()
         self.store.restore_geometry(self)
 
@@ -147,7 +157,7 @@ class MainWindow(QMainWindow):
         p.gridChanged.connect(self.flow.set_grid)
         p.forceModelChanged.connect(lambda m: self.flow.set_force_models(selected=m))
         p.compareAllToggled.connect(lambda on: self.flow.set_force_models(compare_all=on))
-        p.displayModeChanged.connect(self.loop.set_display_mode)
+        p.displayModeChanged.connect(self.loop.display.set_mode)
         p.arrowsToggled.connect(lambda on: setattr(self.viewport, "show_arrows", on))
         p.inputChanged.connect(self.inputs.set_input)
         vp.contextReady.connect(self.on_context)
@@ -208,15 +218,15 @@ class MainWindow(QMainWindow):
             self.bodies.install_default_polygon()
 
     def _simulation_started(self):
-        self.viewport.mode = self.loop.display_mode
+        self.viewport.mode = self.loop.display.mode
         self.events.shownChanged.emit(self.sim)   # the viewport and the plot show it, its field drawn
-        self.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.panel.show_params(self.sim.params, self.loop.display.mode)
         self.status["renderer"].setText(self.backends.status_text(self.viewport.renderer().split(' (')[0], self.backend))
         self.status["renderer"].setToolTip(f"{self.viewport.renderer()}; {self.backends.description}")
         self.inputs.refresh_devices()
         self.flow.say_guard()
         self.loop.start()
-        self.loop.refresh_readouts()
+        self.loop.readouts.refresh()
         self.units.start()
         if not self.statusBar().currentMessage():   # a note about ignored settings comes first
             self.statusBar().showMessage(MOUSE_HINT, 20000)
@@ -237,7 +247,7 @@ class MainWindow(QMainWindow):
     def remember(self):
         """What the next start comes back to (app/gui/window/settings.py)."""
         self.store.remember(self.params_now(), self.sim.polygon if self.sim is not None else None,
-                        self.loop.display_mode, self.saveGeometry())
+                        self.loop.display.mode, self.saveGeometry())
 
     def closeEvent(self, ev):
         self.remember()

@@ -139,7 +139,7 @@ class SelfTest:
         fresh = drag[n0:]
         if len(fresh) == 0 or not np.isfinite(fresh).any():
             self.failures.append("the plot got no data from the pressure model")
-        w.loop.refresh_readouts()
+        w.loop.readouts.refresh()
         self._save_screenshot()
 
     def _measure_frames(self):
@@ -180,7 +180,7 @@ class SelfTest:
                 return
             w.plot.view.setCurrentIndex(index)
             yield from self._wait(1.5)
-        w.loop.refresh_readouts()
+        w.loop.readouts.refresh()
         w.plot.refresh(force=True)
         self.results["grid"] = f"{sim.config.nx}x{sim.config.ny}"
         polar = sim.polar

@@ -75,7 +75,7 @@ class BodyController:
         except (ShapeError, ConfigError, ValueError) as exc:
             self.flow.refuse_dialog("This shape cannot be used", exc)
             return False
-        self.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.panel.show_params(self.sim.params, self.loop.display.mode)
         if self.flow.say_guard():
             self.flow.after_rebuild()
         self.viewport.update()
@@ -98,7 +98,7 @@ class BodyController:
             self.sim.set_shape(kind="polygon", polygon=verts)
         except (ShapeError, ValueError) as exc:
             self.flow.refuse_dialog("This shape cannot be used", exc)
-        self.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.panel.show_params(self.sim.params, self.loop.display.mode)
 
     def install_loaded_shape(self, shape):
         """A shape read from a file (app/gui/window/exports.py): a polygon is an undoable edit."""
@@ -226,5 +226,5 @@ class BodyController:
     def _install_polygon(self, verts):
         self.make_current()
         self.sim.set_shape(kind="polygon", polygon=[tuple(v) for v in verts])
-        self.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.panel.show_params(self.sim.params, self.loop.display.mode)
         self.viewport.update()

@@ -46,14 +46,14 @@ class FlowController:
 
     def _replay_stopped(self, _paused: bool):
         """Back on the live tunnel: the panel shows its parameters, the status bar its operator."""
-        self.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.panel.show_params(self.sim.params, self.loop.display.mode)
         self.after_rebuild()
 
     def _guard_acted(self):
         """The local stability guard raised the viscosity: the status bar says so, the panel
         shows it, and the tunnel's followers follow."""
         self.say_guard()
-        self.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.panel.show_params(self.sim.params, self.loop.display.mode)
         self.after_rebuild()
 
     def apply(self, **changes):
@@ -67,7 +67,7 @@ class FlowController:
             self.refuse_dialog("This flow setting cannot be used", exc)
             return
         if self.say_guard():
-            self.panel.show_params(self.sim.params, self.loop.display_mode)
+            self.panel.show_params(self.sim.params, self.loop.display.mode)
         self.after_rebuild()
 
     def set_grid(self, grid):
@@ -86,7 +86,7 @@ class FlowController:
         if self.sim is not None and not self.replays.refuse("the scene cannot be changed"):
             self.make_current()
             self.sim.set_force_models(selected=selected, compare_all=compare_all)
-            self.loop.refresh_readouts()
+            self.loop.readouts.refresh()
             self.plot.refresh(force=True)
 
     def reset(self, _=None):
@@ -113,4 +113,4 @@ class FlowController:
     def refuse_dialog(self, title, exc):
         """A change the model refused: one-line dialog, the panel back at the model's values."""
         QMessageBox.warning(self.parent, title, str(exc))
-        self.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.panel.show_params(self.sim.params, self.loop.display.mode)

@@ -62,10 +62,10 @@ class LessonController:
             self.sim.start_sweep(lesson.wind_sweep, lesson.hold_steps)
         if lesson.angle_sweep:
             self.sim.start_polar(lesson.angle_sweep)
-        self.loop.set_display_mode(lesson.display)
+        self.loop.display.set_mode(lesson.display)
         self.plot.view.setCurrentIndex(self.plot.view.findData(lesson.plot_view))
         self.viewport.tracers = None
-        self.panel.show_params(self.sim.params, self.loop.display_mode)
+        self.panel.show_params(self.sim.params, self.loop.display.mode)
         self.flow.after_rebuild()
         self.loop.set_paused(False)
         self.status.showMessage(f"{lesson.title}: {lesson.note}", 20000)

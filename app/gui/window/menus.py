@@ -95,7 +95,7 @@ def build_menus(w: "MainWindow") -> Actions:
     add_action(w, v, "Full screen", lambda _=False: w.showNormal() if w.isFullScreen() else w.showFullScreen(), "F11")
     v.addSeparator()
     for key, mode in DISPLAY_MODES.items():
-        add_action(w, v, mode.label, lambda _=False, k=key: w.loop.set_display_mode(k))
+        add_action(w, v, mode.label, lambda _=False, k=key: w.loop.display.set_mode(k))
     p = bar.addMenu("&Presets")
     for key, preset in PRESETS.items():
         add_action(w, p, preset.title, lambda _=False, k=key: w.lessons.apply(k))

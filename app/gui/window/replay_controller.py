@@ -187,7 +187,7 @@ class ReplayController:
                                   6000)
         p = self.panel
         if self.sim is not None:
-            p.show_params(self.sim.params, self.loop.display_mode)
+            p.show_params(self.sim.params, self.loop.display.mode)
             for box, on in ((p.hold_still, self.sim.hold_still), (p.edit, self.viewport.editing)):
                 box.blockSignals(True)
                 box.setChecked(on)

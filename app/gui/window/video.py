@@ -97,7 +97,7 @@ class VideoController:
         check_output(out, "video", inputs=[session_path], force=force, hint="choose another name")
         session = load_session(session_path)
         backend = session.backend if session.backend in RENDER_BACKENDS else "numpy"
-        mode = self.loop.display_mode if self.loop.display_mode in ("speed", "vorticity", "pressure") else "speed"
+        mode = self.loop.display.mode if self.loop.display.mode in ("speed", "vorticity", "pressure") else "speed"
         render = SessionRender(session, out, backend=backend, steps_per_frame=steps_per_frame, width=width, mode=mode)
         return VideoExportJob(render, self.parent)
 
