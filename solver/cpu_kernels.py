@@ -54,10 +54,8 @@ _MIRROR_Y = np.array([0, 1, 4, 3, 2, 8, 7, 6, 5], dtype=np.int64)
 WALLS = {"periodic": 0, "no_slip": 1, "free_slip": 2}
 
 _JIT = dict(cache=True, nogil=True, error_model="numpy", fastmath={"contract", "arcp", "nsz", "reassoc"})
-#: the tunnel kernel's parallelism: its prange over blocks of rows and nothing else. numba would
-#: also turn each array expression and slice copy into a parallel loop of its own (dozens in the
-#: kernel, run serially inside the prange anyway) and fuse loops: that tripled the compile time
-#: of a variant and may reorder a step's passes
+#: the tunnel kernel's parallelism: its prange over blocks of rows and nothing else; numba must
+#: not fuse its loops (or turn its array expressions into loops of their own to fuse)
 _PARALLEL = {"prange": True, "fusion": False, "setitem": False, "numpy": False, "comprehension": False,
              "reduction": False, "inplace_binop": False, "stencil": False}
 
@@ -284,19 +282,6 @@ def _kbc_node(b, o, k, omega, keep, target, incomp, has_keep, Fx, Fy, has_force,
 
 
 @numba.njit(inline="always", **_JIT)
-def _store(out, y, x, r):
-    out[0, y, x] = r[0]
-    out[1, y, x] = r[1]
-    out[2, y, x] = r[2]
-    out[3, y, x] = r[3]
-    out[4, y, x] = r[4]
-    out[5, y, x] = r[5]
-    out[6, y, x] = r[6]
-    out[7, y, x] = r[7]
-    out[8, y, x] = r[8]
-
-
-@numba.njit(inline="always", **_JIT)
 def _store_k(o, k, r):
     o[0, k] = r[0]
     o[1, k] = r[1]
@@ -311,21 +296,6 @@ def _store_k(o, k, r):
 
 #: columns per chunk: the pulled populations and the results of a chunk stay in L1
 CHUNK = 128
-
-
-@numba.njit(inline="always", **_JIT)
-def _gather(g, b, y, ym, yp, x0, n):
-    """b[:, :n] = the populations pulled to nodes (y, x0 .. x0+n-1), 1 <= x0, x0 + n < nx."""
-    x1 = x0 + n
-    b[0, :n] = g[0, y, x0:x1]
-    b[1, :n] = g[1, y, x0 - 1:x1 - 1]
-    b[2, :n] = g[2, ym, x0:x1]
-    b[3, :n] = g[3, y, x0 + 1:x1 + 1]
-    b[4, :n] = g[4, yp, x0:x1]
-    b[5, :n] = g[5, ym, x0 - 1:x1 - 1]
-    b[6, :n] = g[6, ym, x0 + 1:x1 + 1]
-    b[7, :n] = g[7, yp, x0 + 1:x1 + 1]
-    b[8, :n] = g[8, yp, x0 - 1:x1 - 1]
 
 
 @numba.njit(inline="always", **_JIT)
@@ -398,29 +368,6 @@ def _columns_rr(b, o, n, cols, op, keep, t, incomp, has_keep, Fx, Fy, has_force,
         _store_k(o, k, r)
         s += r[9]
     return s
-
-
-@numba.njit(inline="always", **_JIT)
-def _pull(g, y, ym, yp, x, xm, xp):
-    return (g[0, y, x], g[1, y, xm], g[2, ym, x], g[3, y, xp], g[4, yp, x],
-            g[5, ym, xm], g[6, ym, xp], g[7, yp, xp], g[8, yp, xm])
-
-
-@numba.njit(inline="always", **_JIT)
-def _gather_node(g, b, k, y, ym, yp, x):
-    """b[:, k] = the populations pulled to node (y, x), periodic neighbours."""
-    nx = g.shape[2]
-    xm = x - 1 if x > 0 else nx - 1
-    xp = x + 1 if x < nx - 1 else 0
-    b[0, k] = g[0, y, x]
-    b[1, k] = g[1, y, xm]
-    b[2, k] = g[2, ym, x]
-    b[3, k] = g[3, y, xp]
-    b[4, k] = g[4, yp, x]
-    b[5, k] = g[5, ym, xm]
-    b[6, k] = g[6, ym, xp]
-    b[7, k] = g[7, yp, xp]
-    b[8, k] = g[8, yp, xm]
 
 
 @numba.njit(inline="always", **_JIT)
