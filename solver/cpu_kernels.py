@@ -374,15 +374,8 @@ def _columns_rr(b, o, n, cols, op, keep, t, incomp, has_keep, Fx, Fy, has_force,
 def _wall_in(b, pre, y, x0, n, lower):
     """b[i, :n] = pre[i, y, x0 .. x0+n-1] for the populations a wall at y = -1/2 (lower) or
     ny - 1/2 writes: rule b on a wall row's chunk inside the parallel pass."""
-    x1 = x0 + n
-    if lower:
-        b[2, :n] = pre[2, y, x0:x1]
-        b[5, :n] = pre[5, y, x0:x1]
-        b[6, :n] = pre[6, y, x0:x1]
-    else:
-        b[4, :n] = pre[4, y, x0:x1]
-        b[7, :n] = pre[7, y, x0:x1]
-        b[8, :n] = pre[8, y, x0:x1]
+    for i in ((2, 5, 6) if lower else (4, 7, 8)):
+        _copy_in(b, i, pre[i, y, x0:x0 + n], n)
 
 
 #: the lattice velocities as integers, for the layout accessors
